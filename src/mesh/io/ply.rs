@@ -1,0 +1,136 @@
+//! PLY through `ply-rs-bw`: ASCII, binary little- and big-endian; positions of any numeric type;
+//! faces as `face` lists (`vertex_indices` or `vertex_index`) or `tristrips` (−1 separated
+//! strips, alternate triangles flipped to keep one orientation). Other elements and properties
+//! are read past and ignored.
+
+use crate::error::{Error, Result};
+use crate::mesh::TriMesh;
+use glam::DVec3;
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{Property, PropertyAccess, PropertyAccessResult};
+
+/// One PLY element as we need it: a position, an index list, or neither.
+#[derive(Default)]
+struct Record {
+    xyz: [f64; 3],
+    indices: Vec<i64>,
+}
+
+fn scalar(p: &Property) -> Option<f64> {
+    Some(match *p {
+        Property::Char(v) => v as f64,
+        Property::UChar(v) => v as f64,
+        Property::Short(v) => v as f64,
+        Property::UShort(v) => v as f64,
+        Property::Int(v) => v as f64,
+        Property::UInt(v) => v as f64,
+        Property::Float(v) => v as f64,
+        Property::Double(v) => v,
+        _ => return None,
+    })
+}
+
+fn integer_list(p: Property) -> Option<Vec<i64>> {
+    fn widen<T: Copy + Into<i64>>(v: Vec<T>) -> Vec<i64> {
+        v.into_iter().map(Into::into).collect()
+    }
+    Some(match p {
+        Property::ListChar(v) => widen(v),
+        Property::ListUChar(v) => widen(v),
+        Property::ListShort(v) => widen(v),
+        Property::ListUShort(v) => widen(v),
+        Property::ListInt(v) => widen(v),
+        Property::ListUInt(v) => widen(v),
+        _ => return None,
+    })
+}
+
+impl PropertyAccess for Record {
+    fn new() -> Self {
+        Record::default()
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        let axis = match name {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            "vertex_indices" | "vertex_index" => {
+                return match integer_list(property) {
+                    Some(list) => {
+                        self.indices = list;
+                        PropertyAccessResult::Set
+                    }
+                    None => PropertyAccessResult::UnsupportedType,
+                };
+            }
+            _ => return PropertyAccessResult::Ignored,
+        };
+        match scalar(&property) {
+            Some(v) => {
+                self.xyz[axis] = v;
+                PropertyAccessResult::Set
+            }
+            None => PropertyAccessResult::UnsupportedType,
+        }
+    }
+}
+
+pub fn read(bytes: &[u8]) -> Result<TriMesh> {
+    let parser = Parser::<Record>::new();
+    let mut source = bytes;
+    let ply = parser
+        .read_ply(&mut source)
+        .map_err(|e| Error::mesh(format!("PLY: {e}")))?;
+    let vertex_def = ply
+        .header
+        .elements
+        .get("vertex")
+        .ok_or_else(|| Error::mesh("PLY: no vertex element"))?;
+    for axis in ["x", "y", "z"] {
+        if !vertex_def.properties.contains_key(axis) {
+            return Err(Error::mesh(format!("PLY: vertex has no '{axis}' property")));
+        }
+    }
+    let positions: Vec<DVec3> = ply
+        .payload
+        .get("vertex")
+        .map(|v| v.iter().map(|r| DVec3::from(r.xyz)).collect())
+        .unwrap_or_default();
+    let n = positions.len() as i64;
+    let index = |i: i64| -> Result<u32> {
+        if (0..n).contains(&i) {
+            Ok(i as u32)
+        } else {
+            Err(Error::mesh(format!(
+                "PLY: face index {i} out of range ({n} vertices)"
+            )))
+        }
+    };
+    let mut faces = Vec::new();
+    for record in ply.payload.get("face").into_iter().flatten() {
+        let polygon = record
+            .indices
+            .iter()
+            .map(|&i| index(i))
+            .collect::<Result<Vec<u32>>>()?;
+        super::text::fan(&polygon, &mut faces);
+    }
+    for record in ply.payload.get("tristrips").into_iter().flatten() {
+        for strip in record.indices.split(|&i| i < 0) {
+            let strip = strip.iter().map(|&i| index(i)).collect::<Result<Vec<u32>>>()?;
+            for (k, w) in strip.windows(3).enumerate() {
+                let tri = if k % 2 == 0 {
+                    [w[0], w[1], w[2]]
+                } else {
+                    [w[1], w[0], w[2]]
+                };
+                // Strips repeat a vertex to turn corners; those triangles are not faces.
+                if tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2] {
+                    faces.push(tri);
+                }
+            }
+        }
+    }
+    Ok(TriMesh::new(positions, faces))
+}
