@@ -106,7 +106,10 @@ impl Header {
             bits,
         };
         if !floats.iter().all(|f| f.is_finite()) || !grid.cell.iter().all(|&c| c > 0.0) {
-            return Err(bad(pos - 48, "grid origin or cell size is not a finite positive number"));
+            return Err(bad(
+                pos - 48,
+                "grid origin or cell size is not a finite positive number",
+            ));
         }
         let vertices = count(&mut pos, "vertices", limits::MAX_VERTICES)?;
         let triangles = count(&mut pos, "triangles", limits::MAX_TRIANGLES)?;
@@ -213,7 +216,11 @@ impl<'a> StreamReader<'a> {
                 return Ok(None);
             }
             Err(varint::VarintFault::Overflow) => {
-                return Err(Error::malformed(self.next_level, self.pos, "level length overflows"))
+                return Err(Error::malformed(
+                    self.next_level,
+                    self.pos,
+                    "level length overflows",
+                ))
             }
         };
         let available = (self.bytes.len() - pos) as u64;

@@ -32,7 +32,7 @@ pub enum Error {
     #[error("{0}")]
     InvalidMesh(MeshFault),
     /// Operating-system I/O failure.
-    #[error("{0}")]
+    #[error(transparent)]
     Io(#[from] std::io::Error),
 }
 

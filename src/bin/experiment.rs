@@ -1,1 +1,228 @@
-fn main(){}
+//! `experiment <codec> <mesh>`: encode, decode every level, measure, write results and plots,
+//! print the level table. `experiment run FILE.toml`: a set of codecs × meshes × quantizations,
+//! with one comparison chart per mesh.
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use meshcodec::codecs::{self, Codec};
+use meshcodec::harness::{self, RunOptions, RunResult};
+use meshcodec::mesh::io::{mesh_name, resolve};
+use meshcodec::mesh::quantize::GridShape;
+use meshcodec::plot;
+use serde::Deserialize;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(version, about, args_conflicts_with_subcommands = true)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+    /// Codec name (raw, …).
+    codec: Option<String>,
+    /// Mesh file, or a name looked up in $MESHCODEC_DATA and ../shared/meshes.
+    mesh: Option<String>,
+    #[command(flatten)]
+    settings: Settings,
+}
+
+#[derive(clap::Args, Clone)]
+struct Settings {
+    /// Quantization bits per axis (default: the codec's).
+    #[arg(long)]
+    quant: Option<u8>,
+    /// Grid shape: cubic (DESIGN.md A2) or per-axis.
+    #[arg(long, value_parser = parse_grid)]
+    grid: Option<GridShape>,
+    /// Random samples per original triangle for the error metrics.
+    #[arg(long, default_value_t = meshcodec::metrics::DEFAULT_SAMPLES_PER_TRIANGLE)]
+    samples: usize,
+    /// Folder for results.
+    #[arg(long, default_value = "results")]
+    out: PathBuf,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run an experiment set (experiments/*.toml).
+    Run {
+        /// The set's TOML file.
+        file: PathBuf,
+        #[command(flatten)]
+        settings: Settings,
+    },
+}
+
+fn parse_grid(s: &str) -> Result<GridShape, String> {
+    match s {
+        "cubic" => Ok(GridShape::Cubic),
+        "per-axis" => Ok(GridShape::PerAxis),
+        _ => Err(format!("unknown grid '{s}' (cubic, per-axis)")),
+    }
+}
+
+/// An experiment set: every codec on every mesh at every quantization.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExperimentSet {
+    /// What the set is for.
+    #[serde(default)]
+    description: String,
+    codecs: Vec<String>,
+    meshes: Vec<String>,
+    /// Quantization bits; absent: each codec's default.
+    #[serde(default)]
+    quant: Vec<u8>,
+    /// Samples per triangle for the metrics.
+    samples: Option<usize>,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let outcome = match &cli.command {
+        Some(Command::Run { file, settings }) => run_set(file, settings),
+        None => match (&cli.codec, &cli.mesh) {
+            (Some(codec), Some(mesh)) => run_one(codec, mesh, &cli.settings).map(|_| ()),
+            _ => Err(anyhow::anyhow!(
+                "usage: experiment <codec> <mesh> [--quant BITS] [--samples N] [--out DIR] | experiment run FILE"
+            )),
+        },
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line, whatever the error's text holds (DESIGN.md A6).
+            let message = format!("{e:#}").replace(['\n', '\t'], " ");
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
+    RunOptions {
+        quant_bits: quant.or(settings.quant),
+        grid: settings.grid,
+        samples_per_triangle: settings.samples,
+        progress: std::io::stderr().is_terminal(),
+    }
+}
+
+fn run_one(codec_name: &str, mesh: &str, settings: &Settings) -> Result<RunResult> {
+    let codec = codecs::by_name(codec_name)?;
+    let path = resolve(mesh).with_context(|| mesh.to_string())?;
+    run_codec(codec, &path, &run_options(settings, None), &settings.out)
+}
+
+fn run_codec(
+    codec: &dyn Codec,
+    path: &Path,
+    options: &RunOptions,
+    out: &Path,
+) -> Result<RunResult> {
+    let result = harness::run(codec, path, options).with_context(|| path.display().to_string())?;
+    println!(
+        "{} on {} ({}): {} vertices, {} triangles at {} bits; {} bytes = {:.3} bits/vertex, \
+         {:.3} bits/triangle",
+        result.codec,
+        result.mesh,
+        result.source,
+        result.vertices,
+        result.triangles,
+        result.quant_bits,
+        result.bytes,
+        result.bytes as f64 * 8.0 / result.vertices as f64,
+        result.bytes as f64 * 8.0 / result.triangles as f64,
+    );
+    print!("{}", harness::level_table(&result));
+    println!(
+        "encode {:.3} s, decode {:.4} s ({:.0} vertices/s); lossless: {}",
+        result.encode_seconds,
+        result.decode_seconds,
+        result.vertices as f64 / result.decode_seconds.max(1e-9),
+        match &result.lossless_error {
+            None => "yes".to_string(),
+            Some(e) => format!("NO — {e}"),
+        }
+    );
+    let stem = harness::result_stem(codec, &result);
+    let written = harness::write_result(&result, &stem, out)
+        .with_context(|| format!("writing results to {}", out.display()))?;
+    for path in written {
+        println!("wrote {}", path.display());
+    }
+    if !result.lossless {
+        anyhow::bail!("{} on {} is not lossless", result.codec, result.mesh);
+    }
+    Ok(result)
+}
+
+fn run_set(file: &Path, settings: &Settings) -> Result<()> {
+    let text = std::fs::read_to_string(file).with_context(|| file.display().to_string())?;
+    let set: ExperimentSet =
+        toml::from_str(&text).with_context(|| format!("{}: bad experiment set", file.display()))?;
+    let codecs = set
+        .codecs
+        .iter()
+        .map(|c| codecs::by_name(c))
+        .collect::<meshcodec::Result<Vec<_>>>()
+        .with_context(|| file.display().to_string())?;
+    let paths = set
+        .meshes
+        .iter()
+        .map(|m| resolve(m).with_context(|| m.clone()))
+        .collect::<Result<Vec<_>>>()?;
+    let quants: Vec<Option<u8>> = if set.quant.is_empty() {
+        vec![None]
+    } else {
+        set.quant.iter().map(|&q| Some(q)).collect()
+    };
+    let settings = Settings {
+        samples: set.samples.unwrap_or(settings.samples),
+        ..settings.clone()
+    };
+    let set_name = mesh_name(file);
+    if !set.description.is_empty() {
+        println!("{set_name}: {}", set.description);
+    }
+    let mut summary = Vec::new();
+    for path in &paths {
+        let mut runs = Vec::new();
+        for &codec in &codecs {
+            for &quant in &quants {
+                runs.push(run_codec(
+                    codec,
+                    path,
+                    &run_options(&settings, quant),
+                    &settings.out,
+                )?);
+            }
+        }
+        let dir = settings.out.join("compare").join(&set_name);
+        std::fs::create_dir_all(&dir)?;
+        let name = mesh_name(path);
+        let title = format!("{name} ({set_name})");
+        plot::rate_resolution(&runs, &title).draw(&dir.join(format!("{name}-rate-resolution")))?;
+        plot::rate_distortion(&runs, &title).draw(&dir.join(format!("{name}-rate-distortion")))?;
+        println!("wrote comparison charts to {}", dir.display());
+        summary.extend(runs);
+    }
+    println!(
+        "\n{:<10} {:<22} {:>5} {:>10} {:>9} {:>9} {:>9}",
+        "codec", "mesh", "quant", "bytes", "bpv", "bpt", "lossless"
+    );
+    for r in &summary {
+        println!(
+            "{:<10} {:<22} {:>5} {:>10} {:>9.3} {:>9.3} {:>9}",
+            r.codec,
+            r.mesh,
+            r.quant_bits,
+            r.bytes,
+            r.bytes as f64 * 8.0 / r.vertices as f64,
+            r.bytes as f64 * 8.0 / r.triangles as f64,
+            r.lossless
+        );
+    }
+    Ok(())
+}

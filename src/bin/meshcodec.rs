@@ -1,1 +1,371 @@
-fn main(){}
+//! `meshcodec`: encode a mesh, decode a stream (whole or any prefix), describe a stream, and
+//! measure the distance between two meshes (Metro-style).
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use meshcodec::codecs::{self, LevelMesh, Stop};
+use meshcodec::container::StreamReader;
+use meshcodec::harness::{encode_options, RunOptions};
+use meshcodec::mesh::io::{read_mesh, resolve, write_atomically, write_mesh};
+use meshcodec::mesh::quantize::GridShape;
+use meshcodec::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    version,
+    about = "Progressive mesh compression: encode, decode, info, distance"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Encode a mesh file into a stream.
+    Encode {
+        /// Codec name.
+        #[arg(long)]
+        codec: String,
+        /// Quantization bits per axis (default: the codec's).
+        #[arg(long)]
+        quant: Option<u8>,
+        /// Grid shape: cubic or per-axis (default: the codec's).
+        #[arg(long, value_parser = parse_grid)]
+        grid: Option<GridShape>,
+        /// Mesh file or name.
+        input: String,
+        /// Stream file to write.
+        output: PathBuf,
+    },
+    /// Decode a stream (or a prefix of it) into a PLY or OBJ file.
+    Decode {
+        /// Stream file.
+        input: PathBuf,
+        /// Mesh file to write (.ply or .obj).
+        output: PathBuf,
+        /// Stop after this many levels.
+        #[arg(long, conflicts_with = "bytes")]
+        level: Option<usize>,
+        /// Use only the first N bytes of the stream.
+        #[arg(long)]
+        bytes: Option<usize>,
+    },
+    /// Describe a stream: header, grid, levels.
+    Info {
+        /// Stream file.
+        input: PathBuf,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Distance between two meshes' surfaces: one-sided both ways, Hausdorff, RMS.
+    Distance {
+        /// Reference mesh.
+        a: String,
+        /// Compared mesh.
+        b: String,
+        /// Random samples per triangle of A (taken on each mesh).
+        #[arg(long, default_value_t = DEFAULT_SAMPLES_PER_TRIANGLE)]
+        samples: usize,
+        /// Sampler seed.
+        #[arg(long, default_value_t = DEFAULT_SEED)]
+        seed: u64,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Write every sample and its distance as CSV (direction,x,y,z,distance).
+        #[arg(long)]
+        write_samples: Option<PathBuf>,
+    },
+}
+
+fn parse_grid(s: &str) -> Result<GridShape, String> {
+    match s {
+        "cubic" => Ok(GridShape::Cubic),
+        "per-axis" => Ok(GridShape::PerAxis),
+        _ => Err(format!("unknown grid '{s}' (cubic, per-axis)")),
+    }
+}
+
+fn main() -> ExitCode {
+    let outcome = match Cli::parse().command {
+        Command::Encode {
+            codec,
+            quant,
+            grid,
+            input,
+            output,
+        } => encode(&codec, quant, grid, &input, &output),
+        Command::Decode {
+            input,
+            output,
+            level,
+            bytes,
+        } => decode(&input, &output, level, bytes),
+        Command::Info { input, json } => info(&input, json),
+        Command::Distance {
+            a,
+            b,
+            samples,
+            seed,
+            json,
+            write_samples,
+        } => distance(&a, &b, samples, seed, json, write_samples.as_deref()),
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // One line, whatever the error's text holds (DESIGN.md A6).
+            let message = format!("{e:#}").replace(['\n', '\t'], " ");
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn load(name: &str) -> Result<(PathBuf, meshcodec::mesh::TriMesh)> {
+    let path = resolve(name).with_context(|| name.to_string())?;
+    let mesh = read_mesh(&path).with_context(|| path.display().to_string())?;
+    Ok((path, mesh))
+}
+
+fn encode(
+    codec: &str,
+    quant: Option<u8>,
+    grid: Option<GridShape>,
+    input: &str,
+    output: &Path,
+) -> Result<()> {
+    let codec = codecs::by_name(codec)?;
+    let (path, mesh) = load(input)?;
+    let options = encode_options(
+        codec,
+        &RunOptions {
+            quant_bits: quant,
+            grid,
+            ..RunOptions::default()
+        },
+    );
+    let canonical =
+        codecs::canonical_for(&mesh, &options).with_context(|| path.display().to_string())?;
+    let encoded = codec
+        .encode(&canonical, &options)
+        .with_context(|| path.display().to_string())?;
+    write_atomically(output, &encoded.bytes).with_context(|| output.display().to_string())?;
+    let bits = encoded.bytes.len() as f64 * 8.0;
+    println!(
+        "{}: {} vertices, {} triangles at {} bits -> {} bytes in {} levels ({:.3} bits/vertex, {:.3} bits/triangle)",
+        output.display(),
+        canonical.vertex_count(),
+        canonical.face_count(),
+        options.quant_bits,
+        encoded.bytes.len(),
+        encoded.levels.len(),
+        bits / canonical.vertex_count() as f64,
+        bits / canonical.face_count() as f64
+    );
+    Ok(())
+}
+
+fn read_stream(input: &Path) -> Result<Vec<u8>> {
+    std::fs::read(input).with_context(|| input.display().to_string())
+}
+
+fn decode(input: &Path, output: &Path, level: Option<usize>, bytes: Option<usize>) -> Result<()> {
+    let stream = read_stream(input)?;
+    let prefix = &stream[..bytes.unwrap_or(stream.len()).min(stream.len())];
+    let stop = level.map_or(Stop::All, Stop::Levels);
+    let (decoded, levels) =
+        codecs::decode(prefix, stop).with_context(|| input.display().to_string())?;
+    if decoded.mesh.faces.is_empty() {
+        anyhow::bail!(
+            "{}: the first {} bytes decode to no triangle ({} levels, {} vertices)",
+            input.display(),
+            prefix.len(),
+            levels,
+            decoded.mesh.vertex_count()
+        );
+    }
+    write_mesh(&decoded.mesh, output).with_context(|| output.display().to_string())?;
+    println!(
+        "{}: level {levels}, {} vertices, {} triangles from {} bytes",
+        output.display(),
+        decoded.mesh.vertex_count(),
+        decoded.mesh.face_count(),
+        prefix.len()
+    );
+    Ok(())
+}
+
+fn info(input: &Path, json: bool) -> Result<()> {
+    let stream = read_stream(input)?;
+    let context = || input.display().to_string();
+    let mut reader = StreamReader::open(&stream).with_context(context)?;
+    let header = reader.header().clone();
+    let codec = codecs::by_id(header.codec_id).with_context(context)?;
+    // Level sizes from the container, mesh sizes from decoding.
+    let mut sizes = Vec::new();
+    while let Some(level) = reader.next_level().with_context(context)? {
+        sizes.push((level.start, level.bytes.len()));
+    }
+    let mut decoder = codecs::open(&stream).with_context(context)?;
+    let mut levels = Vec::new();
+    for &(start, len) in &sizes {
+        decoder.advance().with_context(context)?;
+        let LevelMesh { mesh, loose_edges } = decoder.mesh();
+        levels.push(serde_json::json!({
+            "level": decoder.levels_decoded(),
+            "end_byte": start + len,
+            "payload_bytes": len,
+            "vertices": mesh.vertex_count(),
+            "triangles": mesh.face_count(),
+            "loose_edges": loose_edges.len(),
+        }));
+    }
+    let report = serde_json::json!({
+        "file": input.display().to_string(),
+        "bytes": stream.len(),
+        "format_version": meshcodec::container::FORMAT_VERSION,
+        "codec": codec.name(),
+        "origin": header.grid.origin,
+        "cell": header.grid.cell,
+        "bits": header.grid.bits,
+        "vertices": header.vertices,
+        "triangles": header.triangles,
+        "levels_declared": header.levels,
+        "levels_present": sizes.len(),
+        "truncated": reader.truncated(),
+        "levels": levels,
+    });
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "{}: {} bytes, format version {}, codec {}",
+        input.display(),
+        stream.len(),
+        meshcodec::container::FORMAT_VERSION,
+        codec.name()
+    );
+    let _ = writeln!(
+        text,
+        "grid: {} bits, origin {:?}, cell {:?}",
+        header.grid.bits, header.grid.origin, header.grid.cell
+    );
+    let _ = writeln!(
+        text,
+        "full mesh: {} vertices, {} triangles; {} of {} levels present{}",
+        header.vertices,
+        header.triangles,
+        sizes.len(),
+        header.levels,
+        if reader.truncated() {
+            " (truncated)"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(
+        text,
+        "{:>5} {:>10} {:>10} {:>10} {:>10}",
+        "level", "end byte", "bytes", "vertices", "triangles"
+    );
+    for l in &levels {
+        let cell = |key: &str| l[key].to_string();
+        let _ = writeln!(
+            text,
+            "{:>5} {:>10} {:>10} {:>10} {:>10}",
+            cell("level"),
+            cell("end_byte"),
+            cell("payload_bytes"),
+            cell("vertices"),
+            cell("triangles")
+        );
+    }
+    print!("{text}");
+    Ok(())
+}
+
+fn distance(
+    a: &str,
+    b: &str,
+    samples: usize,
+    seed: u64,
+    json: bool,
+    dump: Option<&Path>,
+) -> Result<()> {
+    let (path_a, mesh_a) = load(a)?;
+    let (path_b, mesh_b) = load(b)?;
+    let reference = Reference::new(&mesh_a, samples, seed);
+    let level = LevelMesh {
+        mesh: mesh_b,
+        loose_edges: Vec::new(),
+    };
+    let m = reference
+        .measure(&level)
+        .context("the compared mesh has no vertex")?;
+    let diag = reference.diagonal;
+    let hausdorff = m.forward.max.max(m.backward.max);
+    let n = (m.forward.samples + m.backward.samples) as f64;
+    let rms = ((m.forward.sum_squares + m.backward.sum_squares) / n).sqrt();
+    if let Some(dump) = dump {
+        let mut csv = String::from("direction,x,y,z,distance\n");
+        let rows = [
+            ("a_to_b", &reference.samples.points, &m.to_level),
+            ("b_to_a", &m.level_samples.points, &m.to_original),
+        ];
+        for (direction, points, distances) in rows {
+            for (p, d) in points.iter().zip(distances.iter()) {
+                let _ = writeln!(csv, "{direction},{:?},{:?},{:?},{:?}", p.x, p.y, p.z, d);
+            }
+        }
+        write_atomically(dump, csv.as_bytes()).with_context(|| dump.display().to_string())?;
+    }
+    let report = serde_json::json!({
+        "a": path_a.display().to_string(),
+        "b": path_b.display().to_string(),
+        "diagonal": diag,
+        "samples_per_triangle": samples,
+        "seed": seed,
+        "a_to_b": m.forward,
+        "b_to_a": m.backward,
+        "hausdorff": hausdorff,
+        "rms": rms,
+        "hausdorff_relative": hausdorff / diag,
+        "rms_relative": rms / diag,
+        "hausdorff_paper": m.paper,
+    });
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+        return Ok(());
+    }
+    println!(
+        "A = {} , B = {} (diagonal of A {:.6e})",
+        path_a.display(),
+        path_b.display(),
+        diag
+    );
+    println!(
+        "{:<8} {:>10} {:>13} {:>13} {:>13}",
+        "", "samples", "max", "mean", "rms"
+    );
+    for (name, s) in [("A -> B", m.forward), ("B -> A", m.backward)] {
+        println!(
+            "{name:<8} {:>10} {:>13.6e} {:>13.6e} {:>13.6e}",
+            s.samples, s.max, s.mean, s.rms
+        );
+    }
+    println!(
+        "Hausdorff {hausdorff:.6e} ({:.6e} of diagonal), RMS {rms:.6e} ({:.6e} of diagonal)",
+        hausdorff / diag,
+        rms / diag
+    );
+    Ok(())
+}

@@ -101,7 +101,10 @@ pub fn by_name(name: &str) -> Result<&'static dyn Codec> {
         .find(|c| c.name() == name)
         .ok_or_else(|| {
             let names: Vec<_> = registry().iter().map(|c| c.name()).collect();
-            Error::Unsupported(format!("unknown codec '{name}' (codecs: {})", names.join(", ")))
+            Error::Unsupported(format!(
+                "unknown codec '{name}' (codecs: {})",
+                names.join(", ")
+            ))
         })
 }
 

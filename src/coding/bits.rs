@@ -93,7 +93,16 @@ mod tests {
 
     #[test]
     fn index_bits_is_ceil_log2() {
-        let cases = [(0, 0), (1, 0), (2, 1), (3, 2), (4, 2), (5, 3), (34834, 16), (65536, 16)];
+        let cases = [
+            (0, 0),
+            (1, 0),
+            (2, 1),
+            (3, 2),
+            (4, 2),
+            (5, 3),
+            (34834, 16),
+            (65536, 16),
+        ];
         for (n, bits) in cases {
             assert_eq!(index_bits(n), bits, "n = {n}");
         }

@@ -54,7 +54,10 @@ mod tests {
             assert_eq!(pos, out.len());
             let mut pos = 0;
             if out.len() > 1 {
-                assert_eq!(get(&out[..out.len() - 1], &mut pos), Err(VarintFault::Truncated));
+                assert_eq!(
+                    get(&out[..out.len() - 1], &mut pos),
+                    Err(VarintFault::Truncated)
+                );
             }
         }
         let mut pos = 0;

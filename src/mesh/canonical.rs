@@ -75,7 +75,10 @@ impl CanonicalMesh {
     /// The mesh with every vertex at its cell centre.
     pub fn to_mesh(&self) -> TriMesh {
         TriMesh::new(
-            self.cells.iter().map(|&q| self.grid.dequantize(q)).collect(),
+            self.cells
+                .iter()
+                .map(|&q| self.grid.dequantize(q))
+                .collect(),
             self.faces.clone(),
         )
     }

@@ -158,7 +158,8 @@ pub fn messy(seed: u64) -> TriMesh {
     let patch = terrain(rng.gen_range(3..25), rng.gen());
     let (offset, scale) = (spread(&mut rng), rng.gen_range(0.5..2.0));
     append(&mut mesh, patch, offset, scale);
-    let pick_face = |mesh: &TriMesh, rng: &mut Pcg64| mesh.faces[rng.gen_range(0..mesh.faces.len())];
+    let pick_face =
+        |mesh: &TriMesh, rng: &mut Pcg64| mesh.faces[rng.gen_range(0..mesh.faces.len())];
     // Fins: a third (and fourth) face on an existing edge.
     for _ in 0..rng.gen_range(0..=2) {
         let [a, b, _] = pick_face(&mesh, &mut rng);
@@ -236,7 +237,10 @@ mod tests {
         assert_eq!(icosphere(2).faces.len(), 320);
         let torus = torus(2.0, 0.5, 16, 9);
         // Euler characteristic of a torus is 0.
-        assert_eq!(torus.positions.len() as i64 * 2 - torus.faces.len() as i64, 0);
+        assert_eq!(
+            torus.positions.len() as i64 * 2 - torus.faces.len() as i64,
+            0
+        );
     }
 
     #[test]

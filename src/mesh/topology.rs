@@ -62,7 +62,9 @@ pub fn analyze(mesh: &TriMesh) -> TopologyReport {
     let mut edge_faces: HashMap<(VertexId, VertexId), u32> = HashMap::new();
     for f in &faces {
         for k in 0..3 {
-            *edge_faces.entry(edge_key(f[k], f[(k + 1) % 3])).or_default() += 1;
+            *edge_faces
+                .entry(edge_key(f[k], f[(k + 1) % 3]))
+                .or_default() += 1;
         }
     }
     let boundary_edges = edge_faces.values().filter(|&&n| n == 1).count();

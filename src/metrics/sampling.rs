@@ -82,6 +82,9 @@ mod tests {
         assert_eq!(samples.vertices, 6);
         let on_second = samples.points[6..].iter().filter(|p| p.x >= 10.0).count();
         assert!((on_second as f64 / 4000.0 - 0.75).abs() < 0.01);
-        assert_eq!(sample_surface(&mesh, 100, 9).points, sample_surface(&mesh, 100, 9).points);
+        assert_eq!(
+            sample_surface(&mesh, 100, 9).points,
+            sample_surface(&mesh, 100, 9).points
+        );
     }
 }

@@ -71,7 +71,10 @@ impl Codec for Raw {
             return Err(Error::malformed(
                 0,
                 0,
-                format!("raw streams have 1 level, this one declares {}", stream.header().levels),
+                format!(
+                    "raw streams have 1 level, this one declares {}",
+                    stream.header().levels
+                ),
             ));
         }
         Ok(Box::new(RawDecoder {
@@ -132,7 +135,9 @@ impl LevelDecoder for RawDecoder<'_> {
             for slot in &mut face {
                 *slot = source.get(b as u32).expect("length checked above");
             }
-            if face.iter().any(|&x| x as u64 >= v) || face[0] == face[1] || face[1] == face[2]
+            if face.iter().any(|&x| x as u64 >= v)
+                || face[0] == face[1]
+                || face[1] == face[2]
                 || face[0] == face[2]
             {
                 return Err(Error::malformed(
@@ -171,7 +176,10 @@ mod tests {
         let (decoded, levels) = decode(&encoded.bytes, Stop::All).unwrap();
         assert_eq!(levels, 1);
         assert_eq!(canonical.check_lossless(&decoded.mesh), Ok(()));
-        let (v, t) = (canonical.vertex_count() as u64, canonical.face_count() as u64);
+        let (v, t) = (
+            canonical.vertex_count() as u64,
+            canonical.face_count() as u64,
+        );
         let record = encoded.levels[0];
         assert_eq!(record.geometry_bits, 36 * v);
         assert_eq!(record.connectivity_bits, 3 * index_bits(v) as u64 * t);

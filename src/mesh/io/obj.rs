@@ -51,9 +51,9 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
         for tri in mesh.indices.chunks_exact(3) {
             let mut face = [0u32; 3];
             for (slot, &i) in face.iter_mut().zip(tri) {
-                *slot = *local.get(i as usize).ok_or_else(|| {
-                    Error::mesh(format!("OBJ: face index {i} out of range"))
-                })?;
+                *slot = *local
+                    .get(i as usize)
+                    .ok_or_else(|| Error::mesh(format!("OBJ: face index {i} out of range")))?;
             }
             faces.push(face);
         }

@@ -9,9 +9,7 @@ use glam::DVec3;
 pub fn read(bytes: &[u8]) -> Result<TriMesh> {
     let text = as_text(bytes);
     let mut lines = content_lines(&text);
-    let (first_no, first) = lines
-        .next()
-        .ok_or_else(|| Error::mesh("empty OFF file"))?;
+    let (first_no, first) = lines.next().ok_or_else(|| Error::mesh("empty OFF file"))?;
     let mut tokens = first.split_whitespace();
     let keyword = tokens.next().unwrap_or("");
     if !keyword.ends_with("OFF") {
@@ -41,7 +39,10 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
     let mut faces = Vec::with_capacity(nf.min(bytes.len() / 6));
     for _ in 0..nv {
         let (no, line) = lines.next().ok_or_else(|| {
-            Error::Truncated(format!("OFF file ends after {} of {nv} vertices", positions.len()))
+            Error::Truncated(format!(
+                "OFF file ends after {} of {nv} vertices",
+                positions.len()
+            ))
         })?;
         let mut t = line.split_whitespace();
         let x = number(t.next(), no, "x")?;
@@ -51,9 +52,9 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
     }
     let mut polygon = Vec::new();
     for f in 0..nf {
-        let (no, line) = lines.next().ok_or_else(|| {
-            Error::Truncated(format!("OFF file ends after {f} of {nf} faces"))
-        })?;
+        let (no, line) = lines
+            .next()
+            .ok_or_else(|| Error::Truncated(format!("OFF file ends after {f} of {nf} faces")))?;
         let mut t = line.split_whitespace();
         let n: usize = number(t.next(), no, "face size")?;
         polygon.clear();

@@ -81,7 +81,8 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
     let mut source = bytes;
     let ply = parser
         .read_ply(&mut source)
-        .map_err(|e| Error::mesh(format!("PLY: {e}")))?;
+        // ply-rs reports over several lines; errors here are one line (DESIGN.md A6).
+        .map_err(|e| Error::mesh(format!("PLY: {}", one_line(&e.to_string()))))?;
     let vertex_def = ply
         .header
         .elements
@@ -118,7 +119,10 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
     }
     for record in ply.payload.get("tristrips").into_iter().flatten() {
         for strip in record.indices.split(|&i| i < 0) {
-            let strip = strip.iter().map(|&i| index(i)).collect::<Result<Vec<u32>>>()?;
+            let strip = strip
+                .iter()
+                .map(|&i| index(i))
+                .collect::<Result<Vec<u32>>>()?;
             for (k, w) in strip.windows(3).enumerate() {
                 let tri = if k % 2 == 0 {
                     [w[0], w[1], w[2]]
@@ -133,4 +137,8 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
         }
     }
     Ok(TriMesh::new(positions, faces))
+}
+
+fn one_line(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
 }

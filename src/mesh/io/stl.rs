@@ -15,13 +15,15 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
         }
     }
     let head = &bytes[..bytes.len().min(512)];
-    let looks_ascii = head.trim_ascii_start().starts_with(b"solid")
-        && as_text(head).contains("facet");
+    let looks_ascii =
+        head.trim_ascii_start().starts_with(b"solid") && as_text(head).contains("facet");
     if looks_ascii || bytes.len() < 84 && bytes.trim_ascii_start().starts_with(b"solid") {
         return read_ascii(bytes);
     }
     if bytes.len() < 84 {
-        return Err(Error::Truncated("STL file shorter than its 84-byte header".into()));
+        return Err(Error::Truncated(
+            "STL file shorter than its 84-byte header".into(),
+        ));
     }
     let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
     Err(Error::Truncated(format!(

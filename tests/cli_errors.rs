@@ -1,0 +1,158 @@
+//! Bad input through the binaries: every fault exits 1 with one line on stderr naming the file,
+//! writes no output file, and never panics (DESIGN.md A6).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+struct Outcome {
+    code: Option<i32>,
+    stderr: String,
+}
+
+fn run(bin: &str, args: &[&str], dir: &Path) -> Outcome {
+    let out = Command::new(bin)
+        .args(args)
+        .current_dir(dir)
+        .env(
+            "MESHCODEC_DATA",
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes"),
+        )
+        .output()
+        .expect("binary runs");
+    Outcome {
+        code: out.status.code(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+    }
+}
+
+fn assert_clean_failure(outcome: &Outcome, mentions: &str) {
+    assert_eq!(outcome.code, Some(1), "stderr: {}", outcome.stderr);
+    assert_eq!(
+        outcome.stderr.lines().count(),
+        1,
+        "stderr: {}",
+        outcome.stderr
+    );
+    assert!(outcome.stderr.starts_with("error: "), "{}", outcome.stderr);
+    assert!(
+        outcome.stderr.contains(mentions),
+        "'{mentions}' not in {}",
+        outcome.stderr
+    );
+}
+
+fn scratch() -> tempfile::TempDir {
+    tempfile::tempdir().unwrap()
+}
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+const EXPERIMENT: &str = env!("CARGO_BIN_EXE_experiment");
+const MESHCODEC: &str = env!("CARGO_BIN_EXE_meshcodec");
+
+#[test]
+fn bad_meshes_fail_cleanly_and_leave_no_results() {
+    let dir = scratch();
+    let d = dir.path();
+    let bunny =
+        std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes/bunny.ply"))
+            .unwrap();
+    let cases: Vec<(PathBuf, &str)> = vec![
+        (d.join("missing.ply"), "missing.ply"),
+        (
+            write(
+                d,
+                "nan.off",
+                b"OFF\n3 1 0\n0 0 0\nnan 1 0\n0 1 1\n3 0 1 2\n",
+            ),
+            "non-finite",
+        ),
+        (
+            write(d, "range.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"),
+            "range.obj",
+        ),
+        (
+            write(
+                d,
+                "range.off",
+                b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+            ),
+            "out of range",
+        ),
+        (write(d, "empty.off", b"OFF\n0 0 0\n"), "empty mesh"),
+        (write(d, "empty.obj", b"# nothing\n"), "empty.obj"),
+        (
+            write(d, "trunc.ply", &bunny[..bunny.len() / 3]),
+            "trunc.ply",
+        ),
+        (write(d, "cut.stl", &[0u8; 120]), "cut.stl"),
+    ];
+    for (path, mentions) in &cases {
+        let p = path.to_str().unwrap();
+        assert_clean_failure(
+            &run(EXPERIMENT, &["raw", p, "--out", "results"], d),
+            mentions,
+        );
+        assert!(!d.join("results").exists(), "{p} left results behind");
+        assert_clean_failure(
+            &run(MESHCODEC, &["encode", "--codec", "raw", p, "out.mc"], d),
+            mentions,
+        );
+        assert!(!d.join("out.mc").exists(), "{p} left a stream behind");
+    }
+}
+
+#[test]
+fn unknown_names_list_what_is_known() {
+    let dir = scratch();
+    let outcome = run(EXPERIMENT, &["raw", "no-such-mesh"], dir.path());
+    assert_clean_failure(&outcome, "known names");
+    assert!(outcome.stderr.contains("bunny"));
+    assert_clean_failure(
+        &run(EXPERIMENT, &["nocodec", "bunny"], dir.path()),
+        "codecs: raw",
+    );
+}
+
+#[test]
+fn garbage_and_cut_streams_fail_cleanly() {
+    let dir = scratch();
+    let d = dir.path();
+    let mut noise = Vec::new();
+    let mut x: u32 = 12345;
+    for _ in 0..4000 {
+        x = x.wrapping_mul(1_103_515_245).wrapping_add(12345);
+        noise.push((x >> 16) as u8);
+    }
+    write(d, "garbage.mc", &noise);
+    for args in [
+        &["decode", "garbage.mc", "out.ply"][..],
+        &["info", "garbage.mc"][..],
+        &["info", "garbage.mc", "--json"][..],
+    ] {
+        assert_clean_failure(&run(MESHCODEC, args, d), "garbage.mc");
+        assert!(!d.join("out.ply").exists());
+    }
+    let encoded = run(
+        MESHCODEC,
+        &["encode", "--codec", "raw", "beethoven", "b.mc"],
+        d,
+    );
+    assert_eq!(encoded.code, Some(0), "{}", encoded.stderr);
+    let stream = std::fs::read(d.join("b.mc")).unwrap();
+    for cut in [0, 3, 20, 60, stream.len() / 2, stream.len() - 1] {
+        write(d, "cut.mc", &stream[..cut]);
+        assert_clean_failure(
+            &run(MESHCODEC, &["decode", "cut.mc", "out.obj"], d),
+            "cut.mc",
+        );
+        assert!(!d.join("out.obj").exists());
+    }
+    let whole = run(MESHCODEC, &["decode", "b.mc", "out.obj"], d);
+    assert_eq!(whole.code, Some(0), "{}", whole.stderr);
+    assert!(d.join("out.obj").exists());
+}

@@ -1,0 +1,64 @@
+//! Every mesh in ../shared/meshes loads with the vertex and face counts its MANIFEST.md states.
+
+use meshcodec::mesh::io::{data_dirs, read_mesh};
+use std::path::PathBuf;
+
+fn shared_dir() -> PathBuf {
+    data_dirs()
+        .into_iter()
+        .find(|d| d.join("MANIFEST.md").is_file())
+        .expect("../shared/meshes with its MANIFEST.md beside the checkout")
+}
+
+/// (file, vertices, faces) rows of the manifest's table.
+fn manifest_rows() -> Vec<(String, usize, usize)> {
+    let text = std::fs::read_to_string(shared_dir().join("MANIFEST.md")).unwrap();
+    let number = |cell: &str| -> Option<usize> {
+        let digits: String = cell
+            .split_whitespace()
+            .next()?
+            .chars()
+            .filter(|c| c.is_ascii_digit())
+            .collect();
+        digits.parse().ok()
+    };
+    text.lines()
+        .filter(|l| l.starts_with('|'))
+        .filter_map(|l| {
+            let cells: Vec<&str> = l.split('|').map(str::trim).collect();
+            let file = cells.get(1)?.to_string();
+            let readable = meshcodec::mesh::io::EXTENSIONS
+                .iter()
+                .any(|e| file.ends_with(&format!(".{e}")));
+            if !readable {
+                return None;
+            }
+            Some((file, number(cells.get(3)?)?, number(cells.get(4)?)?))
+        })
+        .collect()
+}
+
+#[test]
+fn every_shared_mesh_loads_with_its_manifest_counts() {
+    let rows = manifest_rows();
+    assert!(rows.len() >= 30, "manifest lists {} meshes", rows.len());
+    let dir = shared_dir();
+    let mut wrong = Vec::new();
+    for (file, vertices, faces) in &rows {
+        let mesh = read_mesh(&dir.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        if (mesh.vertex_count(), mesh.face_count()) != (*vertices, *faces) {
+            wrong.push(format!(
+                "{file}: {} v / {} f, manifest {vertices} / {faces}",
+                mesh.vertex_count(),
+                mesh.face_count()
+            ));
+        }
+    }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+}
+
+#[test]
+fn bunny_has_34834_referenced_vertices() {
+    let mesh = read_mesh(&shared_dir().join("bunny.ply")).unwrap();
+    assert_eq!(mesh.referenced().iter().filter(|&&u| u).count(), 34_834);
+}
