@@ -215,7 +215,7 @@ mod tests {
             if format == "ply" {
                 assert!(back == mesh, "ply changed the mesh");
             }
-            let mut sorted = |m: &TriMesh| {
+            let sorted = |m: &TriMesh| {
                 let mut corners: Vec<[[u64; 3]; 3]> = m
                     .faces
                     .iter()

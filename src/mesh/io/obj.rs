@@ -15,7 +15,6 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let mut reader = std::io::BufReader::new(bytes);
     // Materials are not geometry: a missing .mtl must not stop the mesh from loading.
@@ -36,7 +35,8 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
             .positions
             .chunks_exact(3)
             .map(|c| {
-                let p = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64);
+                // tobj is built with `use_f64`: positions arrive as the file's doubles.
+                let p = DVec3::new(c[0], c[1], c[2]);
                 if single {
                     positions.push(p);
                     return (positions.len() - 1) as u32;
