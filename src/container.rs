@@ -175,6 +175,7 @@ pub struct StreamReader<'a> {
     pos: usize,
     next_level: usize,
     truncated: bool,
+    partial_start: Option<usize>,
 }
 
 impl<'a> StreamReader<'a> {
@@ -187,6 +188,7 @@ impl<'a> StreamReader<'a> {
             pos,
             next_level: 0,
             truncated: false,
+            partial_start: None,
         })
     }
 
@@ -226,6 +228,7 @@ impl<'a> StreamReader<'a> {
         let available = (self.bytes.len() - pos) as u64;
         if len > available {
             self.truncated = true;
+            self.partial_start = Some(pos);
             return Ok(None);
         }
         let payload = LevelPayload {
@@ -241,6 +244,16 @@ impl<'a> StreamReader<'a> {
     /// True when the bytes ended inside a level.
     pub fn truncated(&self) -> bool {
         self.truncated
+    }
+
+    /// The bytes present of the level the stream was cut in (after its complete length
+    /// prefix), for codecs that can decode part of a level.
+    pub fn partial_level(&self) -> Option<LevelPayload<'a>> {
+        self.partial_start.map(|start| LevelPayload {
+            index: self.next_level,
+            start,
+            bytes: &self.bytes[start..],
+        })
     }
 }
 

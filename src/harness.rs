@@ -71,6 +71,9 @@ pub struct RunResult {
     /// Random samples per original triangle used by the metrics.
     #[serde(default)]
     pub samples_per_triangle: usize,
+    /// Codec-specific counts: bits per syntax element, operation counts.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub codec_stats: std::collections::BTreeMap<String, f64>,
     /// Per-level rows.
     pub levels: Vec<LevelRow>,
 }
@@ -175,6 +178,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunRe
         lossless_error,
         grid: encode.grid,
         samples_per_triangle: options.samples_per_triangle,
+        codec_stats: encoded.stats,
         levels,
     })
 }

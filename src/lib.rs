@@ -30,6 +30,7 @@ pub mod coding;
 pub mod container;
 pub mod error;
 pub mod harness;
+pub mod hierarchy;
 pub mod limits;
 pub mod mesh;
 pub mod metrics;

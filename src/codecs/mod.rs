@@ -4,6 +4,7 @@
 //! [`LevelDecoder`] that walks a stream level by level, coarse to fine, as Hoppe's PMeshIter
 //! walks vertex splits. The full decode of a stream is lossless: it equals the canonical mesh.
 
+pub mod emc;
 pub mod raw;
 
 use crate::container::{Header, StreamReader};
@@ -42,6 +43,8 @@ pub struct Encoded {
     pub bytes: Vec<u8>,
     /// One record per level, in stream order.
     pub levels: Vec<LevelRecord>,
+    /// Codec-specific counts (bits per syntax element, operation counts…) for tables.
+    pub stats: std::collections::BTreeMap<String, f64>,
 }
 
 /// The mesh a stream decodes to at some level: positions at cell centres (of the level's own,
@@ -85,13 +88,18 @@ pub trait LevelDecoder {
     /// Decodes the next complete level; `Ok(false)` when none is left (the stream's end, or the
     /// prefix ends inside the next level).
     fn advance(&mut self) -> Result<bool>;
+    /// Decodes what is present of a level the stream was cut in, where the codec's syntax allows
+    /// it; `Ok(false)` when nothing more could be decoded.
+    fn advance_partial(&mut self) -> Result<bool> {
+        Ok(false)
+    }
     /// The mesh after the levels decoded so far.
     fn mesh(&self) -> LevelMesh;
 }
 
 /// Every codec of this build.
 pub fn registry() -> Vec<&'static dyn Codec> {
-    vec![&raw::Raw]
+    vec![&raw::Raw, &emc::Emc]
 }
 
 /// The codec called `name`, or an error listing the names known.
@@ -153,5 +161,8 @@ pub fn decode(bytes: &[u8], stop: Stop) -> Result<(LevelMesh, usize)> {
         Stop::Levels(n) => n,
     };
     while decoder.levels_decoded() < wanted && decoder.advance()? {}
+    if stop == Stop::All {
+        decoder.advance_partial()?;
+    }
     Ok((decoder.mesh(), decoder.levels_decoded()))
 }

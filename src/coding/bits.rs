@@ -31,6 +31,11 @@ impl BitSink {
         self.ledger.add(class, bits as u64);
     }
 
+    /// Bits booked so far.
+    pub fn ledger(&self) -> BitLedger {
+        self.ledger
+    }
+
     /// Pads to a byte boundary and returns the bytes and the ledger (padding is not booked).
     pub fn finish(mut self) -> (Vec<u8>, BitLedger) {
         self.writer

@@ -2,6 +2,7 @@
 //! geometry, bit-level writers and readers over it, and LEB128 variable-length integers.
 
 pub mod bits;
+pub mod huffman;
 pub mod varint;
 
 pub use bits::{BitSink, BitSource};

@@ -63,6 +63,7 @@ impl Codec for Raw {
                 triangles: mesh.face_count(),
             }],
             bytes,
+            stats: Default::default(),
         })
     }
 

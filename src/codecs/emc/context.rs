@@ -1,0 +1,210 @@
+//! The state that EMC's encoder and decoder update identically: the vertex list with each
+//! vertex's cell prefix, its next split step and its edge list, and the triangles rebuilt from
+//! the edges.
+
+use super::syntax::EdgeCode;
+use crate::codecs::LevelMesh;
+use crate::hierarchy::cliques::{loose_edges, oriented, propagate_orientation, triangles};
+use crate::hierarchy::octree::StepOrder;
+use crate::mesh::{Grid, TriMesh};
+use glam::DVec3;
+
+/// "No further split".
+pub const NO_SPLIT: u16 = u16::MAX;
+
+/// The decoder's view of the mesh after some steps.
+#[derive(Clone, Debug)]
+pub struct EmcState {
+    /// Step order of the stream.
+    pub order: StepOrder,
+    /// Cell index bits taken so far on each axis (a prefix of the full cell index).
+    pub cells: Vec<[u32; 3]>,
+    /// Steps applied to each vertex (all equal between passes; differ inside a cut pass).
+    pub depth: Vec<u16>,
+    /// Step of each vertex's next split, or [`NO_SPLIT`].
+    pub next_split: Vec<u16>,
+    /// Sorted neighbour lists (ids are positions in the vertex list).
+    pub adjacency: Vec<Vec<u32>>,
+}
+
+impl EmcState {
+    /// One vertex at the centre of the box. It splits at step 0 when the mesh has two or more
+    /// vertices: the longest axis spans the whole grid, so its extremes lie in opposite halves.
+    pub fn new(order: StepOrder, total_vertices: u64) -> EmcState {
+        EmcState {
+            order,
+            cells: vec![[0; 3]],
+            depth: vec![0],
+            next_split: vec![if total_vertices >= 2 { 0 } else { NO_SPLIT }],
+            adjacency: vec![Vec::new()],
+        }
+    }
+
+    /// Number of vertices (never zero: the list starts with one).
+    #[allow(clippy::len_without_is_empty)]
+    pub fn len(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// RF: vertex `v` takes `bit` at `step`.
+    pub fn refine(&mut self, v: usize, step: usize, bit: u32) {
+        let axis = self.order.axis(step);
+        self.cells[v][axis] = (self.cells[v][axis] << 1) | bit;
+        self.depth[v] += 1;
+    }
+
+    /// VS of `v` at `step`: `v` keeps the left half and the edges coded STAY or DUPLICATE; a new
+    /// vertex takes the right half and the edges coded MOVE or DUPLICATE, plus the connecting
+    /// edge if `connecting`. `codes[i]` is the code of `v`'s i-th neighbour (ascending ids).
+    /// Returns the new vertex.
+    pub fn split(
+        &mut self,
+        v: usize,
+        step: usize,
+        connecting: bool,
+        codes: &[EdgeCode],
+        next: [u16; 2],
+    ) -> usize {
+        let r = self.cells.len() as u32;
+        let mut cell = self.cells[v];
+        let axis = self.order.axis(step);
+        self.cells[v][axis] = cell[axis] << 1;
+        cell[axis] = (cell[axis] << 1) | 1;
+        self.cells.push(cell);
+        self.depth[v] += 1;
+        self.depth.push(self.depth[v]);
+        self.next_split[v] = next[0];
+        self.next_split.push(next[1]);
+
+        let old = std::mem::take(&mut self.adjacency[v]);
+        let mut kept = Vec::with_capacity(old.len() + 1);
+        let mut moved = Vec::with_capacity(old.len() + 1);
+        for (&n, &code) in old.iter().zip(codes) {
+            let around = &mut self.adjacency[n as usize];
+            match code {
+                EdgeCode::Stay => kept.push(n),
+                EdgeCode::Move => {
+                    if let Ok(i) = around.binary_search(&(v as u32)) {
+                        around.remove(i);
+                    }
+                    around.push(r); // r is the largest id: the list stays sorted
+                    moved.push(n);
+                }
+                EdgeCode::Duplicate => {
+                    around.push(r);
+                    kept.push(n);
+                    moved.push(n);
+                }
+            }
+        }
+        if connecting {
+            kept.push(r);
+            let at = moved.partition_point(|&x| x < v as u32);
+            moved.insert(at, v as u32);
+        }
+        self.adjacency[v] = kept;
+        self.adjacency.push(moved);
+        r as usize
+    }
+
+    /// Position of vertex `v`: the centre of its cell at the resolution it has reached.
+    pub fn position(&self, grid: &Grid, v: usize) -> DVec3 {
+        let bits = self.order.bits_per_axis(self.depth[v] as usize);
+        let shift = bits.map(|b| grid.bits - b);
+        grid.coarse_centre(self.cells[v], shift)
+    }
+
+    /// All positions.
+    pub fn positions(&self, grid: &Grid) -> Vec<DVec3> {
+        (0..self.len()).map(|v| self.position(grid, v)).collect()
+    }
+
+    /// The 3-cliques of the edge graph, ascending triples in lexicographic order.
+    pub fn cliques(&self) -> Vec<[u32; 3]> {
+        triangles(&self.adjacency)
+    }
+
+    /// The mesh as the paper's decoder shows it between levels: every 3-clique a triangle,
+    /// oriented by propagation from outward-facing guesses (no bits are spent on it).
+    pub fn level_mesh(&self, grid: &Grid) -> LevelMesh {
+        let positions = self.positions(grid);
+        let cliques = self.cliques();
+        let skipped = vec![false; cliques.len()];
+        let centre = centroid(&positions);
+        let flipped = propagate_orientation(&cliques, &skipped, &positions, centre, |_, _, p| p);
+        let faces = cliques
+            .iter()
+            .zip(&flipped)
+            .map(|(&t, &f)| oriented(t, f))
+            .collect();
+        LevelMesh {
+            loose_edges: loose_edges(&self.adjacency, &cliques),
+            mesh: TriMesh::new(positions, faces),
+        }
+    }
+}
+
+/// Mean of the positions (the guess for outward orientation looks away from it).
+pub fn centroid(positions: &[DVec3]) -> DVec3 {
+    if positions.is_empty() {
+        return DVec3::ZERO;
+    }
+    positions.iter().copied().sum::<DVec3>() / positions.len() as f64
+}
+
+/// What the last level adds to make the clique triangles exactly the mesh's faces.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FaceCorrections {
+    /// Positions in the clique list of 3-cliques that are not faces.
+    pub false_triangles: Vec<u32>,
+    /// Positions in the clique list of triangles that are faces in both orientations.
+    pub double_sided: Vec<u32>,
+    /// Visits (in propagation order) whose predicted orientation is wrong.
+    pub orientation_exceptions: Vec<u32>,
+}
+
+/// Applies `corrections` to the cliques of the final state: the faces of the full mesh.
+pub fn final_faces(
+    cliques: &[[u32; 3]],
+    positions: &[DVec3],
+    corrections: &FaceCorrections,
+) -> Vec<[u32; 3]> {
+    let mut skipped = vec![false; cliques.len()];
+    for &i in corrections
+        .false_triangles
+        .iter()
+        .chain(&corrections.double_sided)
+    {
+        skipped[i as usize] = true;
+    }
+    let mut exceptions = corrections.orientation_exceptions.iter().peekable();
+    let flipped = propagate_orientation(
+        cliques,
+        &skipped,
+        positions,
+        centroid(positions),
+        |visit, _, predicted| {
+            if exceptions.peek() == Some(&&(visit as u32)) {
+                exceptions.next();
+                !predicted
+            } else {
+                predicted
+            }
+        },
+    );
+    let is_false: std::collections::HashSet<u32> =
+        corrections.false_triangles.iter().copied().collect();
+    let mut faces = Vec::with_capacity(cliques.len());
+    for (i, &t) in cliques.iter().enumerate() {
+        if is_false.contains(&(i as u32)) {
+            continue;
+        }
+        if corrections.double_sided.binary_search(&(i as u32)).is_ok() {
+            faces.push(oriented(t, false));
+            faces.push(oriented(t, true));
+        } else {
+            faces.push(oriented(t, flipped[i]));
+        }
+    }
+    faces
+}

@@ -1,0 +1,198 @@
+//! EMC decoder: the passes of the paper, over the shared [`EmcState`]. A level can be decoded
+//! from a cut payload too: every vertex operation is read whole before it is applied, so a cut
+//! leaves the state after the last complete operation.
+
+use super::context::{final_faces, EmcState, FaceCorrections, NO_SPLIT};
+use super::syntax;
+use crate::codecs::{LevelDecoder, LevelMesh};
+use crate::coding::BitSource;
+use crate::container::{Header, LevelPayload, StreamReader};
+use crate::error::{Error, Result};
+use crate::hierarchy::cliques::loose_edges;
+use crate::mesh::TriMesh;
+
+pub struct EmcDecoder<'a> {
+    stream: StreamReader<'a>,
+    header: Header,
+    state: EmcState,
+    levels_done: usize,
+    /// Faces of the full mesh once the last level's corrections are read.
+    final_faces: Option<Vec<[u32; 3]>>,
+}
+
+/// Why a level could not be decoded to its end.
+enum Stop {
+    /// The bits ran out (a cut payload).
+    OutOfBits,
+    /// The stream contradicts itself.
+    Fault(Error),
+}
+
+impl<'a> EmcDecoder<'a> {
+    pub fn new(stream: StreamReader<'a>, order: crate::hierarchy::octree::StepOrder) -> Self {
+        let header = stream.header().clone();
+        EmcDecoder {
+            state: EmcState::new(order, header.vertices),
+            header,
+            stream,
+            levels_done: 0,
+            final_faces: None,
+        }
+    }
+
+    /// Decodes the steps of level `levels_done + 1` from `payload`.
+    fn decode_level(&mut self, payload: &LevelPayload) -> Result<(), Stop> {
+        let order = self.state.order;
+        let level = self.levels_done + 1;
+        let mut source = BitSource::new(payload.bytes);
+        let fault = |what: String| Stop::Fault(Error::malformed(level, payload.start, what));
+        for step in 3 * (level - 1)..3 * level {
+            // Vertices that were present before the pass; a cut pass resumes nowhere, so each
+            // vertex is checked by its depth.
+            let present = self.state.len();
+            for v in 0..present {
+                if self.state.depth[v] as usize > step {
+                    continue;
+                }
+                if self.state.next_split[v] as usize != step {
+                    let bit = source.get(1).ok_or(Stop::OutOfBits)?;
+                    self.state.refine(v, step, bit);
+                    continue;
+                }
+                if self.state.len() as u64 >= self.header.vertices {
+                    return Err(fault(format!(
+                        "more splits than the {} vertices the header declares",
+                        self.header.vertices
+                    )));
+                }
+                let connecting = source.get(1).ok_or(Stop::OutOfBits)? == 1;
+                let degree = self.state.adjacency[v].len();
+                let mut codes = Vec::with_capacity(degree);
+                for _ in 0..degree {
+                    codes.push(syntax::get_edge(&mut source).ok_or(Stop::OutOfBits)?);
+                }
+                let mut next = [NO_SPLIT; 2];
+                for slot in &mut next {
+                    if let Some(d) = syntax::get_distance(&mut source).ok_or(Stop::OutOfBits)? {
+                        if step + d >= order.steps() {
+                            return Err(fault(format!(
+                                "split distance {d} at step {step} passes the last step"
+                            )));
+                        }
+                        *slot = (step + d) as u16;
+                    }
+                }
+                self.state.split(v, step, connecting, &codes, next);
+            }
+        }
+        if level == order.levels as usize {
+            self.read_corrections(&mut source, payload)?;
+        }
+        Ok(())
+    }
+
+    fn read_corrections(
+        &mut self,
+        source: &mut BitSource,
+        payload: &LevelPayload,
+    ) -> Result<(), Stop> {
+        let level = self.levels_done + 1;
+        let fault = |what: &str| Stop::Fault(Error::malformed(level, payload.start, what));
+        if self.state.len() as u64 != self.header.vertices {
+            return Err(fault(&format!(
+                "{} vertices decoded, the header declares {}",
+                self.state.len(),
+                self.header.vertices
+            )));
+        }
+        let cliques = self.state.cliques();
+        let false_triangles = syntax::get_list(source, cliques.len()).ok_or(Stop::OutOfBits)?;
+        let double_sided = syntax::get_list(source, cliques.len()).ok_or(Stop::OutOfBits)?;
+        let orientation_exceptions =
+            syntax::get_list(source, cliques.len()).ok_or(Stop::OutOfBits)?;
+        if false_triangles
+            .iter()
+            .any(|t| double_sided.binary_search(t).is_ok())
+        {
+            return Err(fault("a triangle is listed both false and double-sided"));
+        }
+        let corrections = FaceCorrections {
+            false_triangles,
+            double_sided,
+            orientation_exceptions,
+        };
+        let positions = self.state.positions(&self.header.grid);
+        let faces = final_faces(&cliques, &positions, &corrections);
+        if faces.len() as u64 != self.header.triangles {
+            return Err(fault(&format!(
+                "{} triangles decoded, the header declares {}",
+                faces.len(),
+                self.header.triangles
+            )));
+        }
+        self.final_faces = Some(faces);
+        Ok(())
+    }
+}
+
+impl LevelDecoder for EmcDecoder<'_> {
+    fn header(&self) -> &Header {
+        &self.header
+    }
+
+    fn levels_decoded(&self) -> usize {
+        self.levels_done
+    }
+
+    fn advance(&mut self) -> Result<bool> {
+        let Some(payload) = self.stream.next_level()? else {
+            return Ok(false);
+        };
+        match self.decode_level(&payload) {
+            Ok(()) => {
+                self.levels_done += 1;
+                Ok(true)
+            }
+            Err(Stop::Fault(e)) => Err(e),
+            Err(Stop::OutOfBits) => Err(Error::malformed(
+                self.levels_done + 1,
+                payload.start,
+                "level payload ends before its last operation",
+            )),
+        }
+    }
+
+    fn advance_partial(&mut self) -> Result<bool> {
+        let Some(payload) = self.stream.partial_level() else {
+            return Ok(false);
+        };
+        let before = self.state.depth.iter().map(|&d| d as usize).sum::<usize>();
+        match self.decode_level(&payload) {
+            Ok(()) | Err(Stop::OutOfBits) => {}
+            Err(Stop::Fault(e)) => return Err(e),
+        }
+        let after = self.state.depth.iter().map(|&d| d as usize).sum::<usize>();
+        Ok(after > before)
+    }
+
+    fn mesh(&self) -> LevelMesh {
+        match &self.final_faces {
+            Some(faces) => {
+                let positions = self.state.positions(&self.header.grid);
+                let unoriented: Vec<[u32; 3]> = faces
+                    .iter()
+                    .map(|f| {
+                        let mut t = *f;
+                        t.sort_unstable();
+                        t
+                    })
+                    .collect();
+                LevelMesh {
+                    loose_edges: loose_edges(&self.state.adjacency, &unoriented),
+                    mesh: TriMesh::new(positions, faces.clone()),
+                }
+            }
+            None => self.state.level_mesh(&self.header.grid),
+        }
+    }
+}

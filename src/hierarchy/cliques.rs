@@ -1,0 +1,217 @@
+//! Triangles from an edge graph, as EMC's decoder rebuilds them: every 3-cycle (3-clique) of the
+//! graph is a candidate triangle; orientations are propagated across edges that exactly two
+//! candidates share, so that neighbours agree, starting each connected patch from a guess.
+//!
+//! The propagation is the same in encoder and decoder; the encoder compares its result with the
+//! real faces and transmits only where it is wrong (see `codecs::emc`).
+
+use glam::DVec3;
+
+/// All 3-cliques of an undirected graph given as sorted adjacency lists, each as an ascending
+/// triple, in lexicographic order.
+pub fn triangles(adjacency: &[Vec<u32>]) -> Vec<[u32; 3]> {
+    let mut out = Vec::new();
+    for (a, around_a) in adjacency.iter().enumerate() {
+        let a = a as u32;
+        let above_a = &around_a[around_a.partition_point(|&x| x <= a)..];
+        for (i, &b) in above_a.iter().enumerate() {
+            let around_b = &adjacency[b as usize];
+            // c > b and adjacent to both: intersect two sorted lists.
+            let (mut p, mut q) = (i + 1, around_b.partition_point(|&x| x <= b));
+            while p < above_a.len() && q < around_b.len() {
+                match above_a[p].cmp(&around_b[q]) {
+                    std::cmp::Ordering::Less => p += 1,
+                    std::cmp::Ordering::Greater => q += 1,
+                    std::cmp::Ordering::Equal => {
+                        out.push([a, b, above_a[p]]);
+                        p += 1;
+                        q += 1;
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Edges of the graph that lie on no triangle of `tris`.
+pub fn loose_edges(adjacency: &[Vec<u32>], tris: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let mut on_triangle: Vec<(u32, u32)> = tris
+        .iter()
+        .flat_map(|&[a, b, c]| [(a, b), (b, c), (a, c)])
+        .collect();
+    on_triangle.sort_unstable();
+    on_triangle.dedup();
+    let mut out = Vec::new();
+    for (a, around) in adjacency.iter().enumerate() {
+        for &b in around.iter().filter(|&&b| b > a as u32) {
+            if on_triangle.binary_search(&(a as u32, b)).is_err() {
+                out.push([a as u32, b]);
+            }
+        }
+    }
+    out
+}
+
+/// A triangle as an ascending triple plus whether it is flipped: unflipped means the cycle
+/// a → b → c, flipped a → c → b.
+pub fn oriented(tri: [u32; 3], flipped: bool) -> [u32; 3] {
+    if flipped {
+        [tri[0], tri[2], tri[1]]
+    } else {
+        tri
+    }
+}
+
+/// Does the cycle a → b → c of `tri` (ascending) traverse the directed edge u → v?
+fn traverses(tri: [u32; 3], u: u32, v: u32) -> bool {
+    let [a, b, c] = tri;
+    (u, v) == (a, b) || (u, v) == (b, c) || (u, v) == (c, a)
+}
+
+/// Orients the triangles `tris` (ascending triples) that are not `skipped`.
+///
+/// Visits them patch by patch in a fixed order: a patch starts at its lowest unvisited
+/// triangle, whose orientation is guessed so that its normal points away from `centre`, and
+/// grows breadth-first across edges shared by exactly two non-skipped triangles, each reached
+/// triangle predicted to agree with the one it was reached from. `decide(visit, triangle,
+/// predicted)`
+/// returns the orientation to use for the `visit`-th triangle visited (true = flipped); the
+/// result holds the chosen orientation of every triangle (skipped ones: false). `decide` is
+/// also told which triangle it decides: the visiting order depends only on the graph.
+pub fn propagate_orientation(
+    tris: &[[u32; 3]],
+    skipped: &[bool],
+    positions: &[DVec3],
+    centre: DVec3,
+    mut decide: impl FnMut(usize, usize, bool) -> bool,
+) -> Vec<bool> {
+    // Edge → triangles, by sorting (edge, triangle) pairs.
+    let mut by_edge: Vec<((u32, u32), u32)> = tris
+        .iter()
+        .enumerate()
+        .filter(|(t, _)| !skipped[*t])
+        .flat_map(|(t, &[a, b, c])| [((a, b), t as u32), ((b, c), t as u32), ((a, c), t as u32)])
+        .collect();
+    by_edge.sort_unstable();
+    // For each triangle and each of its 3 edges, the one other triangle across it, if exactly one.
+    let mut across = vec![[u32::MAX; 3]; tris.len()];
+    let mut i = 0;
+    while i < by_edge.len() {
+        let mut j = i + 1;
+        while j < by_edge.len() && by_edge[j].0 == by_edge[i].0 {
+            j += 1;
+        }
+        if j - i == 2 {
+            let (e, t1, t2) = (by_edge[i].0, by_edge[i].1, by_edge[i + 1].1);
+            for (t, other) in [(t1, t2), (t2, t1)] {
+                // Edges of an ascending triple: (a,b) slot 0, (b,c) slot 1, (a,c) slot 2.
+                let [a, b, _] = tris[t as usize];
+                let slot = if e == (a, b) {
+                    0
+                } else if e.0 == b {
+                    1
+                } else {
+                    2
+                };
+                across[t as usize][slot] = other;
+            }
+        }
+        i = j;
+    }
+    let mut flipped = vec![false; tris.len()];
+    let mut seen = skipped.to_vec();
+    let mut queue = std::collections::VecDeque::new();
+    let mut visit = 0;
+    for start in 0..tris.len() {
+        if seen[start] {
+            continue;
+        }
+        seen[start] = true;
+        let [a, b, c] = tris[start].map(|v| positions[v as usize]);
+        let outward = (b - a).cross(c - a).dot((a + b + c) / 3.0 - centre) >= 0.0;
+        flipped[start] = decide(visit, start, !outward);
+        visit += 1;
+        queue.push_back(start);
+        while let Some(t) = queue.pop_front() {
+            let tri = tris[t];
+            let edges = [(tri[0], tri[1]), (tri[1], tri[2]), (tri[0], tri[2])];
+            for (slot, &(u, v)) in edges.iter().enumerate() {
+                let other = across[t][slot];
+                if other == u32::MAX || seen[other as usize] {
+                    continue;
+                }
+                seen[other as usize] = true;
+                // Direction in which t, as oriented, traverses this edge.
+                let (from, to) = if traverses(oriented(tri, flipped[t]), u, v) {
+                    (u, v)
+                } else {
+                    (v, u)
+                };
+                // The neighbour agrees when it traverses the edge the other way.
+                let predicted = traverses(tris[other as usize], from, to);
+                flipped[other as usize] = decide(visit, other as usize, predicted);
+                visit += 1;
+                queue.push_back(other as usize);
+            }
+        }
+    }
+    flipped
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate;
+
+    fn adjacency_of(n: usize, faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
+        let mut adj = vec![Vec::new(); n];
+        for f in faces {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                adj[a as usize].push(b);
+                adj[b as usize].push(a);
+            }
+        }
+        for list in &mut adj {
+            list.sort_unstable();
+            list.dedup();
+        }
+        adj
+    }
+
+    #[test]
+    fn a_sphere_is_rebuilt_with_outward_orientation() {
+        let sphere = generate::icosphere(2);
+        let adj = adjacency_of(sphere.positions.len(), &sphere.faces);
+        let tris = triangles(&adj);
+        assert_eq!(tris.len(), sphere.faces.len());
+        let skipped = vec![false; tris.len()];
+        let mut guesses = 0;
+        let flipped = propagate_orientation(
+            &tris,
+            &skipped,
+            &sphere.positions,
+            DVec3::ZERO,
+            |_, _, p| {
+                guesses += 1;
+                p
+            },
+        );
+        assert_eq!(guesses, tris.len());
+        let mut ours: Vec<[u32; 3]> = tris
+            .iter()
+            .zip(&flipped)
+            .map(|(t, &f)| crate::mesh::canonical::rotate_to_smallest(oriented(*t, f)))
+            .collect();
+        let mut theirs: Vec<[u32; 3]> = sphere
+            .faces
+            .iter()
+            .map(|f| crate::mesh::canonical::rotate_to_smallest(*f))
+            .collect();
+        ours.sort_unstable();
+        theirs.sort_unstable();
+        assert_eq!(ours, theirs);
+        assert!(loose_edges(&adj, &tris).is_empty());
+    }
+}
