@@ -144,6 +144,7 @@ fn garbage_and_cut_streams_fail_cleanly() {
     );
     assert_eq!(encoded.code, Some(0), "{}", encoded.stderr);
     let stream = std::fs::read(d.join("b.mc")).unwrap();
+    // raw has one level: every cut short of the whole stream holds no complete level.
     for cut in [0, 3, 20, 60, stream.len() / 2, stream.len() - 1] {
         write(d, "cut.mc", &stream[..cut]);
         assert_clean_failure(
@@ -155,4 +156,44 @@ fn garbage_and_cut_streams_fail_cleanly() {
     let whole = run(MESHCODEC, &["decode", "b.mc", "out.obj"], d);
     assert_eq!(whole.code, Some(0), "{}", whole.stderr);
     assert!(d.join("out.obj").exists());
+}
+
+#[test]
+fn emc_commands_work_on_every_shared_mesh() {
+    let dir = scratch();
+    let d = dir.path();
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&shared)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| {
+            let ext = p.extension().map(|e| e.to_string_lossy().to_string()).unwrap_or_default();
+            meshcodec::mesh::io::EXTENSIONS.contains(&ext.as_str())
+        })
+        .collect();
+    files.sort();
+    assert!(files.len() >= 30);
+    for file in files {
+        let f = file.to_str().unwrap();
+        let ok = |args: &[&str]| {
+            let out = run(MESHCODEC, args, d);
+            assert_eq!(out.code, Some(0), "{args:?}: {}", out.stderr);
+        };
+        ok(&["encode", "--codec", "emc", f, "m.mc"]);
+        let info = Command::new(MESHCODEC).args(["info", "m.mc", "--json"]).current_dir(d).output().unwrap();
+        assert!(info.status.success());
+        let json: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+        assert_eq!(json["codec"], "emc");
+        assert_eq!(json["levels_present"], 24, "{f}");
+        assert_eq!(json["bits"], 24);
+        assert_eq!(json["cell"].as_array().unwrap().len(), 3);
+        ok(&["decode", "m.mc", "full.ply"]);
+        ok(&["decode", "m.mc", "level8.obj", "--level", "8"]);
+        ok(&["decode", "m.mc", "half.ply", "--bytes", &(std::fs::metadata(d.join("m.mc")).unwrap().len() / 2).to_string()]);
+        let full = meshcodec::mesh::io::read_mesh(&d.join("full.ply")).unwrap();
+        assert_eq!(full.vertex_count() as u64, json["vertices"].as_u64().unwrap(), "{f}");
+        assert_eq!(full.face_count() as u64, json["triangles"].as_u64().unwrap(), "{f}");
+        let coarse = meshcodec::mesh::io::read_mesh(&d.join("level8.obj")).unwrap();
+        assert!(coarse.vertex_count() <= full.vertex_count());
+    }
 }

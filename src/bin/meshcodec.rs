@@ -181,13 +181,11 @@ fn decode(input: &Path, output: &Path, level: Option<usize>, bytes: Option<usize
     let stop = level.map_or(Stop::All, Stop::Levels);
     let (decoded, levels) =
         codecs::decode(prefix, stop).with_context(|| input.display().to_string())?;
-    if decoded.mesh.faces.is_empty() {
+    if decoded.mesh.positions.is_empty() {
         anyhow::bail!(
-            "{}: the first {} bytes decode to no triangle ({} levels, {} vertices)",
+            "{}: the first {} bytes hold no complete level",
             input.display(),
-            prefix.len(),
-            levels,
-            decoded.mesh.vertex_count()
+            prefix.len()
         );
     }
     write_mesh(&decoded.mesh, output).with_context(|| output.display().to_string())?;

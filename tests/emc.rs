@@ -1,0 +1,116 @@
+//! EMC: lossless on messy meshes, prefixes equal levels, every cut decodes or fails cleanly,
+//! encoding is deterministic.
+
+use meshcodec::codecs::{self, EncodeOptions, LevelMesh, Stop};
+use meshcodec::mesh::generate;
+use meshcodec::mesh::quantize::GridShape;
+use meshcodec::Error;
+use proptest::prelude::*;
+
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(256)
+}
+
+/// Indices in range, no face repeating a vertex, loose edges in range and not degenerate.
+fn assert_valid(level: &LevelMesh) {
+    let n = level.mesh.positions.len() as u32;
+    for f in &level.mesh.faces {
+        assert!(f.iter().all(|&v| v < n), "face {f:?} out of range ({n} vertices)");
+        assert!(f[0] != f[1] && f[1] != f[2] && f[0] != f[2], "degenerate face {f:?}");
+    }
+    for e in &level.loose_edges {
+        assert!(e[0] < n && e[1] < n && e[0] != e[1], "bad edge {e:?}");
+    }
+    assert!(level.mesh.positions.iter().all(|p| p.is_finite()));
+}
+
+fn encode(seed: u64, bits: u8, per_axis: bool) -> Option<(meshcodec::mesh::CanonicalMesh, codecs::Encoded)> {
+    let mesh = generate::messy(seed);
+    let grid = if per_axis { GridShape::PerAxis } else { GridShape::Cubic };
+    let options = EncodeOptions { quant_bits: bits, grid };
+    let canonical = codecs::canonical_for(&mesh, &options).ok()?;
+    let encoded = codecs::by_name("emc").unwrap().encode(&canonical, &options).unwrap();
+    Some((canonical, encoded))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases()))]
+
+    #[test]
+    fn full_decode_is_lossless_and_deterministic(seed in any::<u64>(), bits in 1u8..=24, per_axis in any::<bool>()) {
+        let Some((canonical, encoded)) = encode(seed, bits, per_axis) else { return Ok(()) };
+        let (_, again) = encode(seed, bits, per_axis).unwrap();
+        prop_assert_eq!(&encoded.bytes, &again.bytes);
+        let (decoded, levels) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
+        prop_assert_eq!(levels, bits as usize);
+        prop_assert_eq!(canonical.check_lossless(&decoded.mesh), Ok(()));
+    }
+
+    #[test]
+    fn a_stream_cut_after_level_k_is_level_k(seed in any::<u64>(), bits in 2u8..=16, per_axis in any::<bool>()) {
+        let Some((_, encoded)) = encode(seed, bits, per_axis) else { return Ok(()) };
+        let mut decoder = codecs::open(&encoded.bytes).unwrap();
+        for record in &encoded.levels {
+            prop_assert!(decoder.advance().unwrap());
+            let full = decoder.mesh();
+            assert_valid(&full);
+            prop_assert_eq!(full.mesh.vertex_count(), record.vertices);
+            let (cut, k) = codecs::decode(&encoded.bytes[..record.end_byte], Stop::All).unwrap();
+            prop_assert_eq!(k, decoder.levels_decoded());
+            prop_assert!(cut == full, "cut after level {} differs", k);
+        }
+        prop_assert!(!decoder.advance().unwrap());
+    }
+
+    #[test]
+    fn every_cut_decodes_to_a_valid_mesh_or_a_clean_error(seed in any::<u64>(), bits in 1u8..=10) {
+        let Some((_, encoded)) = encode(seed, bits, false) else { return Ok(()) };
+        let mut vertices = 0;
+        let (_, header_len) = meshcodec::container::Header::read(&encoded.bytes).unwrap();
+        for cut in 0..encoded.bytes.len() {
+            match codecs::decode(&encoded.bytes[..cut], Stop::All) {
+                Ok((level, _)) => {
+                    assert_valid(&level);
+                    // A longer prefix never decodes to fewer vertices.
+                    prop_assert!(level.mesh.vertex_count() >= vertices);
+                    vertices = level.mesh.vertex_count();
+                }
+                Err(Error::Truncated(_)) => prop_assert!(cut < header_len, "only a cut header may fail"),
+                Err(e) => prop_assert!(false, "cut {}: {}", cut, e),
+            }
+        }
+    }
+}
+
+#[test]
+fn a_cut_inside_a_level_decodes_the_operations_before_it() {
+    let (_, encoded) = encode(7, 12, false).unwrap();
+    let (end5, end6) = (encoded.levels[4].end_byte, encoded.levels[5].end_byte);
+    let at = |cut: usize| codecs::decode(&encoded.bytes[..cut], Stop::All).unwrap().0;
+    let (l5, mid, l6) = (at(end5), at((end5 + end6) / 2), at(end6));
+    assert!(l5.mesh.vertex_count() <= mid.mesh.vertex_count());
+    assert!(mid.mesh.vertex_count() <= l6.mesh.vertex_count());
+    assert!(mid != l5, "half a level adds refinements or splits");
+}
+
+#[test]
+fn corrupt_streams_fail_cleanly() {
+    let (_, encoded) = encode(11, 12, false).unwrap();
+    let mut x = 0x9e37_79b9_u32;
+    for trial in 0..2000 {
+        let mut bytes = encoded.bytes.clone();
+        for _ in 0..1 + trial % 4 {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            let i = x as usize % bytes.len();
+            bytes[i] ^= 1 << (x >> 29);
+        }
+        if let Ok((level, _)) = codecs::decode(&bytes, Stop::All) {
+            assert_valid(&level);
+        }
+    }
+}
