@@ -114,8 +114,16 @@ pub fn encode_options(codec: &dyn Codec, options: &RunOptions) -> EncodeOptions 
     encode
 }
 
+/// A run's result and the stream it measured.
+pub struct RunOutput {
+    /// What was measured.
+    pub result: RunResult,
+    /// The encoded stream.
+    pub stream: Vec<u8>,
+}
+
 /// Runs `codec` on the mesh file at `path`.
-pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunResult> {
+pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOutput> {
     let original = read_mesh(path)?;
     let encode = encode_options(codec, options);
     let canonical = codecs::canonical_for(&original, &encode)?;
@@ -163,8 +171,9 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunRe
         bar.inc(1);
     }
     bar.finish_and_clear();
+    drop(decoder);
 
-    Ok(RunResult {
+    let result = RunResult {
         codec: codec.name().to_string(),
         mesh: mesh_name(path),
         source: path.display().to_string(),
@@ -180,6 +189,10 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunRe
         samples_per_triangle: options.samples_per_triangle,
         codec_stats: encoded.stats,
         levels,
+    };
+    Ok(RunOutput {
+        result,
+        stream: encoded.bytes,
     })
 }
 
@@ -224,13 +237,20 @@ fn progress_bar(show: bool, levels: usize, codec: &str, path: &Path) -> indicati
 }
 
 /// File stem of a run's results: the mesh name, with `-q<bits>` when the quantization is not the
-/// codec's default.
+/// codec's default and `-per-axis` / `-cubic` when the grid is not.
 pub fn result_stem(codec: &dyn Codec, result: &RunResult) -> String {
-    if result.quant_bits == codec.default_options().quant_bits {
-        result.mesh.clone()
-    } else {
-        format!("{}-q{}", result.mesh, result.quant_bits)
+    let defaults = codec.default_options();
+    let mut stem = result.mesh.clone();
+    if result.quant_bits != defaults.quant_bits {
+        stem.push_str(&format!("-q{}", result.quant_bits));
     }
+    if result.grid != defaults.grid {
+        stem.push_str(match result.grid {
+            GridShape::Cubic => "-cubic",
+            GridShape::PerAxis => "-per-axis",
+        });
+    }
+    stem
 }
 
 /// Writes `<out>/<codec>/<stem>.json`, `.csv` and the two plots (PNG and SVG); returns the

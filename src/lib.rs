@@ -35,5 +35,7 @@ pub mod limits;
 pub mod mesh;
 pub mod metrics;
 pub mod plot;
+pub mod render;
+pub mod tables;
 
 pub use error::{Error, Result};

@@ -115,7 +115,7 @@ fn run_label(run: &RunResult, all: &[RunResult]) -> String {
 
 /// Registers a sans-serif font with plotters once: DejaVu Sans from the system if present,
 /// else the Ubuntu font shipped inside the `epaint_default_fonts` crate.
-fn ensure_font() -> Result<()> {
+pub fn ensure_font() -> Result<()> {
     static REGISTERED: OnceLock<std::result::Result<(), String>> = OnceLock::new();
     REGISTERED
         .get_or_init(|| {

@@ -41,6 +41,9 @@ struct Settings {
     /// Folder for results.
     #[arg(long, default_value = "results")]
     out: PathBuf,
+    /// Also write the stream as results/<codec>/<stem>.mc (figures decode it).
+    #[arg(long)]
+    keep_stream: bool,
 }
 
 #[derive(Subcommand)]
@@ -51,6 +54,15 @@ enum Command {
         file: PathBuf,
         #[command(flatten)]
         settings: Settings,
+    },
+    /// Regenerate the papers' tables and figures in paper-tables/ from results/.
+    Tables {
+        /// Folder of result files.
+        #[arg(long, default_value = "results")]
+        results: PathBuf,
+        /// Folder to write the tables to.
+        #[arg(long, default_value = "paper-tables")]
+        out: PathBuf,
     },
 }
 
@@ -76,12 +88,18 @@ struct ExperimentSet {
     quant: Vec<u8>,
     /// Samples per triangle for the metrics.
     samples: Option<usize>,
+    /// Grid shape ("cubic" or "per-axis"); absent: each codec's default.
+    grid: Option<String>,
+    /// Keep the streams beside the results.
+    #[serde(default)]
+    keep_streams: bool,
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match &cli.command {
         Some(Command::Run { file, settings }) => run_set(file, settings),
+        Some(Command::Tables { results, out }) => tables(results, out),
         None => match (&cli.codec, &cli.mesh) {
             (Some(codec), Some(mesh)) => run_one(codec, mesh, &cli.settings).map(|_| ()),
             _ => Err(anyhow::anyhow!(
@@ -112,7 +130,7 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
 fn run_one(codec_name: &str, mesh: &str, settings: &Settings) -> Result<RunResult> {
     let codec = codecs::by_name(codec_name)?;
     let path = resolve(mesh).with_context(|| mesh.to_string())?;
-    run_codec(codec, &path, &run_options(settings, None), &settings.out)
+    run_codec(codec, &path, &run_options(settings, None), &settings.out, settings.keep_stream)
 }
 
 fn run_codec(
@@ -120,8 +138,10 @@ fn run_codec(
     path: &Path,
     options: &RunOptions,
     out: &Path,
+    keep_stream: bool,
 ) -> Result<RunResult> {
-    let result = harness::run(codec, path, options).with_context(|| path.display().to_string())?;
+    let harness::RunOutput { result, stream } =
+        harness::run(codec, path, options).with_context(|| path.display().to_string())?;
     println!(
         "{} on {} ({}): {} vertices, {} triangles at {} bits; {} bytes = {:.3} bits/vertex, \
          {:.3} bits/triangle",
@@ -152,6 +172,11 @@ fn run_codec(
     for path in written {
         println!("wrote {}", path.display());
     }
+    if keep_stream {
+        let path = out.join(&result.codec).join(format!("{stem}.mc"));
+        meshcodec::mesh::io::write_atomically(&path, &stream)?;
+        println!("wrote {}", path.display());
+    }
     if !result.lossless {
         anyhow::bail!("{} on {} is not lossless", result.codec, result.mesh);
     }
@@ -178,8 +203,14 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
     } else {
         set.quant.iter().map(|&q| Some(q)).collect()
     };
+    let grid = match &set.grid {
+        Some(g) => Some(parse_grid(g).map_err(anyhow::Error::msg)?),
+        None => settings.grid,
+    };
     let settings = Settings {
         samples: set.samples.unwrap_or(settings.samples),
+        grid,
+        keep_stream: settings.keep_stream || set.keep_streams,
         ..settings.clone()
     };
     let set_name = mesh_name(file);
@@ -196,6 +227,7 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
                     path,
                     &run_options(&settings, quant),
                     &settings.out,
+                    settings.keep_stream,
                 )?);
             }
         }
@@ -223,6 +255,21 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
             r.bytes as f64 * 8.0 / r.triangles as f64,
             r.lossless
         );
+    }
+    Ok(())
+}
+
+fn tables(results: &Path, out: &Path) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
+    let (written, missing) = meshcodec::tables::regenerate(results, out);
+    for path in &written {
+        println!("wrote {}", path.display());
+    }
+    for why in &missing {
+        println!("skipped {why}");
+    }
+    if written.is_empty() {
+        anyhow::bail!("no table could be made from {}", results.display());
     }
     Ok(())
 }

@@ -55,6 +55,9 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
     let mut stamp = 0u32;
     let mut tally = Tally::default();
     let mut writer = StreamWriter::new(&header);
+    let mut header_bytes = Vec::new();
+    header.write(&mut header_bytes);
+    tally.add("header_bytes", header_bytes.len() as f64);
     let mut levels = Vec::with_capacity(order.levels as usize);
     let mut total = BitLedger::default();
 
