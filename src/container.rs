@@ -105,9 +105,8 @@ impl Header {
             cell: [floats[3], floats[4], floats[5]],
             bits,
         };
-        let far_corner_finite = (0..3).all(|a| {
-            (grid.origin[a] + grid.cell[a] * (1u64 << bits) as f64).is_finite()
-        });
+        let far_corner_finite =
+            (0..3).all(|a| (grid.origin[a] + grid.cell[a] * (1u64 << bits) as f64).is_finite());
         if !floats.iter().all(|f| f.is_finite())
             || !grid.cell.iter().all(|&c| c > 0.0)
             || !far_corner_finite

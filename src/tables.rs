@@ -27,9 +27,39 @@ struct PaperRow {
 
 /// Magnor & Girod, Table 1.
 const EMC_TABLE1: [PaperRow; 3] = [
-    PaperRow { name: "Beethoven", vertices: 2515, triangles: 5036, pm_bytes: 42755, emc_bytes: 23216, conn_bits: 34511, pos_bits: 151206, bits_per_triangle: 6.85, bits_per_vertex: 60.1 },
-    PaperRow { name: "Bunny", vertices: 3318, triangles: 6600, pm_bytes: 56406, emc_bytes: 30416, conn_bits: 42727, pos_bits: 200593, bits_per_triangle: 6.47, bits_per_vertex: 60.5 },
-    PaperRow { name: "VW", vertices: 5217, triangles: 9860, pm_bytes: 88689, emc_bytes: 46875, conn_bits: 65389, pos_bits: 309599, bits_per_triangle: 6.63, bits_per_vertex: 59.3 },
+    PaperRow {
+        name: "Beethoven",
+        vertices: 2515,
+        triangles: 5036,
+        pm_bytes: 42755,
+        emc_bytes: 23216,
+        conn_bits: 34511,
+        pos_bits: 151206,
+        bits_per_triangle: 6.85,
+        bits_per_vertex: 60.1,
+    },
+    PaperRow {
+        name: "Bunny",
+        vertices: 3318,
+        triangles: 6600,
+        pm_bytes: 56406,
+        emc_bytes: 30416,
+        conn_bits: 42727,
+        pos_bits: 200593,
+        bits_per_triangle: 6.47,
+        bits_per_vertex: 60.5,
+    },
+    PaperRow {
+        name: "VW",
+        vertices: 5217,
+        triangles: 9860,
+        pm_bytes: 88689,
+        emc_bytes: 46875,
+        conn_bits: 65389,
+        pos_bits: 309599,
+        bits_per_triangle: 6.63,
+        bits_per_vertex: 59.3,
+    },
 ];
 
 /// Byte counts printed under the paper's Fig. 5: levels 6, 8, 10, 24.
@@ -67,7 +97,10 @@ fn load(results: &Path, codec: &str, stem: &str) -> Result<RunResult> {
 /// Writes paper-tables/emc-table1.md.
 pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
     let mut md = String::new();
-    let _ = writeln!(md, "# EMC, Table 1 — Magnor & Girod, *Fully Embedded Coding of Triangle Meshes*\n");
+    let _ = writeln!(
+        md,
+        "# EMC, Table 1 — Magnor & Girod, *Fully Embedded Coding of Triangle Meshes*\n"
+    );
     let _ = writeln!(md, "Regenerate: `{EMC_TABLE1_COMMAND}`\n");
     let _ = writeln!(md, "Codec `emc`, 24 levels on the paper's per-axis box. Columns as in the paper: PM bytes from its Eq. 2 (17 bytes a vertex); EMC bytes of the stream at level 24 without the header (the paper leaves out its 24-byte header); Conn. bits = connecting-edge flags + STAY/MOVE/DUPLICATE codes; V.Pos. bits = refinement bits + split-distance codes; bits/Δ = Conn. bits over Δ#; bits/vertex = V.Pos. bits over Vertex#. Δ# counts triangles as the paper's decoder rebuilds them: the 3-cliques of the edge graph.\n");
     let _ = writeln!(md, "| Data set | Vertex# | Δ# | PM bytes | EMC bytes | Conn. bits | V.Pos. bits | bits/Δ | bits/Vertex |");
@@ -80,21 +113,62 @@ pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
         let conn = stat(&r, "connecting_flag_bits") + stat(&r, "edge_code_bits");
         let pos = stat(&r, "refinement_bits") + stat(&r, "split_distance_bits");
         let body_bytes = r.bytes as f64 - stat(&r, "header_bytes");
-        let _ = writeln!(md, "| {} (paper) | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} |", paper.name, paper.vertices, paper.triangles, paper.pm_bytes, paper.emc_bytes, paper.conn_bits, paper.pos_bits, paper.bits_per_triangle, paper.bits_per_vertex);
-        let _ = writeln!(md, "| {file} (ours) | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} |", r.vertices, cliques, 17 * r.vertices, body_bytes, conn, pos, conn / cliques, pos / r.vertices as f64);
+        let _ = writeln!(
+            md,
+            "| {} (paper) | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} |",
+            paper.name,
+            paper.vertices,
+            paper.triangles,
+            paper.pm_bytes,
+            paper.emc_bytes,
+            paper.conn_bits,
+            paper.pos_bits,
+            paper.bits_per_triangle,
+            paper.bits_per_vertex
+        );
+        let _ = writeln!(
+            md,
+            "| {file} (ours) | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} |",
+            r.vertices,
+            cliques,
+            17 * r.vertices,
+            body_bytes,
+            conn,
+            pos,
+            conn / cliques,
+            pos / r.vertices as f64
+        );
         let corrections = stat(&r, "face_correction_bits");
         let _ = writeln!(extras, "| {file} | {} | {} | {} | {} | {} | {corrections} ({:.3} bits/vertex) | {} | {} | {} |", r.triangles, cliques, stat(&r, "false_triangles"), stat(&r, "double_sided_faces"), stat(&r, "orientation_exceptions"), corrections / r.vertices as f64, stat(&r, "header_bytes"), r.bytes, r.lossless);
         let _ = writeln!(why, "- **{file}** vs {}: {:+.1}% bits/Δ, {:+.1}% bits/vertex, {:+.1}% EMC bytes; Vertex# {} vs {}.", paper.name, 100.0 * (conn / cliques / paper.bits_per_triangle - 1.0), 100.0 * (pos / r.vertices as f64 / paper.bits_per_vertex - 1.0), 100.0 * (body_bytes / paper.emc_bytes as f64 - 1.0), r.vertices, paper.vertices);
     }
-    let _ = writeln!(md, "\n## Fig. 5 byte counts: stream bytes up to the end of levels 6, 8 and 10\n");
+    let _ = writeln!(
+        md,
+        "\n## Fig. 5 byte counts: stream bytes up to the end of levels 6, 8 and 10\n"
+    );
     let _ = writeln!(md, "| model | level 6 | level 8 | level 10 | level 24 |");
     let _ = writeln!(md, "|---|---:|---:|---:|---:|");
     for (paper, (file, stem)) in EMC_TABLE1.iter().zip(EMC_TABLE1_MESHES) {
         let r = load(results, "emc", stem)?;
         let at = |l: usize| r.levels[l - 1].bits / 8;
-        let p = FIG5_BYTES.iter().find(|f| f.0 == paper.name).map(|f| f.1).unwrap_or([0; 4]);
-        let _ = writeln!(md, "| {} (paper) | {} | {} | {} | {} |", paper.name, p[0], p[1], p[2], p[3]);
-        let _ = writeln!(md, "| {file} (ours) | {} | {} | {} | {} |", at(6), at(8), at(10), at(24));
+        let p = FIG5_BYTES
+            .iter()
+            .find(|f| f.0 == paper.name)
+            .map(|f| f.1)
+            .unwrap_or([0; 4]);
+        let _ = writeln!(
+            md,
+            "| {} (paper) | {} | {} | {} | {} |",
+            paper.name, p[0], p[1], p[2], p[3]
+        );
+        let _ = writeln!(
+            md,
+            "| {file} (ours) | {} | {} | {} | {} |",
+            at(6),
+            at(8),
+            at(10),
+            at(24)
+        );
     }
     let _ = writeln!(md, "\nThe rendered levels are in [emc-fig5.png](emc-fig5.png); the rate-resolution curves (Fig. 4) in [emc-fig4.png](emc-fig4.png).");
     let _ = writeln!(md, "\n## What exact losslessness costs beyond the paper\n");
@@ -126,9 +200,21 @@ pub fn emc_fig4(results: &Path, out: &Path) -> Result<Vec<PathBuf>> {
 /// Views that show each model from the front, as the paper's Fig. 5.
 fn view_of(mesh: &str) -> View {
     match mesh {
-        "beethoven" => View { up: 1, yaw: 0.0, pitch: 0.0 },
-        "bunny-3k-closed" => View { up: 1, yaw: 0.0, pitch: 0.0 },
-        _ => View { up: 1, yaw: 30.0, pitch: 20.0 },
+        "beethoven" => View {
+            up: 1,
+            yaw: 0.0,
+            pitch: 0.0,
+        },
+        "bunny-3k-closed" => View {
+            up: 1,
+            yaw: 0.0,
+            pitch: 0.0,
+        },
+        _ => View {
+            up: 1,
+            yaw: 30.0,
+            pitch: 20.0,
+        },
     }
 }
 
@@ -149,7 +235,10 @@ pub fn emc_fig5(results: &Path, out: &Path) -> Result<PathBuf> {
         let result = load(results, "emc", stem)?;
         let stream_path = results.join("emc").join(format!("{stem}.mc"));
         let stream = std::fs::read(&stream_path).map_err(|e| {
-            Error::Unsupported(format!("{}: {e} (make it with: {EMC_TABLE1_COMMAND})", stream_path.display()))
+            Error::Unsupported(format!(
+                "{}: {e} (make it with: {EMC_TABLE1_COMMAND})",
+                stream_path.display()
+            ))
         })?;
         let original = read_mesh(Path::new(&result.source))?;
         let frame = original

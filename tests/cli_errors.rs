@@ -167,7 +167,10 @@ fn emc_commands_work_on_every_shared_mesh() {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| {
-            let ext = p.extension().map(|e| e.to_string_lossy().to_string()).unwrap_or_default();
+            let ext = p
+                .extension()
+                .map(|e| e.to_string_lossy().to_string())
+                .unwrap_or_default();
             meshcodec::mesh::io::EXTENSIONS.contains(&ext.as_str())
         })
         .collect();
@@ -180,7 +183,11 @@ fn emc_commands_work_on_every_shared_mesh() {
             assert_eq!(out.code, Some(0), "{args:?}: {}", out.stderr);
         };
         ok(&["encode", "--codec", "emc", f, "m.mc"]);
-        let info = Command::new(MESHCODEC).args(["info", "m.mc", "--json"]).current_dir(d).output().unwrap();
+        let info = Command::new(MESHCODEC)
+            .args(["info", "m.mc", "--json"])
+            .current_dir(d)
+            .output()
+            .unwrap();
         assert!(info.status.success());
         let json: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
         assert_eq!(json["codec"], "emc");
@@ -189,10 +196,24 @@ fn emc_commands_work_on_every_shared_mesh() {
         assert_eq!(json["cell"].as_array().unwrap().len(), 3);
         ok(&["decode", "m.mc", "full.ply"]);
         ok(&["decode", "m.mc", "level8.obj", "--level", "8"]);
-        ok(&["decode", "m.mc", "half.ply", "--bytes", &(std::fs::metadata(d.join("m.mc")).unwrap().len() / 2).to_string()]);
+        ok(&[
+            "decode",
+            "m.mc",
+            "half.ply",
+            "--bytes",
+            &(std::fs::metadata(d.join("m.mc")).unwrap().len() / 2).to_string(),
+        ]);
         let full = meshcodec::mesh::io::read_mesh(&d.join("full.ply")).unwrap();
-        assert_eq!(full.vertex_count() as u64, json["vertices"].as_u64().unwrap(), "{f}");
-        assert_eq!(full.face_count() as u64, json["triangles"].as_u64().unwrap(), "{f}");
+        assert_eq!(
+            full.vertex_count() as u64,
+            json["vertices"].as_u64().unwrap(),
+            "{f}"
+        );
+        assert_eq!(
+            full.face_count() as u64,
+            json["triangles"].as_u64().unwrap(),
+            "{f}"
+        );
         let coarse = meshcodec::mesh::io::read_mesh(&d.join("level8.obj")).unwrap();
         assert!(coarse.vertex_count() <= full.vertex_count());
     }

@@ -18,8 +18,14 @@ fn cases() -> u32 {
 fn assert_valid(level: &LevelMesh) {
     let n = level.mesh.positions.len() as u32;
     for f in &level.mesh.faces {
-        assert!(f.iter().all(|&v| v < n), "face {f:?} out of range ({n} vertices)");
-        assert!(f[0] != f[1] && f[1] != f[2] && f[0] != f[2], "degenerate face {f:?}");
+        assert!(
+            f.iter().all(|&v| v < n),
+            "face {f:?} out of range ({n} vertices)"
+        );
+        assert!(
+            f[0] != f[1] && f[1] != f[2] && f[0] != f[2],
+            "degenerate face {f:?}"
+        );
     }
     for e in &level.loose_edges {
         assert!(e[0] < n && e[1] < n && e[0] != e[1], "bad edge {e:?}");
@@ -27,12 +33,26 @@ fn assert_valid(level: &LevelMesh) {
     assert!(level.mesh.positions.iter().all(|p| p.is_finite()));
 }
 
-fn encode(seed: u64, bits: u8, per_axis: bool) -> Option<(meshcodec::mesh::CanonicalMesh, codecs::Encoded)> {
+fn encode(
+    seed: u64,
+    bits: u8,
+    per_axis: bool,
+) -> Option<(meshcodec::mesh::CanonicalMesh, codecs::Encoded)> {
     let mesh = generate::messy(seed);
-    let grid = if per_axis { GridShape::PerAxis } else { GridShape::Cubic };
-    let options = EncodeOptions { quant_bits: bits, grid };
+    let grid = if per_axis {
+        GridShape::PerAxis
+    } else {
+        GridShape::Cubic
+    };
+    let options = EncodeOptions {
+        quant_bits: bits,
+        grid,
+    };
     let canonical = codecs::canonical_for(&mesh, &options).ok()?;
-    let encoded = codecs::by_name("emc").unwrap().encode(&canonical, &options).unwrap();
+    let encoded = codecs::by_name("emc")
+        .unwrap()
+        .encode(&canonical, &options)
+        .unwrap();
     Some((canonical, encoded))
 }
 

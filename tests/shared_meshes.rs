@@ -79,7 +79,10 @@ fn every_shared_mesh_round_trips_losslessly() {
                     if codec.name() == "raw" && grid == GridShape::PerAxis {
                         continue;
                     }
-                    let options = EncodeOptions { quant_bits: bits, grid };
+                    let options = EncodeOptions {
+                        quant_bits: bits,
+                        grid,
+                    };
                     let canonical = codecs::canonical_for(&mesh, &options).unwrap();
                     let encoded = codec.encode(&canonical, &options).unwrap();
                     let (decoded, _) = codecs::decode(&encoded.bytes, Stop::All).unwrap();

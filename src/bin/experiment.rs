@@ -130,7 +130,13 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
 fn run_one(codec_name: &str, mesh: &str, settings: &Settings) -> Result<RunResult> {
     let codec = codecs::by_name(codec_name)?;
     let path = resolve(mesh).with_context(|| mesh.to_string())?;
-    run_codec(codec, &path, &run_options(settings, None), &settings.out, settings.keep_stream)
+    run_codec(
+        codec,
+        &path,
+        &run_options(settings, None),
+        &settings.out,
+        settings.keep_stream,
+    )
 }
 
 fn run_codec(

@@ -34,23 +34,79 @@ pub fn triangles(adjacency: &[Vec<u32>]) -> Vec<[u32; 3]> {
     out
 }
 
-/// Edges of the graph that lie on no triangle of `tris`.
-pub fn loose_edges(adjacency: &[Vec<u32>], tris: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let mut on_triangle: Vec<(u32, u32)> = tris
-        .iter()
-        .flat_map(|&[a, b, c]| [(a, b), (b, c), (a, c)])
-        .collect();
-    on_triangle.sort_unstable();
-    on_triangle.dedup();
-    let mut out = Vec::new();
-    for (a, around) in adjacency.iter().enumerate() {
-        for &b in around.iter().filter(|&&b| b > a as u32) {
-            if on_triangle.binary_search(&(a as u32, b)).is_err() {
-                out.push([a as u32, b]);
-            }
+/// Numbers the edges of a graph: edge (a, b) with a < b gets `first[a]` + the rank of b among
+/// a's neighbours above a. Lets per-edge data live in flat arrays instead of sorted pair lists.
+pub struct EdgeIds<'g> {
+    adjacency: &'g [Vec<u32>],
+    first: Vec<u32>,
+    /// Where each vertex's neighbours above it start in its list.
+    above: Vec<u32>,
+}
+
+impl<'g> EdgeIds<'g> {
+    /// Numbers the edges of `adjacency` (sorted lists).
+    pub fn new(adjacency: &'g [Vec<u32>]) -> Self {
+        let mut first = Vec::with_capacity(adjacency.len() + 1);
+        let mut above = Vec::with_capacity(adjacency.len());
+        let mut total = 0u32;
+        for (a, list) in adjacency.iter().enumerate() {
+            let start = list.partition_point(|&x| x <= a as u32);
+            first.push(total);
+            above.push(start as u32);
+            total += (list.len() - start) as u32;
+        }
+        first.push(total);
+        EdgeIds {
+            adjacency,
+            first,
+            above,
         }
     }
-    out
+
+    /// Number of edges.
+    pub fn len(&self) -> usize {
+        *self.first.last().unwrap_or(&0) as usize
+    }
+
+    /// True for a graph without edges.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Id of edge (a, b), a < b, which must exist.
+    pub fn id(&self, a: u32, b: u32) -> usize {
+        let list = &self.adjacency[a as usize];
+        let above = &list[self.above[a as usize] as usize..];
+        self.first[a as usize] as usize + above.partition_point(|&x| x < b)
+    }
+
+    /// The edges in id order.
+    pub fn edges(&self) -> impl Iterator<Item = [u32; 2]> + '_ {
+        self.adjacency
+            .iter()
+            .enumerate()
+            .flat_map(move |(a, list)| {
+                list[self.above[a] as usize..]
+                    .iter()
+                    .map(move |&b| [a as u32, b])
+            })
+    }
+}
+
+/// Edges of the graph that lie on no triangle of `tris` (ascending triples of its edges).
+pub fn loose_edges(adjacency: &[Vec<u32>], tris: &[[u32; 3]]) -> Vec<[u32; 2]> {
+    let ids = EdgeIds::new(adjacency);
+    let mut covered = vec![false; ids.len()];
+    for &[a, b, c] in tris {
+        for (u, v) in [(a, b), (b, c), (a, c)] {
+            covered[ids.id(u, v)] = true;
+        }
+    }
+    ids.edges()
+        .zip(covered)
+        .filter(|(_, c)| !c)
+        .map(|(e, _)| e)
+        .collect()
 }
 
 /// A triangle as an ascending triple plus whether it is flipped: unflipped means the cycle
@@ -69,7 +125,8 @@ fn traverses(tri: [u32; 3], u: u32, v: u32) -> bool {
     (u, v) == (a, b) || (u, v) == (b, c) || (u, v) == (c, a)
 }
 
-/// Orients the triangles `tris` (ascending triples) that are not `skipped`.
+/// Orients the triangles `tris` (ascending triples of edges of the graph `adjacency`) that are
+/// not `skipped`.
 ///
 /// Visits them patch by patch in a fixed order: a patch starts at its lowest unvisited
 /// triangle, whose orientation is guessed so that its normal points away from `centre`, and
@@ -82,42 +139,42 @@ fn traverses(tri: [u32; 3], u: u32, v: u32) -> bool {
 pub fn propagate_orientation(
     tris: &[[u32; 3]],
     skipped: &[bool],
+    adjacency: &[Vec<u32>],
     positions: &[DVec3],
     centre: DVec3,
     mut decide: impl FnMut(usize, usize, bool) -> bool,
 ) -> Vec<bool> {
-    // Edge → triangles, by sorting (edge, triangle) pairs.
-    let mut by_edge: Vec<((u32, u32), u32)> = tris
-        .iter()
-        .enumerate()
-        .filter(|(t, _)| !skipped[*t])
-        .flat_map(|(t, &[a, b, c])| [((a, b), t as u32), ((b, c), t as u32), ((a, c), t as u32)])
-        .collect();
-    by_edge.sort_unstable();
-    // For each triangle and each of its 3 edges, the one other triangle across it, if exactly one.
-    let mut across = vec![[u32::MAX; 3]; tris.len()];
-    let mut i = 0;
-    while i < by_edge.len() {
-        let mut j = i + 1;
-        while j < by_edge.len() && by_edge[j].0 == by_edge[i].0 {
-            j += 1;
+    // For each edge, how many non-skipped triangles use it and the first two of them.
+    let ids = EdgeIds::new(adjacency);
+    let mut users = vec![(0u32, u32::MAX, u32::MAX); ids.len()];
+    let edge_slots = |&[a, b, c]: &[u32; 3]| [(a, b), (b, c), (a, c)];
+    for (t, tri) in tris.iter().enumerate() {
+        if skipped[t] {
+            continue;
         }
-        if j - i == 2 {
-            let (e, t1, t2) = (by_edge[i].0, by_edge[i].1, by_edge[i + 1].1);
-            for (t, other) in [(t1, t2), (t2, t1)] {
-                // Edges of an ascending triple: (a,b) slot 0, (b,c) slot 1, (a,c) slot 2.
-                let [a, b, _] = tris[t as usize];
-                let slot = if e == (a, b) {
-                    0
-                } else if e.0 == b {
-                    1
-                } else {
-                    2
-                };
-                across[t as usize][slot] = other;
+        for (u, v) in edge_slots(tri) {
+            let e = &mut users[ids.id(u, v)];
+            match e.0 {
+                0 => e.1 = t as u32,
+                1 => e.2 = t as u32,
+                _ => {}
+            }
+            e.0 += 1;
+        }
+    }
+    // For each triangle and each of its edges (a,b), (b,c), (a,c): the one other triangle across
+    // it, if exactly two share the edge.
+    let mut across = vec![[u32::MAX; 3]; tris.len()];
+    for (t, tri) in tris.iter().enumerate() {
+        if skipped[t] {
+            continue;
+        }
+        for (slot, (u, v)) in edge_slots(tri).into_iter().enumerate() {
+            let (count, first, second) = users[ids.id(u, v)];
+            if count == 2 {
+                across[t][slot] = if first == t as u32 { second } else { first };
             }
         }
-        i = j;
     }
     let mut flipped = vec![false; tris.len()];
     let mut seen = skipped.to_vec();
@@ -191,6 +248,7 @@ mod tests {
         let flipped = propagate_orientation(
             &tris,
             &skipped,
+            &adj,
             &sphere.positions,
             DVec3::ZERO,
             |_, _, p| {

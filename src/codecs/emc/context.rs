@@ -107,16 +107,15 @@ impl EmcState {
         r as usize
     }
 
-    /// Position of vertex `v`: the centre of its cell at the resolution it has reached.
-    pub fn position(&self, grid: &Grid, v: usize) -> DVec3 {
-        let bits = self.order.bits_per_axis(self.depth[v] as usize);
-        let shift = bits.map(|b| grid.bits - b);
-        grid.coarse_centre(self.cells[v], shift)
-    }
-
-    /// All positions.
+    /// Position of every vertex: the centre of its cell at the resolution it has reached.
     pub fn positions(&self, grid: &Grid) -> Vec<DVec3> {
-        (0..self.len()).map(|v| self.position(grid, v)).collect()
+        // Vertices share few depths: work out each depth's cell shifts once.
+        let shifts: Vec<[u8; 3]> = (0..=self.order.steps())
+            .map(|d| self.order.bits_per_axis(d).map(|b| grid.bits - b))
+            .collect();
+        (0..self.len())
+            .map(|v| grid.coarse_centre(self.cells[v], shifts[self.depth[v] as usize]))
+            .collect()
     }
 
     /// The 3-cliques of the edge graph, ascending triples in lexicographic order.
@@ -131,7 +130,14 @@ impl EmcState {
         let cliques = self.cliques();
         let skipped = vec![false; cliques.len()];
         let centre = centroid(&positions);
-        let flipped = propagate_orientation(&cliques, &skipped, &positions, centre, |_, _, p| p);
+        let flipped = propagate_orientation(
+            &cliques,
+            &skipped,
+            &self.adjacency,
+            &positions,
+            centre,
+            |_, _, p| p,
+        );
         let faces = cliques
             .iter()
             .zip(&flipped)
@@ -166,6 +172,7 @@ pub struct FaceCorrections {
 /// Applies `corrections` to the cliques of the final state: the faces of the full mesh.
 pub fn final_faces(
     cliques: &[[u32; 3]],
+    adjacency: &[Vec<u32>],
     positions: &[DVec3],
     corrections: &FaceCorrections,
 ) -> Vec<[u32; 3]> {
@@ -181,6 +188,7 @@ pub fn final_faces(
     let flipped = propagate_orientation(
         cliques,
         &skipped,
+        adjacency,
         positions,
         centroid(positions),
         |visit, _, predicted| {
@@ -192,17 +200,16 @@ pub fn final_faces(
             }
         },
     );
-    let is_false: std::collections::HashSet<u32> =
-        corrections.false_triangles.iter().copied().collect();
-    let mut faces = Vec::with_capacity(cliques.len());
+    let mut double = vec![false; cliques.len()];
+    for &i in &corrections.double_sided {
+        double[i as usize] = true;
+    }
+    let mut faces = Vec::with_capacity(cliques.len() + corrections.double_sided.len());
     for (i, &t) in cliques.iter().enumerate() {
-        if is_false.contains(&(i as u32)) {
-            continue;
-        }
-        if corrections.double_sided.binary_search(&(i as u32)).is_ok() {
+        if double[i] {
             faces.push(oriented(t, false));
             faces.push(oriented(t, true));
-        } else {
+        } else if !skipped[i] {
             faces.push(oriented(t, flipped[i]));
         }
     }

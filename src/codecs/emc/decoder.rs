@@ -16,8 +16,8 @@ pub struct EmcDecoder<'a> {
     header: Header,
     state: EmcState,
     levels_done: usize,
-    /// Faces of the full mesh once the last level's corrections are read.
-    final_faces: Option<Vec<[u32; 3]>>,
+    /// The full mesh once the last level's corrections are read.
+    final_mesh: Option<LevelMesh>,
 }
 
 /// Why a level could not be decoded to its end.
@@ -36,7 +36,7 @@ impl<'a> EmcDecoder<'a> {
             header,
             stream,
             levels_done: 0,
-            final_faces: None,
+            final_mesh: None,
         }
     }
 
@@ -122,7 +122,7 @@ impl<'a> EmcDecoder<'a> {
             orientation_exceptions,
         };
         let positions = self.state.positions(&self.header.grid);
-        let faces = final_faces(&cliques, &positions, &corrections);
+        let faces = final_faces(&cliques, &self.state.adjacency, &positions, &corrections);
         if faces.len() as u64 != self.header.triangles {
             return Err(fault(&format!(
                 "{} triangles decoded, the header declares {}",
@@ -130,7 +130,20 @@ impl<'a> EmcDecoder<'a> {
                 self.header.triangles
             )));
         }
-        self.final_faces = Some(faces);
+        let mut is_false = vec![false; cliques.len()];
+        for &i in &corrections.false_triangles {
+            is_false[i as usize] = true;
+        }
+        let true_cliques: Vec<[u32; 3]> = cliques
+            .iter()
+            .zip(&is_false)
+            .filter(|(_, &f)| !f)
+            .map(|(t, _)| *t)
+            .collect();
+        self.final_mesh = Some(LevelMesh {
+            loose_edges: loose_edges(&self.state.adjacency, &true_cliques),
+            mesh: TriMesh::new(positions, faces),
+        });
         Ok(())
     }
 }
@@ -176,22 +189,8 @@ impl LevelDecoder for EmcDecoder<'_> {
     }
 
     fn mesh(&self) -> LevelMesh {
-        match &self.final_faces {
-            Some(faces) => {
-                let positions = self.state.positions(&self.header.grid);
-                let unoriented: Vec<[u32; 3]> = faces
-                    .iter()
-                    .map(|f| {
-                        let mut t = *f;
-                        t.sort_unstable();
-                        t
-                    })
-                    .collect();
-                LevelMesh {
-                    loose_edges: loose_edges(&self.state.adjacency, &unoriented),
-                    mesh: TriMesh::new(positions, faces.clone()),
-                }
-            }
+        match &self.final_mesh {
+            Some(mesh) => mesh.clone(),
             None => self.state.level_mesh(&self.header.grid),
         }
     }

@@ -232,6 +232,7 @@ fn face_corrections(
     propagate_orientation(
         &cliques,
         &skipped,
+        &state.adjacency,
         &positions,
         centre,
         |visit, t, predicted| {
@@ -250,7 +251,7 @@ fn face_corrections(
     );
     debug_assert_eq!(
         {
-            let mut got: Vec<_> = final_faces(&cliques, &positions, &corrections)
+            let mut got: Vec<_> = final_faces(&cliques, &state.adjacency, &positions, &corrections)
                 .into_iter()
                 .map(rotate_to_smallest)
                 .collect();
