@@ -47,6 +47,8 @@ pub struct Chart {
     pub y_log: bool,
     /// Curves.
     pub series: Vec<Series>,
+    /// Corner for the legend, away from where the curves run.
+    pub legend: SeriesLabelPosition,
 }
 
 /// Rate-resolution chart: resolution level vs cumulative bits per vertex, one curve per run.
@@ -57,6 +59,7 @@ pub fn rate_resolution(runs: &[RunResult], title: &str) -> Chart {
         y_desc: "cumulative bits per vertex".into(),
         x_log: false,
         y_log: false,
+        legend: SeriesLabelPosition::UpperLeft,
         series: runs
             .iter()
             .map(|r| Series {
@@ -80,6 +83,7 @@ pub fn rate_distortion(runs: &[RunResult], title: &str) -> Chart {
         y_desc: "Hausdorff error / bounding-box diagonal (log)".into(),
         x_log: true,
         y_log: true,
+        legend: SeriesLabelPosition::UpperRight,
         series: runs
             .iter()
             .map(|r| Series {
@@ -259,7 +263,7 @@ impl Chart {
             .label_font(("sans-serif", 20))
             .background_style(WHITE.mix(0.85))
             .border_style(RGBColor(160, 160, 160))
-            .position(SeriesLabelPosition::UpperRight)
+            .position(self.legend.clone())
             .draw()
             .map_err(plot_error)?;
         Ok(())
