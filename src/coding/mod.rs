@@ -1,6 +1,7 @@
 //! Bits without meshes: a bit ledger that classes every syntax element as connectivity or
 //! geometry, bit-level writers and readers over it, and LEB128 variable-length integers.
 
+pub mod arith;
 pub mod bits;
 pub mod huffman;
 pub mod varint;

@@ -3,3 +3,5 @@
 
 pub mod cliques;
 pub mod octree;
+pub mod pmesh;
+pub mod simplify;

@@ -1,0 +1,624 @@
+//! Garland–Heckbert quadric error simplification by edge collapses, and the progressive mesh it
+//! defines (Hoppe: base mesh M⁰ plus the vertex splits that undo the collapses in reverse).
+//!
+//! Collapses are taken cheapest first from a binary heap with lazy invalidation (a per-vertex
+//! version stamp), so simplification is O(f log f). A collapse must keep the mesh a manifold
+//! (link condition; no interior edge between two boundary vertices; no two faces on the same
+//! three vertices), must not flip a face's normal, and keeps boundaries through constraint
+//! quadrics on boundary edges. When the heap runs dry, every edge is queued again, until a
+//! whole pass collapses nothing: the base mesh is then as small as these rules allow.
+
+use super::pmesh::{anchor, PmMesh, Rotation, Vsplit, NIL};
+use glam::DVec3;
+use rayon::prelude::*;
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+/// Where a collapse puts the remaining vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Placement {
+    /// Where the summed quadric is smallest (rounded to a cell), else the best endpoint or
+    /// midpoint.
+    Optimal,
+    /// One of the endpoints or their midpoint (Hoppe §6: vad_s = 0).
+    EndpointOrMidpoint,
+}
+
+/// A symmetric 4 × 4 quadric: a2 ab ac ad b2 bc bd c2 cd d2.
+#[derive(Clone, Copy, Debug, Default)]
+struct Quadric([f64; 10]);
+
+impl Quadric {
+    fn plane(n: DVec3, d: f64, w: f64) -> Quadric {
+        let (a, b, c) = (n.x, n.y, n.z);
+        Quadric([a * a, a * b, a * c, a * d, b * b, b * c, b * d, c * c, c * d, d * d].map(|x| x * w))
+    }
+    fn add(&mut self, o: &Quadric) {
+        for i in 0..10 {
+            self.0[i] += o.0[i];
+        }
+    }
+    fn sum(a: &Quadric, b: &Quadric) -> Quadric {
+        let mut q = *a;
+        q.add(b);
+        q
+    }
+    fn error(&self, p: DVec3) -> f64 {
+        let q = &self.0;
+        let (x, y, z) = (p.x, p.y, p.z);
+        x * x * q[0] + 2.0 * x * y * q[1] + 2.0 * x * z * q[2] + 2.0 * x * q[3]
+            + y * y * q[4] + 2.0 * y * z * q[5] + 2.0 * y * q[6]
+            + z * z * q[7] + 2.0 * z * q[8] + q[9]
+    }
+    fn minimizer(&self) -> Option<DVec3> {
+        let q = &self.0;
+        let m = glam::DMat3::from_cols(
+            DVec3::new(q[0], q[1], q[2]),
+            DVec3::new(q[1], q[4], q[5]),
+            DVec3::new(q[2], q[5], q[7]),
+        );
+        let det = m.determinant();
+        let scale = (q[0] + q[4] + q[7]).powi(3).abs().max(f64::MIN_POSITIVE);
+        if det.abs() < 1e-9 * scale {
+            return None;
+        }
+        Some(m.inverse() * -DVec3::new(q[3], q[6], q[8]))
+    }
+}
+
+/// One edge collapse, recorded with what its inverse split needs.
+#[derive(Clone, Debug)]
+pub struct Collapse {
+    /// Remaining vertex.
+    pub vs: u32,
+    /// Removed vertex.
+    pub vt: u32,
+    /// Positions of vs and vt before the collapse.
+    pub before: [[i32; 3]; 2],
+    /// Position of vs after it.
+    pub after: [i32; 3],
+    /// Removed faces: fl holds directed edge vt → vs, fr (or NIL) vs → vt.
+    pub fl: u32,
+    /// See `fl`.
+    pub fr: u32,
+    /// Third corners of fl and fr (vr NIL when fr is).
+    pub vl: u32,
+    /// See `vl`.
+    pub vr: u32,
+    /// Faces of vt other than fl and fr, which now hold vs.
+    pub moved: Vec<u32>,
+}
+
+/// The result of simplification: collapses in order, and what remains.
+pub struct Simplified {
+    /// Collapses, first to last.
+    pub collapses: Vec<Collapse>,
+    /// Which vertices remain.
+    pub vertex_alive: Vec<bool>,
+    /// Which faces remain.
+    pub face_alive: Vec<bool>,
+    /// Positions after simplification.
+    pub positions: Vec<[i32; 3]>,
+    /// Faces (remaining ones valid) after simplification.
+    pub faces: Vec<[u32; 3]>,
+}
+
+#[derive(PartialEq)]
+struct Candidate {
+    cost: f64,
+    a: u32,
+    b: u32,
+    stamps: (u32, u32),
+}
+impl Eq for Candidate {}
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Candidate {
+    fn cmp(&self, other: &Self) -> Ordering {
+        // Reversed: the heap pops the cheapest first; ties by vertex ids, for determinism.
+        other
+            .cost
+            .total_cmp(&self.cost)
+            .then_with(|| (other.a, other.b).cmp(&(self.a, self.b)))
+    }
+}
+
+fn to_f(c: [i32; 3]) -> DVec3 {
+    DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
+}
+
+fn round_cell(p: DVec3) -> [i32; 3] {
+    [p.x.round() as i32, p.y.round() as i32, p.z.round() as i32]
+}
+
+struct State {
+    cells: Vec<[i32; 3]>,
+    faces: Vec<[u32; 3]>,
+    face_alive: Vec<bool>,
+    vertex_alive: Vec<bool>,
+    vfaces: Vec<Vec<u32>>,
+    quadrics: Vec<Quadric>,
+    stamp: Vec<u32>,
+    placement: Placement,
+}
+
+impl State {
+    fn normal(&self, f: [u32; 3], replace: u32, with: DVec3) -> DVec3 {
+        let p = |v: u32| if v == replace { with } else { to_f(self.cells[v as usize]) };
+        let (a, b, c) = (p(f[0]), p(f[1]), p(f[2]));
+        (b - a).cross(c - a)
+    }
+
+    fn neighbours(&self, v: u32, out: &mut Vec<u32>) {
+        out.clear();
+        for &f in &self.vfaces[v as usize] {
+            out.extend(self.faces[f as usize].iter().filter(|&&w| w != v));
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+
+    /// Best position for collapsing (a, b) and its cost.
+    fn place(&self, a: u32, b: u32) -> ([i32; 3], f64) {
+        let q = Quadric::sum(&self.quadrics[a as usize], &self.quadrics[b as usize]);
+        let (ca, cb) = (self.cells[a as usize], self.cells[b as usize]);
+        let mut best = (ca, q.error(to_f(ca)));
+        let mut consider = |c: [i32; 3]| {
+            let e = q.error(to_f(c));
+            if e < best.1 {
+                best = (c, e);
+            }
+        };
+        consider(cb);
+        consider(anchor(1, ca, cb));
+        consider(anchor(1, cb, ca));
+        if self.placement == Placement::Optimal {
+            if let Some(p) = q.minimizer() {
+                let lo = to_f(ca).min(to_f(cb));
+                let hi = to_f(ca).max(to_f(cb));
+                let span = (hi - lo).max_element().max(1.0);
+                // An optimum far outside the edge's box is a numerical accident.
+                if (p - (lo + hi) * 0.5).length() < 2.0 * span {
+                    consider(round_cell(p));
+                }
+            }
+        }
+        (best.0, best.1.max(0.0))
+    }
+
+    /// The collapse of (a, b) to `p` if it keeps the mesh valid: (vs, vt, fl, fr, vl, vr).
+    fn check(&self, a: u32, b: u32, p: [i32; 3], scratch: &mut [Vec<u32>; 3]) -> Option<(u32, u32, u32, u32, u32, u32)> {
+        let edge_faces: Vec<u32> = self.vfaces[a as usize]
+            .iter()
+            .copied()
+            .filter(|&f| self.faces[f as usize].contains(&b))
+            .collect();
+        if edge_faces.is_empty() || edge_faces.len() > 2 {
+            return None;
+        }
+        let [na, nb, _] = scratch;
+        self.neighbours(a, na);
+        self.neighbours(b, nb);
+        let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
+        if common != edge_faces.len() {
+            return None; // link condition
+        }
+        let (bound_a, bound_b) = (na.len() != self.vfaces[a as usize].len(), nb.len() != self.vfaces[b as usize].len());
+        if edge_faces.len() == 2 && bound_a && bound_b {
+            return None;
+        }
+        // Directed edge u → w lies in face f?
+        let holds = |f: u32, u: u32, w: u32| {
+            let t = self.faces[f as usize];
+            (0..3).any(|k| t[k] == u && t[(k + 1) % 3] == w)
+        };
+        let third = |f: u32, u: u32, w: u32| {
+            *self.faces[f as usize].iter().find(|&&x| x != u && x != w).expect("third corner")
+        };
+        // Survivor: for a boundary edge, the face must hold vt → vs; else the endpoint nearer p.
+        let (vs, vt) = if edge_faces.len() == 1 {
+            if holds(edge_faces[0], b, a) { (a, b) } else { (b, a) }
+        } else {
+            let da = (to_f(self.cells[a as usize]) - to_f(p)).length_squared();
+            let db = (to_f(self.cells[b as usize]) - to_f(p)).length_squared();
+            if da <= db { (a, b) } else { (b, a) }
+        };
+        let fl = *edge_faces.iter().find(|&&f| holds(f, vt, vs))?;
+        let fr = edge_faces.iter().copied().find(|&f| holds(f, vs, vt)).unwrap_or(NIL);
+        let (vl, vr) = (third(fl, vs, vt), if fr == NIL { NIL } else { third(fr, vs, vt) });
+        // A split that gives vt no old face is located from vs's faces across (vs, vl) and
+        // (vs, vr): they must exist.
+        let vt_keeps_none = self.vfaces[vt as usize].iter().all(|&f| f == fl || f == fr);
+        if vt_keeps_none {
+            let beside = |u: u32, w: u32, not: u32| {
+                self.vfaces[vs as usize].iter().any(|&f| f != not && holds(f, u, w))
+            };
+            if !beside(vl, vs, fl) || (fr != NIL && !beside(vs, vr, fr)) {
+                return None;
+            }
+        }
+        let pf = to_f(p);
+        // No fold-over, no degenerate face.
+        for &v in &[a, b] {
+            for &f in &self.vfaces[v as usize] {
+                if f == fl || f == fr {
+                    continue;
+                }
+                let t = self.faces[f as usize];
+                let old = self.normal(t, NIL, DVec3::ZERO);
+                let new = self.normal(t, v, pf);
+                if new.length_squared() == 0.0 || old.dot(new) <= 0.0 {
+                    return None;
+                }
+            }
+        }
+        // No two faces on the same three vertices afterwards.
+        let [_, _, keys] = scratch;
+        keys.clear();
+        for &f in &self.vfaces[vs as usize] {
+            if f != fl && f != fr {
+                let mut t = self.faces[f as usize];
+                t.sort_unstable();
+                keys.push(t[0] ^ t[1].rotate_left(11) ^ t[2].rotate_left(22));
+            }
+        }
+        for &f in &self.vfaces[vt as usize] {
+            if f == fl || f == fr {
+                continue;
+            }
+            let mut t = self.faces[f as usize].map(|x| if x == vt { vs } else { x });
+            t.sort_unstable();
+            let key = t[0] ^ t[1].rotate_left(11) ^ t[2].rotate_left(22);
+            if keys.contains(&key) {
+                let clash = self.vfaces[vs as usize].iter().any(|&g| {
+                    let mut u = self.faces[g as usize];
+                    u.sort_unstable();
+                    g != fl && g != fr && u == t
+                });
+                if clash {
+                    return None;
+                }
+            }
+        }
+        Some((vs, vt, fl, fr, vl, vr))
+    }
+}
+
+/// Simplifies the oriented manifold mesh (`cells`, `faces`) as far as the rules allow.
+pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) -> Simplified {
+    let n = cells.len();
+    let mut vfaces = vec![Vec::new(); n];
+    for (f, t) in faces.iter().enumerate() {
+        for &v in t {
+            vfaces[v as usize].push(f as u32);
+        }
+    }
+    // Face planes (area-weighted) and boundary constraint planes, summed per vertex in parallel.
+    let face_quadric = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|v| to_f(cells[v as usize]));
+        let cross = (b - a).cross(c - a);
+        let area2 = cross.length();
+        if area2 == 0.0 {
+            return Quadric::default();
+        }
+        let n = cross / area2;
+        Quadric::plane(n, -n.dot(a), area2 * 0.5)
+    };
+    let mut edge_count: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    for t in faces {
+        for k in 0..3 {
+            let (u, v) = (t[k], t[(k + 1) % 3]);
+            *edge_count.entry((u.min(v), u.max(v))).or_default() += 1;
+        }
+    }
+    let quadrics: Vec<Quadric> = (0..n)
+        .into_par_iter()
+        .map(|v| {
+            let mut q = Quadric::default();
+            for &f in &vfaces[v] {
+                let t = faces[f as usize];
+                q.add(&face_quadric(&t));
+                for k in 0..3 {
+                    let (u, w) = (t[k], t[(k + 1) % 3]);
+                    if (u == v as u32 || w == v as u32) && edge_count[&(u.min(w), u.max(w))] == 1 {
+                        let (pu, pw) = (to_f(cells[u as usize]), to_f(cells[w as usize]));
+                        let [a, b, c] = t.map(|x| to_f(cells[x as usize]));
+                        let normal = (b - a).cross(c - a);
+                        let side = (pw - pu).cross(normal);
+                        if side.length_squared() > 0.0 {
+                            let m = side.normalize();
+                            let weight = 100.0 * (pw - pu).length_squared();
+                            q.add(&Quadric::plane(m, -m.dot(pu), weight));
+                        }
+                    }
+                }
+            }
+            q
+        })
+        .collect();
+    let mut state = State {
+        cells: cells.to_vec(),
+        faces: faces.to_vec(),
+        face_alive: vec![true; faces.len()],
+        vertex_alive: vec![true; n],
+        vfaces,
+        quadrics,
+        stamp: vec![0; n],
+        placement,
+    };
+    let mut collapses = Vec::new();
+    let mut scratch: [Vec<u32>; 3] = Default::default();
+    let mut neighbours = Vec::new();
+    loop {
+        let edges: Vec<(u32, u32)> = edge_list(&state);
+        let initial: Vec<Candidate> = edges
+            .par_iter()
+            .map(|&(a, b)| {
+                let (_, cost) = state.place(a, b);
+                Candidate { cost, a, b, stamps: (state.stamp[a as usize], state.stamp[b as usize]) }
+            })
+            .collect();
+        let mut heap = BinaryHeap::from(initial);
+        let before = collapses.len();
+        while let Some(c) = heap.pop() {
+            let (a, b) = (c.a, c.b);
+            if !state.vertex_alive[a as usize]
+                || !state.vertex_alive[b as usize]
+                || (state.stamp[a as usize], state.stamp[b as usize]) != c.stamps
+            {
+                continue;
+            }
+            let (p, _) = state.place(a, b);
+            let Some((vs, vt, fl, fr, vl, vr)) = state.check(a, b, p, &mut scratch) else {
+                continue;
+            };
+            let moved: Vec<u32> = state.vfaces[vt as usize]
+                .iter()
+                .copied()
+                .filter(|&f| f != fl && f != fr)
+                .collect();
+            collapses.push(Collapse {
+                vs,
+                vt,
+                before: [state.cells[vs as usize], state.cells[vt as usize]],
+                after: p,
+                fl,
+                fr,
+                vl,
+                vr,
+                moved: moved.clone(),
+            });
+            for &f in &moved {
+                for x in state.faces[f as usize].iter_mut() {
+                    if *x == vt {
+                        *x = vs;
+                    }
+                }
+            }
+            for &f in &[fl, fr] {
+                if f == NIL {
+                    continue;
+                }
+                state.face_alive[f as usize] = false;
+                for &v in &state.faces[f as usize] {
+                    state.vfaces[v as usize].retain(|&g| g != f);
+                }
+            }
+            state.vfaces[vs as usize].extend(moved);
+            state.vfaces[vt as usize].clear();
+            state.vertex_alive[vt as usize] = false;
+            let qt = state.quadrics[vt as usize];
+            state.quadrics[vs as usize].add(&qt);
+            state.cells[vs as usize] = p;
+            state.stamp[vs as usize] += 1;
+            state.neighbours(vs, &mut neighbours);
+            for &w in &neighbours {
+                let (_, cost) = state.place(vs, w);
+                heap.push(Candidate { cost, a: vs, b: w, stamps: (state.stamp[vs as usize], state.stamp[w as usize]) });
+            }
+        }
+        if collapses.len() == before {
+            break;
+        }
+    }
+    Simplified {
+        collapses,
+        vertex_alive: state.vertex_alive,
+        face_alive: state.face_alive,
+        positions: state.cells,
+        faces: state.faces,
+    }
+}
+
+fn edge_list(state: &State) -> Vec<(u32, u32)> {
+    let mut edges: Vec<(u32, u32)> = state
+        .faces
+        .iter()
+        .zip(&state.face_alive)
+        .filter(|(_, &alive)| alive)
+        .flat_map(|(t, _)| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+}
+
+/// A progressive mesh: the base mesh and the splits that rebuild the full mesh, with the order
+/// in which the full mesh's vertices and faces are created.
+pub struct ProgressiveMesh {
+    /// M⁰.
+    pub base: PmMesh,
+    /// vsplit₀ … vsplitₙ₋₁.
+    pub vsplits: Vec<Vsplit>,
+    /// Original vertex of each vertex of Mⁿ, in creation order.
+    pub vertex_origin: Vec<u32>,
+}
+
+/// Builds the progressive mesh of a simplification: base mesh from what remains, then the
+/// collapses in reverse as vertex splits with Hoppe's fields, each applied as it is made so that
+/// its face ids are those a decoder will have.
+pub fn progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -> ProgressiveMesh {
+    let n = s.vertex_alive.len();
+    let mut new_id = vec![NIL; n];
+    let mut vertex_origin = Vec::with_capacity(n);
+    for v in 0..n {
+        if s.vertex_alive[v] {
+            new_id[v] = vertex_origin.len() as u32;
+            vertex_origin.push(v as u32);
+        }
+    }
+    let mut face_id = vec![NIL; original_faces.len()];
+    let mut base_faces = Vec::new();
+    for (f, t) in s.faces.iter().enumerate() {
+        if s.face_alive[f] {
+            face_id[f] = base_faces.len() as u32;
+            base_faces.push(t.map(|v| new_id[v as usize]));
+        }
+    }
+    let base_positions: Vec<[i32; 3]> = vertex_origin.iter().map(|&v| s.positions[v as usize]).collect();
+    let base = PmMesh::from_triangles(base_positions, &base_faces).expect("simplification keeps an oriented manifold");
+    let mut mesh = base.clone();
+    // A face of each vertex, to start walks around it.
+    let mut vertex_face = vec![NIL; n];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for &v in &face.v {
+            vertex_face[v as usize] = f as u32;
+        }
+    }
+    let mut vsplits = Vec::with_capacity(s.collapses.len());
+    for c in s.collapses.iter().rev() {
+        let (vs, vl) = (new_id[c.vs as usize], new_id[c.vl as usize]);
+        let vr = if c.vr == NIL { NIL } else { new_id[c.vr as usize] };
+        let moved: std::collections::HashSet<u32> = c.moved.iter().map(|&f| face_id[f as usize]).collect();
+        debug_assert!(
+            mesh.faces[vertex_face[vs as usize] as usize].v.contains(&vs),
+            "vertex_face of {vs} (orig {}) is {} = {:?}",
+            c.vs,
+            vertex_face[vs as usize],
+            mesh.faces[vertex_face[vs as usize] as usize].v
+        );
+        let (flclw, vs_index, vlr_rot) = locate_split(&mesh, vs, vl, vr, vertex_face[vs as usize], &moved);
+        let (ps, pt) = (c.before[0], c.before[1]);
+        let vad_l = [pt[0] - ps[0], pt[1] - ps[1], pt[2] - ps[2]];
+        let (ii, vad_s) = (0..3u8)
+            .map(|ii| {
+                let a = anchor(ii, ps, pt);
+                (ii, [a[0] - c.after[0], a[1] - c.after[1], a[2] - c.after[2]])
+            })
+            .min_by_key(|(ii, d)| (d.iter().map(|x| x.unsigned_abs() as u64).sum::<u64>(), 2 - *ii as i32))
+            .expect("three predictions");
+        let split = Vsplit { flclw, vs_index, vlr_rot, ii, vad_l, vad_s };
+        let vt = mesh.vsplit(&split).expect("a split made from a collapse applies");
+        #[cfg(test)]
+        if let Err(e) = mesh.check_invariants() {
+            panic!("after split {} {:?} (moved {} {:?} {:?}): {e}", vsplits.len(), split, moved.len(), c, s.collapses.len());
+        }
+        debug_assert_eq!(mesh.positions[vt as usize], pt);
+        new_id[c.vt as usize] = vt;
+        vertex_origin.push(c.vt);
+        let fl = mesh.faces.len() as u32 - if c.fr == NIL { 1 } else { 2 };
+        vertex_face[vs as usize] = fl;
+        vertex_face[vt as usize] = fl;
+        face_id[c.fl as usize] = mesh.faces.len() as u32 - if c.fr == NIL { 1 } else { 2 };
+        if c.fr != NIL {
+            face_id[c.fr as usize] = mesh.faces.len() as u32 - 1;
+        }
+        vsplits.push(split);
+    }
+    ProgressiveMesh { base, vsplits, vertex_origin }
+}
+
+/// Hoppe's location fields of the split of `vs` between `vl` and `vr` that gives vt the faces
+/// `moved` (face ids of `mesh`).
+fn locate_split(
+    mesh: &PmMesh,
+    vs: u32,
+    vl: u32,
+    vr: u32,
+    face_of_vs: u32,
+    moved: &std::collections::HashSet<u32>,
+) -> (u32, u8, Rotation) {
+    // Faces around vs, via any face that holds it.
+    let holds = |f: u32, u: u32, w: u32| {
+        let t = mesh.faces[f as usize].v;
+        (0..3).find(|&k| t[k] == u && t[(k + 1) % 3] == w)
+    };
+    let fan = mesh.fan(face_of_vs, vs);
+    if moved.is_empty() {
+        let f = *fan.iter().find(|&&f| holds(f, vl, vs).is_some()).expect("face across (vs, vl)");
+        let i = mesh.corner(f, vs).expect("corner") as u8;
+        let rot = if vr == NIL { Rotation::Empty } else { Rotation::EmptyAcrossGap };
+        return (f, i, rot);
+    }
+    let f0 = *fan
+        .iter()
+        .find(|&&f| moved.contains(&f) && holds(f, vs, vl).is_some())
+        .expect("a moved face starts at vl");
+    let i = mesh.corner(f0, vs).expect("corner") as u8;
+    let rot = if vr == NIL {
+        Rotation::ToBoundary
+    } else {
+        Rotation::Faces(moved.len() as u32 - 1)
+    };
+    (f0, i, rot)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate;
+
+    fn cells_of(mesh: &crate::mesh::TriMesh) -> Vec<[i32; 3]> {
+        mesh.positions
+            .iter()
+            .map(|p| [(p.x * 1000.0) as i32, (p.y * 1000.0) as i32, (p.z * 1000.0) as i32])
+            .collect()
+    }
+
+    fn check_round_trip(mesh: &crate::mesh::TriMesh, placement: Placement) {
+        let cells = cells_of(mesh);
+        let s = simplify(&cells, &mesh.faces, placement);
+        let pm = progressive_mesh(&mesh.faces, &s);
+        let mut m = pm.base.clone();
+        m.check_invariants().unwrap();
+        for (i, split) in pm.vsplits.iter().enumerate() {
+            m.vsplit(split).unwrap();
+            if i % 7 == 0 {
+                m.check_invariants().unwrap();
+            }
+        }
+        m.check_invariants().unwrap();
+        // Same faces and positions as the original, through the vertex order.
+        let mut got: Vec<[u32; 3]> = m
+            .triangles()
+            .iter()
+            .map(|t| crate::mesh::canonical::rotate_to_smallest(t.map(|v| pm.vertex_origin[v as usize])))
+            .collect();
+        let mut want: Vec<[u32; 3]> = mesh.faces.iter().map(|t| crate::mesh::canonical::rotate_to_smallest(*t)).collect();
+        got.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(got, want);
+        for (v, &o) in pm.vertex_origin.iter().enumerate() {
+            assert_eq!(m.positions[v], cells[o as usize]);
+        }
+        for split in pm.vsplits.iter().rev() {
+            m.ecol(split);
+        }
+        assert_eq!(m, pm.base);
+    }
+
+    #[test]
+    fn closed_and_open_meshes_simplify_and_rebuild_exactly() {
+        for placement in [Placement::Optimal, Placement::EndpointOrMidpoint] {
+            check_round_trip(&generate::icosphere(3), placement);
+            check_round_trip(&generate::torus(2.0, 0.6, 24, 12), placement);
+            check_round_trip(&generate::terrain(400, 5), placement);
+        }
+        let sphere = generate::icosphere(3);
+        let s = simplify(&cells_of(&sphere), &sphere.faces, Placement::Optimal);
+        assert_eq!(s.vertex_alive.iter().filter(|&&a| a).count(), 4, "a sphere ends as a tetrahedron");
+    }
+}
