@@ -202,6 +202,11 @@ impl<'a> StreamReader<'a> {
         &self.header
     }
 
+    /// The whole stream (or prefix) being read.
+    pub fn bytes(&self) -> &'a [u8] {
+        self.bytes
+    }
+
     /// The next complete level, or `None` when the stream has no more (all declared levels read,
     /// or the bytes end inside the next one: then [`StreamReader::truncated`] is true).
     pub fn next_level(&mut self) -> Result<Option<LevelPayload<'a>>> {

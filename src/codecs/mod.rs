@@ -5,6 +5,7 @@
 //! walks vertex splits. The full decode of a stream is lossless: it equals the canonical mesh.
 
 pub mod emc;
+pub mod pm;
 pub mod raw;
 
 use crate::container::{Header, StreamReader};
@@ -99,7 +100,12 @@ pub trait LevelDecoder {
 
 /// Every codec of this build.
 pub fn registry() -> Vec<&'static dyn Codec> {
-    vec![&raw::Raw, &emc::Emc]
+    vec![
+        &raw::Raw,
+        &emc::Emc,
+        &pm::Pm { ordering: pm::Ordering::Natural },
+        &pm::Pm { ordering: pm::Ordering::Reordered },
+    ]
 }
 
 /// The codec called `name`, or an error listing the names known.

@@ -126,13 +126,19 @@ impl Ord for Candidate {
     }
 }
 
+/// Grid step of a split's small delta vad_s: positions between a collapse and its split need
+/// not be finer than 1/32 of the split's length, so the optimal placement is snapped to
+/// multiples of this step from an endpoint (the full mesh stays exact: vad_l is not snapped).
+pub fn vad_s_step(vad_l: [i32; 3]) -> i32 {
+    let m = vad_l.iter().map(|x| x.unsigned_abs()).max().unwrap_or(0);
+    let bits = 32 - m.leading_zeros();
+    1 << bits.saturating_sub(5)
+}
+
 fn to_f(c: [i32; 3]) -> DVec3 {
     DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
 }
 
-fn round_cell(p: DVec3) -> [i32; 3] {
-    [p.x.round() as i32, p.y.round() as i32, p.z.round() as i32]
-}
 
 struct State {
     cells: Vec<[i32; 3]>,
@@ -143,6 +149,8 @@ struct State {
     quadrics: Vec<Quadric>,
     stamp: Vec<u32>,
     placement: Placement,
+    /// Box of the input cells: placements stay inside it, hence on the grid.
+    bounds: ([i32; 3], [i32; 3]),
 }
 
 impl State {
@@ -182,7 +190,16 @@ impl State {
                 let span = (hi - lo).max_element().max(1.0);
                 // An optimum far outside the edge's box is a numerical accident.
                 if (p - (lo + hi) * 0.5).length() < 2.0 * span {
-                    consider(round_cell(p));
+                    let (blo, bhi) = self.bounds;
+                    let step = vad_s_step([cb[0] - ca[0], cb[1] - ca[1], cb[2] - ca[2]]);
+                    for end in [ca, cb] {
+                        let snapped = [0, 1, 2].map(|a| {
+                            end[a] - ((end[a] as f64 - p[a]) / step as f64).round() as i32 * step
+                        });
+                        if (0..3).all(|a| (blo[a]..=bhi[a]).contains(&snapped[a])) {
+                            consider(snapped);
+                        }
+                    }
                 }
             }
         }
@@ -348,6 +365,9 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
         quadrics,
         stamp: vec![0; n],
         placement,
+        bounds: cells.iter().fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), c| {
+            ([0, 1, 2].map(|a| lo[a].min(c[a])), [0, 1, 2].map(|a| hi[a].max(c[a])))
+        }),
     };
     let mut collapses = Vec::new();
     let mut scratch: [Vec<u32>; 3] = Default::default();
@@ -503,13 +523,15 @@ pub fn progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -> Progress
         let (flclw, vs_index, vlr_rot) = locate_split(&mesh, vs, vl, vr, vertex_face[vs as usize], &moved);
         let (ps, pt) = (c.before[0], c.before[1]);
         let vad_l = [pt[0] - ps[0], pt[1] - ps[1], pt[2] - ps[2]];
+        let step = vad_s_step(vad_l);
         let (ii, vad_s) = (0..3u8)
             .map(|ii| {
                 let a = anchor(ii, ps, pt);
                 (ii, [a[0] - c.after[0], a[1] - c.after[1], a[2] - c.after[2]])
             })
+            .filter(|(_, d)| d.iter().all(|x| x % step == 0))
             .min_by_key(|(ii, d)| (d.iter().map(|x| x.unsigned_abs() as u64).sum::<u64>(), 2 - *ii as i32))
-            .expect("three predictions");
+            .expect("placements are snapped to an endpoint's step grid");
         let split = Vsplit { flclw, vs_index, vlr_rot, ii, vad_l, vad_s };
         let vt = mesh.vsplit(&split).expect("a split made from a collapse applies");
         #[cfg(test)]
@@ -621,4 +643,9 @@ mod tests {
         let s = simplify(&cells_of(&sphere), &sphere.faces, Placement::Optimal);
         assert_eq!(s.vertex_alive.iter().filter(|&&a| a).count(), 4, "a sphere ends as a tetrahedron");
     }
+}
+
+/// The progressive mesh of a simplification with its splits reordered (see `reorder`).
+pub fn reordered_progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -> ProgressiveMesh {
+    progressive_mesh(original_faces, s)
 }

@@ -1,0 +1,298 @@
+//! PMeshIter (Hoppe §4): a mesh that walks the PM sequence, split by split, forwards over records
+//! read on demand from a stream (or held in memory) and backwards over those already read; and
+//! Geomorph (§5), which blends a finer mesh towards its ancestors in a coarser one.
+
+use super::syntax::{self, FlclwCoding, SplitContexts};
+use super::PmParams;
+use crate::codecs::LevelMesh;
+use crate::coding::arith::ArithDecoder;
+use crate::container::{Header, StreamReader};
+use crate::error::{Error, Result};
+use crate::hierarchy::pmesh::{PmMesh, Vsplit};
+use crate::mesh::{Grid, TriMesh};
+use glam::DVec3;
+
+/// Reads vsplit records one at a time from a stream's levels.
+struct SplitReader<'a> {
+    stream: StreamReader<'a>,
+    contexts: SplitContexts,
+    coder: Option<ArithDecoder>,
+    left_in_level: u64,
+    level_start: usize,
+    levels_read: usize,
+    previous_flclw: u32,
+    flclw: FlclwCoding,
+    with_vad_s: bool,
+}
+
+impl SplitReader<'_> {
+    /// Opens the next level; `Ok(false)` when there is none (complete) in the stream.
+    fn open_level(&mut self) -> Result<bool> {
+        let Some(level) = self.stream.next_level()? else {
+            return Ok(false);
+        };
+        let fault = || Error::malformed(level.index + 1, level.start, "level is not an arithmetic-coded payload");
+        let mut coder = ArithDecoder::new(level.bytes).ok_or_else(fault)?;
+        self.left_in_level = syntax::get_count(&mut coder, &mut self.contexts).ok_or_else(fault)?;
+        self.level_start = level.start;
+        self.coder = Some(coder);
+        self.levels_read += 1;
+        Ok(true)
+    }
+
+    /// The next record for a mesh of `faces` faces, if the current level has one.
+    fn next_in_level(&mut self, faces: u32) -> Result<Option<Vsplit>> {
+        if self.left_in_level == 0 {
+            return Ok(None);
+        }
+        let coder = self.coder.as_mut().expect("a level is open");
+        let split = syntax::get_split(coder, &mut self.contexts, faces, self.previous_flclw, self.flclw, self.with_vad_s)
+            .ok_or_else(|| Error::malformed(self.levels_read, self.level_start, "vsplit record cannot be read"))?;
+        self.left_in_level -= 1;
+        self.previous_flclw = split.flclw;
+        Ok(Some(split))
+    }
+}
+
+/// An iterator over the meshes M⁰ … Mⁿ of a progressive mesh.
+pub struct PMeshIter<'a> {
+    mesh: PmMesh,
+    records: Vec<Vsplit>,
+    applied: usize,
+    reader: Option<SplitReader<'a>>,
+    header: Header,
+    full_vertices: u64,
+}
+
+impl<'a> PMeshIter<'a> {
+    /// An iterator at M⁰ of the stream `bytes` (its first level must be present).
+    pub fn from_stream(bytes: &'a [u8]) -> Result<PMeshIter<'a>> {
+        let mut stream = StreamReader::open(bytes)?;
+        let header = stream.header().clone();
+        let params = PmParams::from_header(&header)?;
+        let base = stream
+            .next_level()?
+            .ok_or_else(|| Error::Truncated("the stream ends before its base mesh".into()))?;
+        let mesh = super::read_base(&header, base.bytes)
+            .ok_or_else(|| Error::malformed(1, base.start, "base mesh cannot be read"))?;
+        Ok(PMeshIter {
+            mesh,
+            records: Vec::new(),
+            applied: 0,
+            full_vertices: header.vertices,
+            header,
+            reader: Some(SplitReader {
+                stream,
+                contexts: SplitContexts::default(),
+                coder: None,
+                left_in_level: 0,
+                level_start: 0,
+                levels_read: 1,
+                previous_flclw: 0,
+                flclw: params.flclw_coding(),
+                with_vad_s: params.with_vad_s(),
+            }),
+        })
+    }
+
+    /// An iterator over records held in memory (a PMesh), at M⁰.
+    pub fn from_records(base: PmMesh, records: Vec<Vsplit>, header: Header) -> PMeshIter<'static> {
+        PMeshIter {
+            full_vertices: (base.positions.len() + records.len()) as u64,
+            mesh: base,
+            records,
+            applied: 0,
+            reader: None,
+            header,
+        }
+    }
+
+    /// The current mesh.
+    pub fn mesh(&self) -> &PmMesh {
+        &self.mesh
+    }
+
+    /// Number of vertices of the current mesh.
+    pub fn nvertices(&self) -> usize {
+        self.mesh.positions.len()
+    }
+
+    /// Number of faces of the current mesh.
+    pub fn nfaces(&self) -> usize {
+        self.mesh.faces.len()
+    }
+
+    /// Levels of the stream read so far (the base mesh is level 1).
+    pub fn levels_read(&self) -> usize {
+        self.reader.as_ref().map_or(1, |r| r.levels_read)
+    }
+
+    /// The next record, reading it from the stream if needed; `None` at the end of what is
+    /// present. Reads records only within open levels unless `cross_levels`.
+    fn peek_record(&mut self, cross_levels: bool) -> Result<Option<Vsplit>> {
+        if self.applied < self.records.len() {
+            return Ok(Some(self.records[self.applied]));
+        }
+        let faces = self.mesh.faces.len() as u32;
+        let Some(reader) = self.reader.as_mut() else {
+            return Ok(None);
+        };
+        loop {
+            if let Some(split) = reader.next_in_level(faces)? {
+                self.records.push(split);
+                return Ok(Some(split));
+            }
+            if !cross_levels || !reader.open_level()? {
+                return Ok(None);
+            }
+        }
+    }
+
+    fn apply(&mut self, split: Vsplit) -> Result<()> {
+        let vs = self
+            .mesh
+            .faces
+            .get(split.flclw as usize)
+            .map(|f| f.v[(split.vs_index as usize).min(2)]);
+        if self.mesh.positions.len() as u64 >= self.full_vertices {
+            return Err(Error::malformed(self.levels_read(), 0, "more vertex splits than the header's vertices"));
+        }
+        self.mesh
+            .vsplit(&split)
+            .map_err(|e| Error::malformed(self.levels_read(), 0, format!("vsplit {}: {}", self.applied, e.0)))?;
+        let top = 1i64 << self.header.grid.bits;
+        let out = |c: [i32; 3]| c.iter().any(|&x| (x as i64) < 0 || x as i64 >= top);
+        let vt = self.mesh.positions.len() - 1;
+        let vs = vs.unwrap_or(vt as u32) as usize;
+        if out(self.mesh.positions[vt]) || out(self.mesh.positions[vs]) {
+            return Err(Error::malformed(self.levels_read(), 0, "vsplit moves a vertex off the grid"));
+        }
+        self.applied += 1;
+        Ok(())
+    }
+
+    /// Applies the next vertex split; `Ok(false)` at the end of the sequence (or of the bytes).
+    pub fn next(&mut self) -> Result<bool> {
+        match self.peek_record(true)? {
+            Some(split) => self.apply(split).map(|_| true),
+            None => Ok(false),
+        }
+    }
+
+    /// Applies the splits left in the level being read, then every split of the next level;
+    /// `Ok(false)` when no further complete level is present.
+    pub fn next_level(&mut self) -> Result<bool> {
+        while self.applied < self.records.len() {
+            self.apply(self.records[self.applied])?;
+        }
+        let opened = match self.reader.as_mut() {
+            Some(reader) => reader.open_level()?,
+            None => return Ok(false),
+        };
+        if !opened {
+            return Ok(false);
+        }
+        while let Some(split) = self.peek_record(false)? {
+            self.apply(split)?;
+        }
+        Ok(true)
+    }
+
+    /// Undoes the last vertex split; `false` at M⁰.
+    pub fn prev(&mut self) -> bool {
+        if self.applied == 0 {
+            return false;
+        }
+        self.applied -= 1;
+        let split = self.records[self.applied];
+        self.mesh.ecol(&split);
+        true
+    }
+
+    /// Moves to the mesh with `n` vertices (or as near as the sequence allows).
+    pub fn goto_nvertices(&mut self, n: usize) -> Result<()> {
+        while self.nvertices() < n && self.next()? {}
+        while self.nvertices() > n && self.prev() {}
+        Ok(())
+    }
+
+    /// Moves to the first mesh with at least `n` faces (or as near as the sequence allows).
+    pub fn goto_nfaces(&mut self, n: usize) -> Result<()> {
+        while self.nfaces() < n && self.next()? {}
+        while self.nfaces() > n && self.prev() {}
+        Ok(())
+    }
+
+    /// The current mesh with positions at cell centres.
+    pub fn level_mesh(&self) -> LevelMesh {
+        LevelMesh {
+            mesh: to_trimesh(&self.mesh, &self.header.grid),
+            loose_edges: Vec::new(),
+        }
+    }
+
+    /// The stream's header.
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+}
+
+fn cell_centre(grid: &Grid, c: [i32; 3]) -> DVec3 {
+    grid.dequantize(c.map(|x| x.max(0) as u32))
+}
+
+/// A PM mesh as a triangle mesh on its grid.
+pub fn to_trimesh(mesh: &PmMesh, grid: &Grid) -> TriMesh {
+    TriMesh::new(
+        mesh.positions.iter().map(|&c| cell_centre(grid, c)).collect(),
+        mesh.triangles(),
+    )
+}
+
+/// A smooth transition between a coarser mesh Mᶜ and a finer Mᶠ: Mᶠ's faces, each vertex moving
+/// from its ancestor's position in Mᶜ (alpha 0) to its own (alpha 1).
+pub struct Geomorph {
+    /// Faces of Mᶠ.
+    pub faces: Vec<[u32; 3]>,
+    /// Positions at alpha = 0: each vertex at its ancestor in Mᶜ.
+    pub coarse: Vec<DVec3>,
+    /// Positions at alpha = 1.
+    pub fine: Vec<DVec3>,
+}
+
+impl Geomorph {
+    /// Builds the geomorph from the iterator's current mesh (Mᶜ) to the mesh with `nvertices`
+    /// vertices, leaving the iterator at Mᶠ (Hoppe's nextA with ancestry tracking).
+    pub fn new(iter: &mut PMeshIter, nvertices: usize) -> Result<Geomorph> {
+        let grid = iter.header.grid;
+        let mut ancestor: Vec<[i32; 3]> = iter.mesh.positions.clone();
+        while iter.nvertices() < nvertices {
+            let Some(split) = iter.peek_record(true)? else { break };
+            let face = iter
+                .mesh
+                .faces
+                .get(split.flclw as usize)
+                .ok_or_else(|| Error::malformed(iter.levels_read(), 0, "flclw out of range"))?;
+            let vs = face.v[(split.vs_index as usize).min(2)];
+            iter.apply(split)?;
+            ancestor.push(ancestor[vs as usize]);
+        }
+        Ok(Geomorph {
+            faces: iter.mesh.triangles(),
+            coarse: ancestor.iter().map(|&c| cell_centre(&grid, c)).collect(),
+            fine: iter.mesh.positions.iter().map(|&c| cell_centre(&grid, c)).collect(),
+        })
+    }
+
+    /// The mesh at `alpha` in [0, 1].
+    pub fn evaluate(&self, alpha: f64) -> TriMesh {
+        TriMesh::new(
+            self.coarse
+                .iter()
+                .zip(&self.fine)
+                .map(|(c, f)| *c + (*f - *c) * alpha)
+                .collect(),
+            self.faces.clone(),
+        )
+    }
+}

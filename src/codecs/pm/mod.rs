@@ -1,0 +1,343 @@
+//! `pm`: Hoppe's progressive meshes, coded.
+//!
+//! Based on: H. Hoppe, *Efficient Implementation of Progressive Meshes*, Computers & Graphics
+//! 22(1), 1998 (../shared/papers/000_54780623804685d2.txt), with the simplification of M. Garland
+//! and P. Heckbert, *Surface Simplification Using Quadric Error Metrics*, SIGGRAPH 1997, made
+//! O(f log f) with an indexed heap as in ../shared/papers/001_461dc93ddc91cb51.txt.
+//!
+//! # Glossary
+//! | paper | here |
+//! |---|---|
+//! | M⁰, base mesh; Mⁿ = M̂, full mesh | `PmMesh` of `hierarchy::pmesh`; first stream level / the canonical mesh |
+//! | vsplit(vs, vl, vr), ecol | [`Vsplit`](crate::hierarchy::pmesh::Vsplit), `PmMesh::vsplit` / `PmMesh::ecol` |
+//! | vt, fl, fr | the new vertex (appended) and faces (appended: fl = (vs, vl, vt), fr = (vs, vt, vr)) |
+//! | flclw, vs_index, vlr_rot | face next to the split, vs's corner in it, rotations from vl to vr (with boundary symbols, Fig. 8) |
+//! | ii, vad_l, vad_s | position prediction (Fig. 10) and the large / small position deltas, in grid cells |
+//! | PMeshIter next / prev / goto | [`iter::PMeshIter`] |
+//! | Geomorph, Ancestry | [`iter::Geomorph`] |
+//! | Δflclw, reordering by a dependency graph | `pm-reordered` (Table 4); `pm` keeps the collapse order (Table 3) |
+//!
+//! # Stream
+//! Level 1 is M⁰: vertex and face counts, cells as Q raw bits a coordinate, corners as
+//! ⌈log2 V⁰⌉ raw bits. Each further level holds a batch of vsplits, the vertex count about
+//! doubling per level, the last level reaching Mⁿ. Every field is arithmetic-coded with an
+//! adaptive binary context of its own ([`syntax`]); the coder is flushed per level.
+//!
+//! Positions are the canonical mesh's cells (DESIGN.md A2, 16 bits by default as Hoppe §6.2), so
+//! the full level is lossless. Wedges (normals, texture coordinates) and material ids are not
+//! coded: the shared meshes carry none that the canonical mesh keeps; the `Vsplit` record leaves
+//! room for Hoppe's `corners` and `matid_predict` fields after `ii`.
+
+pub mod iter;
+pub mod syntax;
+
+use super::{Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, LevelRecord};
+use crate::coding::arith::{ArithDecoder, ArithEncoder};
+use crate::coding::bits::index_bits;
+use crate::coding::{BitLedger, SyntaxClass};
+use crate::container::{Header, StreamReader, StreamWriter};
+use crate::error::{Error, Result};
+use crate::hierarchy::pmesh::PmMesh;
+use crate::hierarchy::simplify::{self, Placement};
+use crate::mesh::quantize::GridShape;
+use crate::mesh::topology::analyze;
+use crate::mesh::{CanonicalMesh, TriMesh};
+use iter::PMeshIter;
+use std::collections::BTreeMap;
+use syntax::{FlclwCoding, SplitContexts};
+
+/// Ordering of the vertex splits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Ordering {
+    /// Collapse order reversed; QEM-optimal placement, vad_s coded (Hoppe Table 3).
+    Natural,
+    /// Reordered along a dependency graph for small Δflclw; endpoint or midpoint placement,
+    /// vad_s = 0 (Hoppe Table 4).
+    Reordered,
+}
+
+/// Parameters stored in the header.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PmParams {
+    /// Split order.
+    pub ordering: Ordering,
+}
+
+impl PmParams {
+    fn to_bytes(self) -> Vec<u8> {
+        vec![match self.ordering {
+            Ordering::Natural => 0,
+            Ordering::Reordered => 1,
+        }]
+    }
+
+    fn from_header(header: &Header) -> Result<PmParams> {
+        let ordering = match header.params.as_slice() {
+            [0] => Ordering::Natural,
+            [1] => Ordering::Reordered,
+            _ => return Err(Error::malformed(0, 6, "pm parameters of unknown syntax")),
+        };
+        Ok(PmParams { ordering })
+    }
+
+    fn flclw_coding(self) -> FlclwCoding {
+        match self.ordering {
+            Ordering::Natural => FlclwCoding::Index,
+            Ordering::Reordered => FlclwCoding::Delta,
+        }
+    }
+
+    fn with_vad_s(self) -> bool {
+        self.ordering == Ordering::Natural
+    }
+}
+
+/// The `pm` codec, in one of its orderings.
+pub struct Pm {
+    /// Which ordering this registry entry uses.
+    pub ordering: Ordering,
+}
+
+/// Refuses meshes that are not oriented 2-manifolds, with the counts that say why.
+fn check_manifold(mesh: &CanonicalMesh) -> Result<()> {
+    let report = analyze(&TriMesh::new(vec![glam::DVec3::ZERO; mesh.vertex_count()], mesh.faces.clone()));
+    let mut directed = std::collections::HashSet::new();
+    let twice = mesh
+        .faces
+        .iter()
+        .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])))
+        .filter(|e| !directed.insert(*e))
+        .count();
+    if !report.is_manifold() || twice > 0 {
+        return Err(Error::Unsupported(format!(
+            "pm needs an oriented 2-manifold; this mesh has {} non-manifold edges, {} non-manifold vertices and {} edges used twice in one direction",
+            report.non_manifold_edges, report.non_manifold_vertices, twice
+        )));
+    }
+    Ok(())
+}
+
+/// Reads a base-mesh level.
+fn read_base(header: &Header, bytes: &[u8]) -> Option<PmMesh> {
+    let mut dec = ArithDecoder::new(bytes)?;
+    let mut ctx = SplitContexts::default();
+    let v = syntax::get_count(&mut dec, &mut ctx)?;
+    let f = syntax::get_count(&mut dec, &mut ctx)?;
+    let q = header.grid.bits as u64;
+    let b = index_bits(v) as u64;
+    // Raw bits cost one bit each: the payload must hold them before anything is allocated.
+    if v > header.vertices || f > header.triangles || 3 * q * v + 3 * b * f > bytes.len() as u64 * 8 + 64 {
+        return None;
+    }
+    let mut positions = Vec::with_capacity(v as usize);
+    for _ in 0..v {
+        let mut c = [0i32; 3];
+        for x in &mut c {
+            *x = dec.raw(q as u32)? as i32;
+        }
+        positions.push(c);
+    }
+    let mut faces = Vec::with_capacity(f as usize);
+    for _ in 0..f {
+        let mut t = [0u32; 3];
+        for x in &mut t {
+            *x = dec.raw(b as u32)? as u32;
+            if *x as u64 >= v {
+                return None;
+            }
+        }
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            return None;
+        }
+        faces.push(t);
+    }
+    PmMesh::from_triangles(positions, &faces)
+}
+
+impl Codec for Pm {
+    fn name(&self) -> &'static str {
+        match self.ordering {
+            Ordering::Natural => "pm",
+            Ordering::Reordered => "pm-reordered",
+        }
+    }
+
+    fn id(&self) -> u8 {
+        match self.ordering {
+            Ordering::Natural => 2,
+            Ordering::Reordered => 3,
+        }
+    }
+
+    fn summary(&self) -> &'static str {
+        match self.ordering {
+            Ordering::Natural => "Hoppe's progressive meshes: QEM collapses, arithmetic-coded vsplits in collapse order (Table 3)",
+            Ordering::Reordered => "Hoppe's progressive meshes, vsplits reordered for small Δflclw, vad_s = 0 (Table 4)",
+        }
+    }
+
+    fn default_options(&self) -> EncodeOptions {
+        EncodeOptions {
+            quant_bits: 16,
+            grid: GridShape::Cubic,
+        }
+    }
+
+    fn encode(&self, mesh: &CanonicalMesh, _options: &EncodeOptions) -> Result<Encoded> {
+        check_manifold(mesh)?;
+        let params = PmParams { ordering: self.ordering };
+        let cells: Vec<[i32; 3]> = mesh.cells.iter().map(|c| c.map(|x| x as i32)).collect();
+        let placement = match self.ordering {
+            Ordering::Natural => Placement::Optimal,
+            Ordering::Reordered => Placement::EndpointOrMidpoint,
+        };
+        let simplified = simplify::simplify(&cells, &mesh.faces, placement);
+        let pm = match self.ordering {
+            Ordering::Natural => simplify::progressive_mesh(&mesh.faces, &simplified),
+            Ordering::Reordered => simplify::reordered_progressive_mesh(&mesh.faces, &simplified),
+        };
+        Ok(encode_pm(self.id(), params, mesh, &pm))
+    }
+
+    fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
+        let header = stream.header().clone();
+        PmParams::from_header(&header)?;
+        Ok(Box::new(PmDecoder {
+            bytes: stream.bytes(),
+            header,
+            iter: None,
+            levels: 0,
+        }))
+    }
+}
+
+/// Writes the stream of a progressive mesh.
+fn encode_pm(id: u8, params: PmParams, mesh: &CanonicalMesh, pm: &simplify::ProgressiveMesh) -> Encoded {
+    let base = &pm.base;
+    let mut schedule = Vec::new();
+    let (mut done, mut vertices) = (0usize, base.positions.len());
+    while done < pm.vsplits.len() {
+        let target = (vertices * 2).max(vertices + 1).max(64);
+        let n = (target - vertices).min(pm.vsplits.len() - done);
+        schedule.push(n);
+        done += n;
+        vertices += n;
+    }
+    let header = Header {
+        codec_id: id,
+        params: params.to_bytes(),
+        grid: mesh.grid,
+        vertices: mesh.vertex_count() as u64,
+        triangles: mesh.face_count() as u64,
+        levels: 1 + schedule.len() as u64,
+    };
+    let mut writer = StreamWriter::new(&header);
+    let mut levels = Vec::new();
+    let mut total = BitLedger::default();
+    let mut stats: BTreeMap<String, f64> = BTreeMap::new();
+
+    // Level 1: the base mesh.
+    let mut enc = ArithEncoder::default();
+    let mut ctx = SplitContexts::default();
+    syntax::put_count(&mut enc, &mut ctx, base.positions.len() as u64);
+    syntax::put_count(&mut enc, &mut ctx, base.faces.len() as u64);
+    let q = mesh.grid.bits as u32;
+    for c in &base.positions {
+        for &x in c {
+            enc.raw(x as u64, q, SyntaxClass::Geometry, "base");
+        }
+    }
+    let b = index_bits(base.positions.len() as u64);
+    for f in &base.faces {
+        for &v in &f.v {
+            enc.raw(v as u64, b, SyntaxClass::Connectivity, "base");
+        }
+    }
+    let mut push = |enc: ArithEncoder, vertices: usize, faces: usize, total: &mut BitLedger, stats: &mut BTreeMap<String, f64>| {
+        for (field, bits) in &enc.field_bits {
+            *stats.entry(format!("bits_{field}")).or_default() += bits;
+        }
+        let (payload, ledger) = enc.finish();
+        writer.push_level(&payload);
+        total.connectivity += ledger.connectivity;
+        total.geometry += ledger.geometry;
+        levels.push((*total, vertices, faces));
+    };
+    push(enc, base.positions.len(), base.faces.len(), &mut total, &mut stats);
+
+    // Further levels: batches of vsplits, coded against the mesh as the decoder will hold it.
+    let mut state = base.clone();
+    let mut ctx = SplitContexts::default();
+    let mut previous = 0u32;
+    let mut next = 0usize;
+    for n in schedule {
+        let mut enc = ArithEncoder::default();
+        syntax::put_count(&mut enc, &mut ctx, n as u64);
+        for split in &pm.vsplits[next..next + n] {
+            let faces = state.faces.len() as u32;
+            syntax::put_split(&mut enc, &mut ctx, split, faces, previous, params.flclw_coding(), params.with_vad_s());
+            previous = split.flclw;
+            state.vsplit(split).expect("the encoder's own splits apply");
+        }
+        next += n;
+        push(enc, state.positions.len(), state.faces.len(), &mut total, &mut stats);
+    }
+    let (bytes, ends) = writer.finish();
+    stats.insert("vsplits".into(), pm.vsplits.len() as f64);
+    stats.insert("base_vertices".into(), base.positions.len() as f64);
+    stats.insert("base_faces".into(), base.faces.len() as f64);
+    Encoded {
+        bytes,
+        levels: levels
+            .into_iter()
+            .zip(ends)
+            .map(|((ledger, vertices, triangles), end_byte)| LevelRecord {
+                end_byte,
+                connectivity_bits: ledger.connectivity,
+                geometry_bits: ledger.geometry,
+                vertices,
+                triangles,
+            })
+            .collect(),
+        stats,
+    }
+}
+
+/// Level-by-level decoder over a [`PMeshIter`]; the first level (the base mesh) is read by the
+/// first `advance`.
+struct PmDecoder<'a> {
+    bytes: &'a [u8],
+    header: Header,
+    iter: Option<PMeshIter<'a>>,
+    levels: usize,
+}
+
+impl LevelDecoder for PmDecoder<'_> {
+    fn header(&self) -> &Header {
+        &self.header
+    }
+
+    fn levels_decoded(&self) -> usize {
+        self.levels
+    }
+
+    fn advance(&mut self) -> Result<bool> {
+        let advanced = match self.iter.as_mut() {
+            Some(iter) => iter.next_level()?,
+            None => match PMeshIter::from_stream(self.bytes) {
+                Ok(iter) => {
+                    self.iter = Some(iter);
+                    true
+                }
+                Err(Error::Truncated(_)) => false,
+                Err(e) => return Err(e),
+            },
+        };
+        self.levels += advanced as usize;
+        Ok(advanced)
+    }
+
+    fn mesh(&self) -> LevelMesh {
+        self.iter.as_ref().map(|i| i.level_mesh()).unwrap_or_default()
+    }
+}

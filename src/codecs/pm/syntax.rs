@@ -1,0 +1,149 @@
+//! How a PM stream codes the base mesh and the vertex split records: adaptive binary arithmetic
+//! coding, one context set per field, contexts kept across levels (the coder is flushed per
+//! level, the probabilities are not reset).
+
+use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext, IntContext, UintContext};
+use crate::coding::bits::index_bits;
+use crate::coding::SyntaxClass::{Connectivity, Geometry};
+use crate::hierarchy::pmesh::{Rotation, Vsplit};
+use crate::hierarchy::simplify::vad_s_step;
+
+/// Field names, as Hoppe's Tables 3 and 4 report them.
+pub const FIELDS: [&str; 7] = ["flclw", "vs_index", "vlr_rot", "ii", "vad_l", "vad_s", "count"];
+
+/// Contexts of every vsplit field.
+#[derive(Clone, Debug, Default)]
+pub struct SplitContexts {
+    delta_flclw: UintContext,
+    vs_index: [BitContext; 2],
+    vlr_rot: UintContext,
+    ii: [BitContext; 2],
+    vad_l: [IntContext; 3],
+    vad_s: [IntContext; 3],
+    count: UintContext,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FlclwCoding {
+    /// As a face index: ⌈log2 F⌉ bits at probability ½ (Table 3).
+    Index,
+    /// As the difference to the previous record's, modulo F (Table 4, after reordering).
+    Delta,
+}
+
+fn rotation_symbol(r: Rotation) -> u64 {
+    match r {
+        Rotation::ToBoundary => 0,
+        Rotation::Empty => 1,
+        Rotation::EmptyAcrossGap => 2,
+        Rotation::Faces(k) => 3 + k as u64,
+    }
+}
+
+fn rotation_of(symbol: u64) -> Option<Rotation> {
+    Some(match symbol {
+        0 => Rotation::ToBoundary,
+        1 => Rotation::Empty,
+        2 => Rotation::EmptyAcrossGap,
+        k => Rotation::Faces(u32::try_from(k - 3).ok()?),
+    })
+}
+
+/// Writes the number of splits in a level.
+pub fn put_count(enc: &mut ArithEncoder, ctx: &mut SplitContexts, n: u64) {
+    enc.uint(&mut ctx.count, n, Connectivity, "count");
+}
+
+/// Reads the number of splits in a level.
+pub fn get_count(dec: &mut ArithDecoder, ctx: &mut SplitContexts) -> Option<u64> {
+    dec.uint(&mut ctx.count)
+}
+
+/// Writes one vsplit; `faces` is the face count before it, `previous` the last record's flclw.
+pub fn put_split(
+    enc: &mut ArithEncoder,
+    ctx: &mut SplitContexts,
+    s: &Vsplit,
+    faces: u32,
+    previous: u32,
+    flclw: FlclwCoding,
+    with_vad_s: bool,
+) {
+    match flclw {
+        FlclwCoding::Index => enc.raw(s.flclw as u64, index_bits(faces as u64), Connectivity, "flclw"),
+        FlclwCoding::Delta => {
+            let delta = (s.flclw as u64 + faces as u64 - previous.min(faces) as u64) % faces as u64;
+            enc.uint(&mut ctx.delta_flclw, delta, Connectivity, "flclw");
+        }
+    }
+    enc.bit(&mut ctx.vs_index[0], s.vs_index == 0, Connectivity, "vs_index");
+    if s.vs_index != 0 {
+        enc.bit(&mut ctx.vs_index[1], s.vs_index == 1, Connectivity, "vs_index");
+    }
+    enc.uint(&mut ctx.vlr_rot, rotation_symbol(s.vlr_rot), Connectivity, "vlr_rot");
+    enc.bit(&mut ctx.ii[0], s.ii == 2, Geometry, "ii");
+    if s.ii != 2 {
+        enc.bit(&mut ctx.ii[1], s.ii == 0, Geometry, "ii");
+    }
+    for a in 0..3 {
+        enc.int(&mut ctx.vad_l[a], s.vad_l[a] as i64, Geometry, "vad_l");
+    }
+    if with_vad_s {
+        let step = vad_s_step(s.vad_l);
+        for a in 0..3 {
+            enc.int(&mut ctx.vad_s[a], (s.vad_s[a] / step) as i64, Geometry, "vad_s");
+        }
+    }
+}
+
+/// Reads one vsplit (see [`put_split`]); `None` when the bits are exhausted or out of range.
+pub fn get_split(
+    dec: &mut ArithDecoder,
+    ctx: &mut SplitContexts,
+    faces: u32,
+    previous: u32,
+    flclw: FlclwCoding,
+    with_vad_s: bool,
+) -> Option<Vsplit> {
+    let flclw = match flclw {
+        FlclwCoding::Index => dec.raw(index_bits(faces as u64))?,
+        FlclwCoding::Delta => {
+            let delta = dec.uint(&mut ctx.delta_flclw)?;
+            (previous as u64).checked_add(delta)? % (faces as u64).max(1)
+        }
+    };
+    let vs_index = if dec.bit(&mut ctx.vs_index[0])? {
+        0
+    } else if dec.bit(&mut ctx.vs_index[1])? {
+        1
+    } else {
+        2
+    };
+    let vlr_rot = rotation_of(dec.uint(&mut ctx.vlr_rot)?)?;
+    let ii = if dec.bit(&mut ctx.ii[0])? {
+        2
+    } else if dec.bit(&mut ctx.ii[1])? {
+        0
+    } else {
+        1
+    };
+    let mut vad_l = [0i32; 3];
+    for a in 0..3 {
+        vad_l[a] = i32::try_from(dec.int(&mut ctx.vad_l[a])?).ok()?;
+    }
+    let mut vad_s = [0i32; 3];
+    if with_vad_s {
+        let step = vad_s_step(vad_l);
+        for a in 0..3 {
+            vad_s[a] = i32::try_from(dec.int(&mut ctx.vad_s[a])?).ok()?.checked_mul(step)?;
+        }
+    }
+    Some(Vsplit {
+        flclw: u32::try_from(flclw).ok()?,
+        vs_index,
+        vlr_rot,
+        ii,
+        vad_l,
+        vad_s,
+    })
+}
