@@ -41,12 +41,14 @@ impl SplitReader<'_> {
     }
 
     /// The next record for a mesh of `faces` faces, if the current level has one.
-    fn next_in_level(&mut self, faces: u32) -> Result<Option<Vsplit>> {
+    fn next_in_level(&mut self, mesh: &PmMesh) -> Result<Option<Vsplit>> {
+        let faces = mesh.faces.len() as u32;
         if self.left_in_level == 0 {
             return Ok(None);
         }
         let coder = self.coder.as_mut().expect("a level is open");
-        let split = syntax::get_split(coder, &mut self.contexts, faces, self.previous_flclw, self.flclw, self.with_vad_s)
+        let tangent = |flclw: u32, vs_index: u8| syntax::Tangent::at(mesh, flclw, vs_index);
+        let split = syntax::get_split(coder, &mut self.contexts, faces, self.previous_flclw, self.flclw, self.with_vad_s, tangent)
             .ok_or_else(|| Error::malformed(self.levels_read, self.level_start, "vsplit record cannot be read"))?;
         self.left_in_level -= 1;
         self.previous_flclw = split.flclw;
@@ -133,12 +135,11 @@ impl<'a> PMeshIter<'a> {
         if self.applied < self.records.len() {
             return Ok(Some(self.records[self.applied]));
         }
-        let faces = self.mesh.faces.len() as u32;
         let Some(reader) = self.reader.as_mut() else {
             return Ok(None);
         };
         loop {
-            if let Some(split) = reader.next_in_level(faces)? {
+            if let Some(split) = reader.next_in_level(&self.mesh)? {
                 self.records.push(split);
                 return Ok(Some(split));
             }

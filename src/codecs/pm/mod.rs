@@ -275,7 +275,8 @@ fn encode_pm(id: u8, params: PmParams, mesh: &CanonicalMesh, pm: &simplify::Prog
         syntax::put_count(&mut enc, &mut ctx, n as u64);
         for split in &pm.vsplits[next..next + n] {
             let faces = state.faces.len() as u32;
-            syntax::put_split(&mut enc, &mut ctx, split, faces, previous, params.flclw_coding(), params.with_vad_s());
+            let tangent = syntax::Tangent::at(&state, split.flclw, split.vs_index);
+            syntax::put_split(&mut enc, &mut ctx, split, faces, previous, params.flclw_coding(), params.with_vad_s(), tangent);
             previous = split.flclw;
             state.vsplit(split).expect("the encoder's own splits apply");
         }

@@ -18,9 +18,55 @@ pub struct SplitContexts {
     vs_index: [BitContext; 2],
     vlr_rot: UintContext,
     ii: [BitContext; 2],
+    /// vad_l: two tangential components, then the residual of the normal one.
     vad_l: [IntContext; 3],
     vad_s: [IntContext; 3],
     count: UintContext,
+}
+
+/// How vad_l is predicted from what the decoder already has: the surface normal at vs. The
+/// component along the axis nearest the normal is coded as its difference from the point on
+/// vs's tangent plane above the other two (an integer prediction, so exactly invertible): the
+/// new vertex lies near that plane.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Tangent {
+    normal: [f64; 3],
+}
+
+impl Tangent {
+    /// The tangent plane at the vertex `vs_index` of face `flclw` (area-weighted normal of its
+    /// faces); no prediction if the face does not exist or the fan is flat-degenerate.
+    pub fn at(mesh: &crate::hierarchy::pmesh::PmMesh, flclw: u32, vs_index: u8) -> Tangent {
+        let Some(face) = mesh.faces.get(flclw as usize) else { return Tangent::default() };
+        let vs = face.v[(vs_index as usize).min(2)];
+        let mut n = [0f64; 3];
+        for f in mesh.fan(flclw, vs) {
+            let [a, b, c] = mesh.faces[f as usize].v.map(|v| mesh.positions[v as usize].map(|x| x as f64));
+            let (u, w) = ([0, 1, 2].map(|k| b[k] - a[k]), [0, 1, 2].map(|k| c[k] - a[k]));
+            n[0] += u[1] * w[2] - u[2] * w[1];
+            n[1] += u[2] * w[0] - u[0] * w[2];
+            n[2] += u[0] * w[1] - u[1] * w[0];
+        }
+        Tangent { normal: n }
+    }
+
+    /// (first tangential axis, second, normal axis).
+    fn axes(&self) -> (usize, usize, usize) {
+        let n = self.normal.map(f64::abs);
+        let k = if n[0] >= n[1] && n[0] >= n[2] { 0 } else if n[1] >= n[2] { 1 } else { 2 };
+        ((k + 1) % 3, (k + 2) % 3, k)
+    }
+
+    /// Predicted normal-axis component for tangential components (di, dj).
+    fn predict(&self, di: i32, dj: i32) -> i64 {
+        let (i, j, k) = self.axes();
+        let nk = self.normal[k];
+        if nk == 0.0 || !nk.is_finite() {
+            return 0;
+        }
+        let p = -(self.normal[i] * di as f64 + self.normal[j] * dj as f64) / nk;
+        p.round().clamp(-(1i64 << 40) as f64, (1i64 << 40) as f64) as i64
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -68,6 +114,7 @@ pub fn put_split(
     previous: u32,
     flclw: FlclwCoding,
     with_vad_s: bool,
+    tangent: Tangent,
 ) {
     match flclw {
         FlclwCoding::Index => enc.raw(s.flclw as u64, index_bits(faces as u64), Connectivity, "flclw"),
@@ -85,9 +132,11 @@ pub fn put_split(
     if s.ii != 2 {
         enc.bit(&mut ctx.ii[1], s.ii == 0, Geometry, "ii");
     }
-    for a in 0..3 {
-        enc.int(&mut ctx.vad_l[a], s.vad_l[a] as i64, Geometry, "vad_l");
-    }
+    let (i, j, k) = tangent.axes();
+    enc.int(&mut ctx.vad_l[0], s.vad_l[i] as i64, Geometry, "vad_l");
+    enc.int(&mut ctx.vad_l[1], s.vad_l[j] as i64, Geometry, "vad_l");
+    let residual = s.vad_l[k] as i64 - tangent.predict(s.vad_l[i], s.vad_l[j]);
+    enc.int(&mut ctx.vad_l[2], residual, Geometry, "vad_l");
     if with_vad_s {
         let step = vad_s_step(s.vad_l);
         for a in 0..3 {
@@ -104,9 +153,10 @@ pub fn get_split(
     previous: u32,
     flclw: FlclwCoding,
     with_vad_s: bool,
+    tangent: impl Fn(u32, u8) -> Tangent,
 ) -> Option<Vsplit> {
     let flclw = match flclw {
-        FlclwCoding::Index => dec.raw(index_bits(faces as u64))?,
+        FlclwCoding::Index => dec.raw(index_bits(faces as u64))?.min(u32::MAX as u64),
         FlclwCoding::Delta => {
             let delta = dec.uint(&mut ctx.delta_flclw)?;
             (previous as u64).checked_add(delta)? % (faces as u64).max(1)
@@ -127,10 +177,13 @@ pub fn get_split(
     } else {
         1
     };
+    let tangent = tangent(u32::try_from(flclw).ok()?, vs_index);
+    let (i, j, k) = tangent.axes();
     let mut vad_l = [0i32; 3];
-    for a in 0..3 {
-        vad_l[a] = i32::try_from(dec.int(&mut ctx.vad_l[a])?).ok()?;
-    }
+    vad_l[i] = i32::try_from(dec.int(&mut ctx.vad_l[0])?).ok()?;
+    vad_l[j] = i32::try_from(dec.int(&mut ctx.vad_l[1])?).ok()?;
+    let residual = dec.int(&mut ctx.vad_l[2])?;
+    vad_l[k] = i32::try_from(residual.checked_add(tangent.predict(vad_l[i], vad_l[j]))?).ok()?;
     let mut vad_s = [0i32; 3];
     if with_vad_s {
         let step = vad_s_step(vad_l);
