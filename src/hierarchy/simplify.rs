@@ -87,6 +87,9 @@ pub struct Collapse {
     pub vr: u32,
     /// Faces of vt other than fl and fr, which now hold vs.
     pub moved: Vec<u32>,
+    /// Faces across (vs, vl) from fl and across (vs, vr) from fr (NIL where none): the split
+    /// re-links them.
+    pub beside: [u32; 2],
 }
 
 /// The result of simplification: collapses in order, and what remains.
@@ -400,6 +403,17 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
                 .copied()
                 .filter(|&f| f != fl && f != fr)
                 .collect();
+            let across = |other: u32, not: u32| {
+                if other == NIL {
+                    return NIL;
+                }
+                state.vfaces[vs as usize]
+                    .iter()
+                    .copied()
+                    .find(|&f| f != not && state.faces[f as usize].contains(&other))
+                    .unwrap_or(NIL)
+            };
+            let beside = [across(vl, fl), across(vr, fr)];
             collapses.push(Collapse {
                 vs,
                 vt,
@@ -410,6 +424,7 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
                 vl,
                 vr,
                 moved: moved.clone(),
+                beside,
             });
             for &f in &moved {
                 for x in state.faces[f as usize].iter_mut() {
@@ -481,6 +496,13 @@ pub struct ProgressiveMesh {
 /// collapses in reverse as vertex splits with Hoppe's fields, each applied as it is made so that
 /// its face ids are those a decoder will have.
 pub fn progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -> ProgressiveMesh {
+    let natural: Vec<usize> = (0..s.collapses.len()).rev().collect();
+    build(original_faces, s, &natural)
+}
+
+/// The progressive mesh with the splits (collapse indices) applied in `order`, which must respect
+/// their dependencies.
+fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> ProgressiveMesh {
     let n = s.vertex_alive.len();
     let mut new_id = vec![NIL; n];
     let mut vertex_origin = Vec::with_capacity(n);
@@ -509,7 +531,7 @@ pub fn progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -> Progress
         }
     }
     let mut vsplits = Vec::with_capacity(s.collapses.len());
-    for c in s.collapses.iter().rev() {
+    for c in order.iter().map(|&i| &s.collapses[i]) {
         let (vs, vl) = (new_id[c.vs as usize], new_id[c.vl as usize]);
         let vr = if c.vr == NIL { NIL } else { new_id[c.vr as usize] };
         let moved: std::collections::HashSet<u32> = c.moved.iter().map(|&f| face_id[f as usize]).collect();
@@ -645,7 +667,113 @@ mod tests {
     }
 }
 
-/// The progressive mesh of a simplification with its splits reordered (see `reorder`).
+/// The progressive mesh of a simplification with its splits reordered so that successive
+/// records name nearby faces (Hoppe §6.2, Table 4): among the splits whose dependencies are met,
+/// always the one whose `flclw` is the next highest after the previous record's (circularly).
+///
+/// Dependencies: a split reads and rewrites its moved faces and the two faces it re-links (fl's
+/// and fr's outer neighbours); it must come after the last split that wrote any of them and
+/// before the next one, after the splits that created vs, vl and vr, and after the previous split
+/// of vs (positions are deltas). The full mesh is the same in any order that keeps them.
 pub fn reordered_progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -> ProgressiveMesh {
-    progressive_mesh(original_faces, s)
+    let splits: Vec<usize> = (0..s.collapses.len()).rev().collect();
+    let n = splits.len();
+    let mut successors: Vec<Vec<u32>> = vec![Vec::new(); n];
+    let mut last_writer: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    let mut readers: std::collections::HashMap<u32, Vec<u32>> = std::collections::HashMap::new();
+    let mut creator: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    let mut last_split_of: std::collections::HashMap<u32, u32> = std::collections::HashMap::new();
+    for (j, &ci) in splits.iter().enumerate() {
+        let c = &s.collapses[ci];
+        let j = j as u32;
+        let touched: Vec<u32> = c.moved.iter().copied().chain(c.beside).filter(|&f| f != NIL).collect();
+        let mut preds: Vec<u32> = Vec::new();
+        for &f in &touched {
+            if let Some(&w) = last_writer.get(&f) {
+                preds.push(w);
+            }
+            for &r in readers.get(&f).map(|v| v.as_slice()).unwrap_or(&[]) {
+                preds.push(r);
+            }
+        }
+        for v in [c.vs, c.vl, c.vr] {
+            if let Some(&k) = creator.get(&v) {
+                preds.push(k);
+            }
+        }
+        if let Some(&k) = last_split_of.get(&c.vs) {
+            preds.push(k);
+        }
+        preds.retain(|&p| p != j);
+        preds.sort_unstable();
+        preds.dedup();
+        for p in preds {
+            successors[p as usize].push(j);
+        }
+        for &f in &touched {
+            last_writer.insert(f, j);
+            readers.insert(f, Vec::new());
+        }
+        for f in [c.fl, c.fr] {
+            if f != NIL {
+                last_writer.insert(f, j);
+            }
+        }
+        creator.insert(c.vt, j);
+        last_split_of.insert(c.vs, j);
+    }
+    let mut indegree = vec![0u32; n];
+    for list in &successors {
+        for &k in list {
+            indegree[k as usize] += 1;
+        }
+    }
+    // flclw of each split, as an original face id, from the natural order's records.
+    let natural = progressive_mesh(original_faces, s);
+    let mut origin_face: Vec<u32> = (0..original_faces.len() as u32).filter(|&f| s.face_alive[f as usize]).collect();
+    for &ci in &splits {
+        let c = &s.collapses[ci];
+        origin_face.push(c.fl);
+        if c.fr != NIL {
+            origin_face.push(c.fr);
+        }
+    }
+    let flclw_origin: Vec<u32> = natural.vsplits.iter().map(|v| origin_face[v.flclw as usize]).collect();
+    // Face ids in the new order, assigned as faces are created.
+    let mut face_id = vec![NIL; original_faces.len()];
+    let mut next_face = 0u32;
+    for (f, &alive) in s.face_alive.iter().enumerate() {
+        if alive {
+            face_id[f] = next_face;
+            next_face += 1;
+        }
+    }
+    let mut ready: std::collections::BTreeSet<(u32, u32)> = std::collections::BTreeSet::new();
+    for j in 0..n {
+        if indegree[j] == 0 {
+            ready.insert((face_id[flclw_origin[j] as usize], j as u32));
+        }
+    }
+    let mut order = Vec::with_capacity(n);
+    let mut previous = 0u32;
+    while let Some(&(key, j)) = ready.range((previous, 0)..).next().or_else(|| ready.iter().next()) {
+        ready.remove(&(key, j));
+        previous = key;
+        let c = &s.collapses[splits[j as usize]];
+        face_id[c.fl as usize] = next_face;
+        next_face += 1;
+        if c.fr != NIL {
+            face_id[c.fr as usize] = next_face;
+            next_face += 1;
+        }
+        order.push(splits[j as usize]);
+        for &k in &successors[j as usize] {
+            indegree[k as usize] -= 1;
+            if indegree[k as usize] == 0 {
+                ready.insert((face_id[flclw_origin[k as usize] as usize], k));
+            }
+        }
+    }
+    debug_assert_eq!(order.len(), n, "the dependency graph is acyclic");
+    build(original_faces, s, &order)
 }
