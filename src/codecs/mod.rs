@@ -103,8 +103,12 @@ pub fn registry() -> Vec<&'static dyn Codec> {
     vec![
         &raw::Raw,
         &emc::Emc,
-        &pm::Pm { ordering: pm::Ordering::Natural },
-        &pm::Pm { ordering: pm::Ordering::Reordered },
+        &pm::Pm {
+            ordering: pm::Ordering::Natural,
+        },
+        &pm::Pm {
+            ordering: pm::Ordering::Reordered,
+        },
     ]
 }
 

@@ -122,7 +122,13 @@ impl Default for ArithEncoder {
 
 impl ArithEncoder {
     /// Codes one bit under `context` and adapts it; books its cost to `class` and `field`.
-    pub fn bit(&mut self, context: &mut BitContext, bit: bool, class: SyntaxClass, field: &'static str) {
+    pub fn bit(
+        &mut self,
+        context: &mut BitContext,
+        bit: bool,
+        class: SyntaxClass,
+        field: &'static str,
+    ) {
         let cost = context.cost(bit);
         self.estimated[class as usize] += cost;
         *self.field_bits.entry(field).or_default() += cost;
@@ -133,7 +139,13 @@ impl ArithEncoder {
     }
 
     /// Codes an unsigned integer.
-    pub fn uint(&mut self, context: &mut UintContext, value: u64, class: SyntaxClass, field: &'static str) {
+    pub fn uint(
+        &mut self,
+        context: &mut UintContext,
+        value: u64,
+        class: SyntaxClass,
+        field: &'static str,
+    ) {
         let v = value + 1;
         let n = 63 - v.leading_zeros() as usize; // bits below the leading one
         for i in 0..n {
@@ -141,16 +153,32 @@ impl ArithEncoder {
         }
         self.bit(&mut context.length[n.min(32)], false, class, field);
         for i in (0..n).rev() {
-            self.bit(&mut context.mantissa[i.min(31)], (v >> i) & 1 == 1, class, field);
+            self.bit(
+                &mut context.mantissa[i.min(31)],
+                (v >> i) & 1 == 1,
+                class,
+                field,
+            );
         }
     }
 
     /// Codes a signed integer.
-    pub fn int(&mut self, context: &mut IntContext, value: i64, class: SyntaxClass, field: &'static str) {
+    pub fn int(
+        &mut self,
+        context: &mut IntContext,
+        value: i64,
+        class: SyntaxClass,
+        field: &'static str,
+    ) {
         self.bit(&mut context.zero, value == 0, class, field);
         if value != 0 {
             self.bit(&mut context.sign, value < 0, class, field);
-            self.uint(&mut context.magnitude, value.unsigned_abs() - 1, class, field);
+            self.uint(
+                &mut context.magnitude,
+                value.unsigned_abs() - 1,
+                class,
+                field,
+            );
         }
     }
 
@@ -165,7 +193,10 @@ impl ArithEncoder {
     /// Flushes; returns the bytes and the ledger (actual bits split in proportion to the
     /// estimates).
     pub fn finish(self) -> (Vec<u8>, BitLedger) {
-        let words = self.coder.into_compressed().expect("writing to a Vec cannot fail");
+        let words = self
+            .coder
+            .into_compressed()
+            .expect("writing to a Vec cannot fail");
         let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
         let total = bytes.len() as f64 * 8.0;
         let estimated = self.estimated[0] + self.estimated[1];
@@ -253,7 +284,11 @@ mod tests {
     #[test]
     fn integers_round_trip_and_skewed_bits_cost_little() {
         let mut enc = ArithEncoder::default();
-        let (mut u, mut i, mut b) = (UintContext::default(), IntContext::default(), BitContext::default());
+        let (mut u, mut i, mut b) = (
+            UintContext::default(),
+            IntContext::default(),
+            BitContext::default(),
+        );
         let values = [0u64, 1, 2, 3, 100, 65535, 1 << 40];
         for &v in &values {
             enc.uint(&mut u, v, SyntaxClass::Geometry, "u");
@@ -264,9 +299,17 @@ mod tests {
         }
         enc.raw(0xabcde, 20, SyntaxClass::Geometry, "r");
         let (bytes, ledger) = enc.finish();
-        assert!(ledger.connectivity < 2_500, "skewed bits: {}", ledger.connectivity);
+        assert!(
+            ledger.connectivity < 2_500,
+            "skewed bits: {}",
+            ledger.connectivity
+        );
         let mut dec = ArithDecoder::new(&bytes).unwrap();
-        let (mut u, mut i, mut b) = (UintContext::default(), IntContext::default(), BitContext::default());
+        let (mut u, mut i, mut b) = (
+            UintContext::default(),
+            IntContext::default(),
+            BitContext::default(),
+        );
         for &v in &values {
             assert_eq!(dec.uint(&mut u), Some(v));
             assert_eq!(dec.int(&mut i), Some(-(v as i64)));

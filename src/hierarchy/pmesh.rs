@@ -63,11 +63,19 @@ pub struct Vsplit {
 }
 
 fn add(a: [i32; 3], b: [i32; 3]) -> [i32; 3] {
-    [a[0].wrapping_add(b[0]), a[1].wrapping_add(b[1]), a[2].wrapping_add(b[2])]
+    [
+        a[0].wrapping_add(b[0]),
+        a[1].wrapping_add(b[1]),
+        a[2].wrapping_add(b[2]),
+    ]
 }
 
 fn sub(a: [i32; 3], b: [i32; 3]) -> [i32; 3] {
-    [a[0].wrapping_sub(b[0]), a[1].wrapping_sub(b[1]), a[2].wrapping_sub(b[2])]
+    [
+        a[0].wrapping_sub(b[0]),
+        a[1].wrapping_sub(b[1]),
+        a[2].wrapping_sub(b[2]),
+    ]
 }
 
 fn half(d: [i32; 3]) -> [i32; 3] {
@@ -85,7 +93,12 @@ pub fn anchor(ii: u8, vs: [i32; 3], vt: [i32; 3]) -> [i32; 3] {
 }
 
 /// Positions after a split of a vertex at `p`: (vs, vt).
-pub fn split_positions(p: [i32; 3], ii: u8, vad_l: [i32; 3], vad_s: [i32; 3]) -> ([i32; 3], [i32; 3]) {
+pub fn split_positions(
+    p: [i32; 3],
+    ii: u8,
+    vad_l: [i32; 3],
+    vad_s: [i32; 3],
+) -> ([i32; 3], [i32; 3]) {
     let a = add(p, vad_s);
     let vs = match ii {
         0 => sub(a, vad_l),
@@ -279,6 +292,32 @@ impl PmMesh {
         }
     }
 
+    /// The neighbours vt will have (vl, the corners of the moved faces, vr) and those vs keeps
+    /// apart from vl and vr, for a split about to apply; `None` if the record does not locate.
+    pub fn split_rings(&self, s: &Vsplit) -> Option<(u32, Vec<u32>, Vec<u32>)> {
+        let (vs, vl, vr, moved) = self.locate(s).ok()?;
+        let mut ring_t = vec![vl];
+        for &f in &moved {
+            let t = self.faces[f as usize].v;
+            ring_t.extend(t.iter().filter(|&&x| x != vs));
+        }
+        if vr != NIL {
+            ring_t.push(vr);
+        }
+        ring_t.sort_unstable();
+        ring_t.dedup();
+        let mut ring_s: Vec<u32> = self
+            .fan(s.flclw, vs)
+            .into_iter()
+            .filter(|f| !moved.contains(f))
+            .flat_map(|f| self.faces[f as usize].v)
+            .filter(|&x| x != vs)
+            .collect();
+        ring_s.sort_unstable();
+        ring_s.dedup();
+        Some((vs, ring_t, ring_s))
+    }
+
     /// Applies a vertex split; returns vt.
     pub fn vsplit(&mut self, s: &Vsplit) -> Result<u32, SplitFault> {
         if s.ii > 2 {
@@ -380,7 +419,10 @@ impl PmMesh {
         for (f, face) in self.faces.iter().enumerate() {
             let [a, b, c] = face.v;
             if a == b || b == c || a == c || face.v.iter().any(|&v| v >= n) {
-                return Err(format!("face {f} {:?} is degenerate or out of range", face.v));
+                return Err(format!(
+                    "face {f} {:?} is degenerate or out of range",
+                    face.v
+                ));
             }
             for k in 0..3 {
                 let (u, v) = (face.v[k], face.v[(k + 1) % 3]);
@@ -402,7 +444,9 @@ impl PmMesh {
             for k in 0..3 {
                 let (u, v) = (face.v[k], face.v[(k + 1) % 3]);
                 if face.nei[k] == NIL && edges.contains(&(v, u)) {
-                    return Err(format!("face {f}: edge ({u}, {v}) has a twin but no neighbour"));
+                    return Err(format!(
+                        "face {f}: edge ({u}, {v}) has a twin but no neighbour"
+                    ));
                 }
             }
         }
@@ -419,7 +463,10 @@ impl PmMesh {
             if some_face[v as usize] != NIL {
                 let fan = self.fan(some_face[v as usize], v).len();
                 if fan != count[v as usize] {
-                    return Err(format!("vertex {v}: fan of {fan} faces, {} incident", count[v as usize]));
+                    return Err(format!(
+                        "vertex {v}: fan of {fan} faces, {} incident",
+                        count[v as usize]
+                    ));
                 }
             }
         }

@@ -31,7 +31,21 @@ struct Quadric([f64; 10]);
 impl Quadric {
     fn plane(n: DVec3, d: f64, w: f64) -> Quadric {
         let (a, b, c) = (n.x, n.y, n.z);
-        Quadric([a * a, a * b, a * c, a * d, b * b, b * c, b * d, c * c, c * d, d * d].map(|x| x * w))
+        Quadric(
+            [
+                a * a,
+                a * b,
+                a * c,
+                a * d,
+                b * b,
+                b * c,
+                b * d,
+                c * c,
+                c * d,
+                d * d,
+            ]
+            .map(|x| x * w),
+        )
     }
     fn add(&mut self, o: &Quadric) {
         for i in 0..10 {
@@ -46,9 +60,16 @@ impl Quadric {
     fn error(&self, p: DVec3) -> f64 {
         let q = &self.0;
         let (x, y, z) = (p.x, p.y, p.z);
-        x * x * q[0] + 2.0 * x * y * q[1] + 2.0 * x * z * q[2] + 2.0 * x * q[3]
-            + y * y * q[4] + 2.0 * y * z * q[5] + 2.0 * y * q[6]
-            + z * z * q[7] + 2.0 * z * q[8] + q[9]
+        x * x * q[0]
+            + 2.0 * x * y * q[1]
+            + 2.0 * x * z * q[2]
+            + 2.0 * x * q[3]
+            + y * y * q[4]
+            + 2.0 * y * z * q[5]
+            + 2.0 * y * q[6]
+            + z * z * q[7]
+            + 2.0 * z * q[8]
+            + q[9]
     }
     fn minimizer(&self) -> Option<DVec3> {
         let q = &self.0;
@@ -142,7 +163,6 @@ fn to_f(c: [i32; 3]) -> DVec3 {
     DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
 }
 
-
 struct State {
     cells: Vec<[i32; 3]>,
     faces: Vec<[u32; 3]>,
@@ -158,7 +178,13 @@ struct State {
 
 impl State {
     fn normal(&self, f: [u32; 3], replace: u32, with: DVec3) -> DVec3 {
-        let p = |v: u32| if v == replace { with } else { to_f(self.cells[v as usize]) };
+        let p = |v: u32| {
+            if v == replace {
+                with
+            } else {
+                to_f(self.cells[v as usize])
+            }
+        };
         let (a, b, c) = (p(f[0]), p(f[1]), p(f[2]));
         (b - a).cross(c - a)
     }
@@ -210,7 +236,13 @@ impl State {
     }
 
     /// The collapse of (a, b) to `p` if it keeps the mesh valid: (vs, vt, fl, fr, vl, vr).
-    fn check(&self, a: u32, b: u32, p: [i32; 3], scratch: &mut [Vec<u32>; 3]) -> Option<(u32, u32, u32, u32, u32, u32)> {
+    fn check(
+        &self,
+        a: u32,
+        b: u32,
+        p: [i32; 3],
+        scratch: &mut [Vec<u32>; 3],
+    ) -> Option<(u32, u32, u32, u32, u32, u32)> {
         let edge_faces: Vec<u32> = self.vfaces[a as usize]
             .iter()
             .copied()
@@ -226,7 +258,10 @@ impl State {
         if common != edge_faces.len() {
             return None; // link condition
         }
-        let (bound_a, bound_b) = (na.len() != self.vfaces[a as usize].len(), nb.len() != self.vfaces[b as usize].len());
+        let (bound_a, bound_b) = (
+            na.len() != self.vfaces[a as usize].len(),
+            nb.len() != self.vfaces[b as usize].len(),
+        );
         if edge_faces.len() == 2 && bound_a && bound_b {
             return None;
         }
@@ -236,25 +271,45 @@ impl State {
             (0..3).any(|k| t[k] == u && t[(k + 1) % 3] == w)
         };
         let third = |f: u32, u: u32, w: u32| {
-            *self.faces[f as usize].iter().find(|&&x| x != u && x != w).expect("third corner")
+            *self.faces[f as usize]
+                .iter()
+                .find(|&&x| x != u && x != w)
+                .expect("third corner")
         };
         // Survivor: for a boundary edge, the face must hold vt → vs; else the endpoint nearer p.
         let (vs, vt) = if edge_faces.len() == 1 {
-            if holds(edge_faces[0], b, a) { (a, b) } else { (b, a) }
+            if holds(edge_faces[0], b, a) {
+                (a, b)
+            } else {
+                (b, a)
+            }
         } else {
             let da = (to_f(self.cells[a as usize]) - to_f(p)).length_squared();
             let db = (to_f(self.cells[b as usize]) - to_f(p)).length_squared();
-            if da <= db { (a, b) } else { (b, a) }
+            if da <= db {
+                (a, b)
+            } else {
+                (b, a)
+            }
         };
         let fl = *edge_faces.iter().find(|&&f| holds(f, vt, vs))?;
-        let fr = edge_faces.iter().copied().find(|&f| holds(f, vs, vt)).unwrap_or(NIL);
-        let (vl, vr) = (third(fl, vs, vt), if fr == NIL { NIL } else { third(fr, vs, vt) });
+        let fr = edge_faces
+            .iter()
+            .copied()
+            .find(|&f| holds(f, vs, vt))
+            .unwrap_or(NIL);
+        let (vl, vr) = (
+            third(fl, vs, vt),
+            if fr == NIL { NIL } else { third(fr, vs, vt) },
+        );
         // A split that gives vt no old face is located from vs's faces across (vs, vl) and
         // (vs, vr): they must exist.
         let vt_keeps_none = self.vfaces[vt as usize].iter().all(|&f| f == fl || f == fr);
         if vt_keeps_none {
             let beside = |u: u32, w: u32, not: u32| {
-                self.vfaces[vs as usize].iter().any(|&f| f != not && holds(f, u, w))
+                self.vfaces[vs as usize]
+                    .iter()
+                    .any(|&f| f != not && holds(f, u, w))
             };
             if !beside(vl, vs, fl) || (fr != NIL && !beside(vs, vr, fr)) {
                 return None;
@@ -327,7 +382,8 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
         let n = cross / area2;
         Quadric::plane(n, -n.dot(a), area2 * 0.5)
     };
-    let mut edge_count: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
+    let mut edge_count: std::collections::HashMap<(u32, u32), u32> =
+        std::collections::HashMap::new();
     for t in faces {
         for k in 0..3 {
             let (u, v) = (t[k], t[(k + 1) % 3]);
@@ -368,9 +424,14 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
         quadrics,
         stamp: vec![0; n],
         placement,
-        bounds: cells.iter().fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), c| {
-            ([0, 1, 2].map(|a| lo[a].min(c[a])), [0, 1, 2].map(|a| hi[a].max(c[a])))
-        }),
+        bounds: cells
+            .iter()
+            .fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), c| {
+                (
+                    [0, 1, 2].map(|a| lo[a].min(c[a])),
+                    [0, 1, 2].map(|a| hi[a].max(c[a])),
+                )
+            }),
     };
     let mut collapses = Vec::new();
     let mut scratch: [Vec<u32>; 3] = Default::default();
@@ -381,7 +442,12 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
             .par_iter()
             .map(|&(a, b)| {
                 let (_, cost) = state.place(a, b);
-                Candidate { cost, a, b, stamps: (state.stamp[a as usize], state.stamp[b as usize]) }
+                Candidate {
+                    cost,
+                    a,
+                    b,
+                    stamps: (state.stamp[a as usize], state.stamp[b as usize]),
+                }
             })
             .collect();
         let mut heap = BinaryHeap::from(initial);
@@ -452,7 +518,12 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
             state.neighbours(vs, &mut neighbours);
             for &w in &neighbours {
                 let (_, cost) = state.place(vs, w);
-                heap.push(Candidate { cost, a: vs, b: w, stamps: (state.stamp[vs as usize], state.stamp[w as usize]) });
+                heap.push(Candidate {
+                    cost,
+                    a: vs,
+                    b: w,
+                    stamps: (state.stamp[vs as usize], state.stamp[w as usize]),
+                });
             }
         }
         if collapses.len() == before {
@@ -474,7 +545,9 @@ fn edge_list(state: &State) -> Vec<(u32, u32)> {
         .iter()
         .zip(&state.face_alive)
         .filter(|(_, &alive)| alive)
-        .flat_map(|(t, _)| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .flat_map(|(t, _)| {
+            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+        })
         .collect();
     edges.sort_unstable();
     edges.dedup();
@@ -520,8 +593,12 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
             base_faces.push(t.map(|v| new_id[v as usize]));
         }
     }
-    let base_positions: Vec<[i32; 3]> = vertex_origin.iter().map(|&v| s.positions[v as usize]).collect();
-    let base = PmMesh::from_triangles(base_positions, &base_faces).expect("simplification keeps an oriented manifold");
+    let base_positions: Vec<[i32; 3]> = vertex_origin
+        .iter()
+        .map(|&v| s.positions[v as usize])
+        .collect();
+    let base = PmMesh::from_triangles(base_positions, &base_faces)
+        .expect("simplification keeps an oriented manifold");
     let mut mesh = base.clone();
     // A face of each vertex, to start walks around it.
     let mut vertex_face = vec![NIL; n];
@@ -533,32 +610,64 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
     let mut vsplits = Vec::with_capacity(s.collapses.len());
     for c in order.iter().map(|&i| &s.collapses[i]) {
         let (vs, vl) = (new_id[c.vs as usize], new_id[c.vl as usize]);
-        let vr = if c.vr == NIL { NIL } else { new_id[c.vr as usize] };
-        let moved: std::collections::HashSet<u32> = c.moved.iter().map(|&f| face_id[f as usize]).collect();
+        let vr = if c.vr == NIL {
+            NIL
+        } else {
+            new_id[c.vr as usize]
+        };
+        let moved: std::collections::HashSet<u32> =
+            c.moved.iter().map(|&f| face_id[f as usize]).collect();
         debug_assert!(
-            mesh.faces[vertex_face[vs as usize] as usize].v.contains(&vs),
+            mesh.faces[vertex_face[vs as usize] as usize]
+                .v
+                .contains(&vs),
             "vertex_face of {vs} (orig {}) is {} = {:?}",
             c.vs,
             vertex_face[vs as usize],
             mesh.faces[vertex_face[vs as usize] as usize].v
         );
-        let (flclw, vs_index, vlr_rot) = locate_split(&mesh, vs, vl, vr, vertex_face[vs as usize], &moved);
+        let (flclw, vs_index, vlr_rot) =
+            locate_split(&mesh, vs, vl, vr, vertex_face[vs as usize], &moved);
         let (ps, pt) = (c.before[0], c.before[1]);
         let vad_l = [pt[0] - ps[0], pt[1] - ps[1], pt[2] - ps[2]];
         let step = vad_s_step(vad_l);
         let (ii, vad_s) = (0..3u8)
             .map(|ii| {
                 let a = anchor(ii, ps, pt);
-                (ii, [a[0] - c.after[0], a[1] - c.after[1], a[2] - c.after[2]])
+                (
+                    ii,
+                    [a[0] - c.after[0], a[1] - c.after[1], a[2] - c.after[2]],
+                )
             })
             .filter(|(_, d)| d.iter().all(|x| x % step == 0))
-            .min_by_key(|(ii, d)| (d.iter().map(|x| x.unsigned_abs() as u64).sum::<u64>(), 2 - *ii as i32))
+            .min_by_key(|(ii, d)| {
+                (
+                    d.iter().map(|x| x.unsigned_abs() as u64).sum::<u64>(),
+                    2 - *ii as i32,
+                )
+            })
             .expect("placements are snapped to an endpoint's step grid");
-        let split = Vsplit { flclw, vs_index, vlr_rot, ii, vad_l, vad_s };
-        let vt = mesh.vsplit(&split).expect("a split made from a collapse applies");
+        let split = Vsplit {
+            flclw,
+            vs_index,
+            vlr_rot,
+            ii,
+            vad_l,
+            vad_s,
+        };
+        let vt = mesh
+            .vsplit(&split)
+            .expect("a split made from a collapse applies");
         #[cfg(test)]
         if let Err(e) = mesh.check_invariants() {
-            panic!("after split {} {:?} (moved {} {:?} {:?}): {e}", vsplits.len(), split, moved.len(), c, s.collapses.len());
+            panic!(
+                "after split {} {:?} (moved {} {:?} {:?}): {e}",
+                vsplits.len(),
+                split,
+                moved.len(),
+                c,
+                s.collapses.len()
+            );
         }
         debug_assert_eq!(mesh.positions[vt as usize], pt);
         new_id[c.vt as usize] = vt;
@@ -572,7 +681,11 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
         }
         vsplits.push(split);
     }
-    ProgressiveMesh { base, vsplits, vertex_origin }
+    ProgressiveMesh {
+        base,
+        vsplits,
+        vertex_origin,
+    }
 }
 
 /// Hoppe's location fields of the split of `vs` between `vl` and `vr` that gives vt the faces
@@ -592,9 +705,16 @@ fn locate_split(
     };
     let fan = mesh.fan(face_of_vs, vs);
     if moved.is_empty() {
-        let f = *fan.iter().find(|&&f| holds(f, vl, vs).is_some()).expect("face across (vs, vl)");
+        let f = *fan
+            .iter()
+            .find(|&&f| holds(f, vl, vs).is_some())
+            .expect("face across (vs, vl)");
         let i = mesh.corner(f, vs).expect("corner") as u8;
-        let rot = if vr == NIL { Rotation::Empty } else { Rotation::EmptyAcrossGap };
+        let rot = if vr == NIL {
+            Rotation::Empty
+        } else {
+            Rotation::EmptyAcrossGap
+        };
         return (f, i, rot);
     }
     let f0 = *fan
@@ -618,7 +738,13 @@ mod tests {
     fn cells_of(mesh: &crate::mesh::TriMesh) -> Vec<[i32; 3]> {
         mesh.positions
             .iter()
-            .map(|p| [(p.x * 1000.0) as i32, (p.y * 1000.0) as i32, (p.z * 1000.0) as i32])
+            .map(|p| {
+                [
+                    (p.x * 1000.0) as i32,
+                    (p.y * 1000.0) as i32,
+                    (p.z * 1000.0) as i32,
+                ]
+            })
             .collect()
     }
 
@@ -639,9 +765,15 @@ mod tests {
         let mut got: Vec<[u32; 3]> = m
             .triangles()
             .iter()
-            .map(|t| crate::mesh::canonical::rotate_to_smallest(t.map(|v| pm.vertex_origin[v as usize])))
+            .map(|t| {
+                crate::mesh::canonical::rotate_to_smallest(t.map(|v| pm.vertex_origin[v as usize]))
+            })
             .collect();
-        let mut want: Vec<[u32; 3]> = mesh.faces.iter().map(|t| crate::mesh::canonical::rotate_to_smallest(*t)).collect();
+        let mut want: Vec<[u32; 3]> = mesh
+            .faces
+            .iter()
+            .map(|t| crate::mesh::canonical::rotate_to_smallest(*t))
+            .collect();
         got.sort_unstable();
         want.sort_unstable();
         assert_eq!(got, want);
@@ -663,7 +795,11 @@ mod tests {
         }
         let sphere = generate::icosphere(3);
         let s = simplify(&cells_of(&sphere), &sphere.faces, Placement::Optimal);
-        assert_eq!(s.vertex_alive.iter().filter(|&&a| a).count(), 4, "a sphere ends as a tetrahedron");
+        assert_eq!(
+            s.vertex_alive.iter().filter(|&&a| a).count(),
+            4,
+            "a sphere ends as a tetrahedron"
+        );
     }
 }
 
@@ -686,7 +822,13 @@ pub fn reordered_progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -
     for (j, &ci) in splits.iter().enumerate() {
         let c = &s.collapses[ci];
         let j = j as u32;
-        let touched: Vec<u32> = c.moved.iter().copied().chain(c.beside).filter(|&f| f != NIL).collect();
+        let touched: Vec<u32> = c
+            .moved
+            .iter()
+            .copied()
+            .chain(c.beside)
+            .filter(|&f| f != NIL)
+            .collect();
         let mut preds: Vec<u32> = Vec::new();
         for &f in &touched {
             if let Some(&w) = last_writer.get(&f) {
@@ -730,7 +872,9 @@ pub fn reordered_progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -
     }
     // flclw of each split, as an original face id, from the natural order's records.
     let natural = progressive_mesh(original_faces, s);
-    let mut origin_face: Vec<u32> = (0..original_faces.len() as u32).filter(|&f| s.face_alive[f as usize]).collect();
+    let mut origin_face: Vec<u32> = (0..original_faces.len() as u32)
+        .filter(|&f| s.face_alive[f as usize])
+        .collect();
     for &ci in &splits {
         let c = &s.collapses[ci];
         origin_face.push(c.fl);
@@ -738,7 +882,11 @@ pub fn reordered_progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -
             origin_face.push(c.fr);
         }
     }
-    let flclw_origin: Vec<u32> = natural.vsplits.iter().map(|v| origin_face[v.flclw as usize]).collect();
+    let flclw_origin: Vec<u32> = natural
+        .vsplits
+        .iter()
+        .map(|v| origin_face[v.flclw as usize])
+        .collect();
     // Face ids in the new order, assigned as faces are created.
     let mut face_id = vec![NIL; original_faces.len()];
     let mut next_face = 0u32;
@@ -756,7 +904,11 @@ pub fn reordered_progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -
     }
     let mut order = Vec::with_capacity(n);
     let mut previous = 0u32;
-    while let Some(&(key, j)) = ready.range((previous, 0)..).next().or_else(|| ready.iter().next()) {
+    while let Some(&(key, j)) = ready
+        .range((previous, 0)..)
+        .next()
+        .or_else(|| ready.iter().next())
+    {
         ready.remove(&(key, j));
         previous = key;
         let c = &s.collapses[splits[j as usize]];

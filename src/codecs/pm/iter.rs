@@ -31,7 +31,13 @@ impl SplitReader<'_> {
         let Some(level) = self.stream.next_level()? else {
             return Ok(false);
         };
-        let fault = || Error::malformed(level.index + 1, level.start, "level is not an arithmetic-coded payload");
+        let fault = || {
+            Error::malformed(
+                level.index + 1,
+                level.start,
+                "level is not an arithmetic-coded payload",
+            )
+        };
         let mut coder = ArithDecoder::new(level.bytes).ok_or_else(fault)?;
         self.left_in_level = syntax::get_count(&mut coder, &mut self.contexts).ok_or_else(fault)?;
         self.level_start = level.start;
@@ -47,9 +53,23 @@ impl SplitReader<'_> {
             return Ok(None);
         }
         let coder = self.coder.as_mut().expect("a level is open");
-        let tangent = |flclw: u32, vs_index: u8| syntax::Tangent::at(mesh, flclw, vs_index);
-        let split = syntax::get_split(coder, &mut self.contexts, faces, self.previous_flclw, self.flclw, self.with_vad_s, tangent)
-            .ok_or_else(|| Error::malformed(self.levels_read, self.level_start, "vsplit record cannot be read"))?;
+        let tangent = |split: &Vsplit| syntax::Tangent::at(mesh, split);
+        let split = syntax::get_split(
+            coder,
+            &mut self.contexts,
+            faces,
+            self.previous_flclw,
+            self.flclw,
+            self.with_vad_s,
+            tangent,
+        )
+        .ok_or_else(|| {
+            Error::malformed(
+                self.levels_read,
+                self.level_start,
+                "vsplit record cannot be read",
+            )
+        })?;
         self.left_in_level -= 1;
         self.previous_flclw = split.flclw;
         Ok(Some(split))
@@ -156,17 +176,29 @@ impl<'a> PMeshIter<'a> {
             .get(split.flclw as usize)
             .map(|f| f.v[(split.vs_index as usize).min(2)]);
         if self.mesh.positions.len() as u64 >= self.full_vertices {
-            return Err(Error::malformed(self.levels_read(), 0, "more vertex splits than the header's vertices"));
+            return Err(Error::malformed(
+                self.levels_read(),
+                0,
+                "more vertex splits than the header's vertices",
+            ));
         }
-        self.mesh
-            .vsplit(&split)
-            .map_err(|e| Error::malformed(self.levels_read(), 0, format!("vsplit {}: {}", self.applied, e.0)))?;
+        self.mesh.vsplit(&split).map_err(|e| {
+            Error::malformed(
+                self.levels_read(),
+                0,
+                format!("vsplit {}: {}", self.applied, e.0),
+            )
+        })?;
         let top = 1i64 << self.header.grid.bits;
         let out = |c: [i32; 3]| c.iter().any(|&x| (x as i64) < 0 || x as i64 >= top);
         let vt = self.mesh.positions.len() - 1;
         let vs = vs.unwrap_or(vt as u32) as usize;
         if out(self.mesh.positions[vt]) || out(self.mesh.positions[vs]) {
-            return Err(Error::malformed(self.levels_read(), 0, "vsplit moves a vertex off the grid"));
+            return Err(Error::malformed(
+                self.levels_read(),
+                0,
+                "vsplit moves a vertex off the grid",
+            ));
         }
         self.applied += 1;
         Ok(())
@@ -245,7 +277,10 @@ fn cell_centre(grid: &Grid, c: [i32; 3]) -> DVec3 {
 /// A PM mesh as a triangle mesh on its grid.
 pub fn to_trimesh(mesh: &PmMesh, grid: &Grid) -> TriMesh {
     TriMesh::new(
-        mesh.positions.iter().map(|&c| cell_centre(grid, c)).collect(),
+        mesh.positions
+            .iter()
+            .map(|&c| cell_centre(grid, c))
+            .collect(),
         mesh.triangles(),
     )
 }
@@ -268,7 +303,9 @@ impl Geomorph {
         let grid = iter.header.grid;
         let mut ancestor: Vec<[i32; 3]> = iter.mesh.positions.clone();
         while iter.nvertices() < nvertices {
-            let Some(split) = iter.peek_record(true)? else { break };
+            let Some(split) = iter.peek_record(true)? else {
+                break;
+            };
             let face = iter
                 .mesh
                 .faces
@@ -281,7 +318,12 @@ impl Geomorph {
         Ok(Geomorph {
             faces: iter.mesh.triangles(),
             coarse: ancestor.iter().map(|&c| cell_centre(&grid, c)).collect(),
-            fine: iter.mesh.positions.iter().map(|&c| cell_centre(&grid, c)).collect(),
+            fine: iter
+                .mesh
+                .positions
+                .iter()
+                .map(|&c| cell_centre(&grid, c))
+                .collect(),
         })
     }
 

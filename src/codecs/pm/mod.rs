@@ -100,7 +100,10 @@ pub struct Pm {
 
 /// Refuses meshes that are not oriented 2-manifolds, with the counts that say why.
 fn check_manifold(mesh: &CanonicalMesh) -> Result<()> {
-    let report = analyze(&TriMesh::new(vec![glam::DVec3::ZERO; mesh.vertex_count()], mesh.faces.clone()));
+    let report = analyze(&TriMesh::new(
+        vec![glam::DVec3::ZERO; mesh.vertex_count()],
+        mesh.faces.clone(),
+    ));
     let mut directed = std::collections::HashSet::new();
     let twice = mesh
         .faces
@@ -126,7 +129,10 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<PmMesh> {
     let q = header.grid.bits as u64;
     let b = index_bits(v) as u64;
     // Raw bits cost one bit each: the payload must hold them before anything is allocated.
-    if v > header.vertices || f > header.triangles || 3 * q * v + 3 * b * f > bytes.len() as u64 * 8 + 64 {
+    if v > header.vertices
+        || f > header.triangles
+        || 3 * q * v + 3 * b * f > bytes.len() as u64 * 8 + 64
+    {
         return None;
     }
     let mut positions = Vec::with_capacity(v as usize);
@@ -185,7 +191,9 @@ impl Codec for Pm {
 
     fn encode(&self, mesh: &CanonicalMesh, _options: &EncodeOptions) -> Result<Encoded> {
         check_manifold(mesh)?;
-        let params = PmParams { ordering: self.ordering };
+        let params = PmParams {
+            ordering: self.ordering,
+        };
         let cells: Vec<[i32; 3]> = mesh.cells.iter().map(|c| c.map(|x| x as i32)).collect();
         let placement = match self.ordering {
             Ordering::Natural => Placement::Optimal,
@@ -212,7 +220,12 @@ impl Codec for Pm {
 }
 
 /// Writes the stream of a progressive mesh.
-fn encode_pm(id: u8, params: PmParams, mesh: &CanonicalMesh, pm: &simplify::ProgressiveMesh) -> Encoded {
+fn encode_pm(
+    id: u8,
+    params: PmParams,
+    mesh: &CanonicalMesh,
+    pm: &simplify::ProgressiveMesh,
+) -> Encoded {
     let base = &pm.base;
     let mut schedule = Vec::new();
     let (mut done, mut vertices) = (0usize, base.positions.len());
@@ -253,7 +266,11 @@ fn encode_pm(id: u8, params: PmParams, mesh: &CanonicalMesh, pm: &simplify::Prog
             enc.raw(v as u64, b, SyntaxClass::Connectivity, "base");
         }
     }
-    let mut push = |enc: ArithEncoder, vertices: usize, faces: usize, total: &mut BitLedger, stats: &mut BTreeMap<String, f64>| {
+    let mut push = |enc: ArithEncoder,
+                    vertices: usize,
+                    faces: usize,
+                    total: &mut BitLedger,
+                    stats: &mut BTreeMap<String, f64>| {
         for (field, bits) in &enc.field_bits {
             *stats.entry(format!("bits_{field}")).or_default() += bits;
         }
@@ -263,7 +280,13 @@ fn encode_pm(id: u8, params: PmParams, mesh: &CanonicalMesh, pm: &simplify::Prog
         total.geometry += ledger.geometry;
         levels.push((*total, vertices, faces));
     };
-    push(enc, base.positions.len(), base.faces.len(), &mut total, &mut stats);
+    push(
+        enc,
+        base.positions.len(),
+        base.faces.len(),
+        &mut total,
+        &mut stats,
+    );
 
     // Further levels: batches of vsplits, coded against the mesh as the decoder will hold it.
     let mut state = base.clone();
@@ -275,13 +298,28 @@ fn encode_pm(id: u8, params: PmParams, mesh: &CanonicalMesh, pm: &simplify::Prog
         syntax::put_count(&mut enc, &mut ctx, n as u64);
         for split in &pm.vsplits[next..next + n] {
             let faces = state.faces.len() as u32;
-            let tangent = syntax::Tangent::at(&state, split.flclw, split.vs_index);
-            syntax::put_split(&mut enc, &mut ctx, split, faces, previous, params.flclw_coding(), params.with_vad_s(), tangent);
+            let tangent = syntax::Tangent::at(&state, split);
+            syntax::put_split(
+                &mut enc,
+                &mut ctx,
+                split,
+                faces,
+                previous,
+                params.flclw_coding(),
+                params.with_vad_s(),
+                tangent,
+            );
             previous = split.flclw;
             state.vsplit(split).expect("the encoder's own splits apply");
         }
         next += n;
-        push(enc, state.positions.len(), state.faces.len(), &mut total, &mut stats);
+        push(
+            enc,
+            state.positions.len(),
+            state.faces.len(),
+            &mut total,
+            &mut stats,
+        );
     }
     let (bytes, ends) = writer.finish();
     stats.insert("vsplits".into(), pm.vsplits.len() as f64);
@@ -339,6 +377,9 @@ impl LevelDecoder for PmDecoder<'_> {
     }
 
     fn mesh(&self) -> LevelMesh {
-        self.iter.as_ref().map(|i| i.level_mesh()).unwrap_or_default()
+        self.iter
+            .as_ref()
+            .map(|i| i.level_mesh())
+            .unwrap_or_default()
     }
 }
