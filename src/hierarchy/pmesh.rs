@@ -255,10 +255,13 @@ impl PmMesh {
                             return Err(SplitFault("rotation passes the boundary twice"));
                         }
                         wrapped = true;
-                        next = g;
+                        // Across the gap: the fan's other end, clockwise of flclw.
+                        next = f0;
+                        let mut steps = 0;
                         while self.cw(next, vs) != NIL {
                             next = self.cw(next, vs);
-                            if next == f0 {
+                            steps += 1;
+                            if steps > self.faces.len() {
                                 return Err(SplitFault("rotation loops"));
                             }
                         }

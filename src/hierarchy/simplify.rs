@@ -305,6 +305,18 @@ impl State {
         // A split that gives vt no old face is located from vs's faces across (vs, vl) and
         // (vs, vr): they must exist.
         let vt_keeps_none = self.vfaces[vt as usize].iter().all(|&f| f == fl || f == fr);
+        if !vt_keeps_none {
+            // The moved faces must start at vl and end at vr: the faces across (vl, vt) and
+            // (vt, vr) exist (otherwise the split could not be located from flclw).
+            let beyond = |u: u32, w: u32, not: u32| {
+                self.vfaces[vt as usize]
+                    .iter()
+                    .any(|&f| f != not && holds(f, u, w))
+            };
+            if !beyond(vt, vl, fl) || (fr != NIL && !beyond(vr, vt, fr)) {
+                return None;
+            }
+        }
         if vt_keeps_none {
             let beside = |u: u32, w: u32, not: u32| {
                 self.vfaces[vs as usize]

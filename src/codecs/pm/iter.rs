@@ -333,7 +333,8 @@ impl Geomorph {
             self.coarse
                 .iter()
                 .zip(&self.fine)
-                .map(|(c, f)| *c + (*f - *c) * alpha)
+                // Weighted sum, not c + (f − c)·alpha: exact at both ends.
+                .map(|(c, f)| *c * (1.0 - alpha) + *f * alpha)
                 .collect(),
             self.faces.clone(),
         )
