@@ -173,6 +173,8 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
     bar.finish_and_clear();
     drop(decoder);
 
+    let mut codec_stats = encoded.stats;
+    codec_stats.extend(codec.measure(&encoded.bytes)?);
     let result = RunResult {
         codec: codec.name().to_string(),
         mesh: mesh_name(path),
@@ -187,7 +189,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
         lossless_error,
         grid: encode.grid,
         samples_per_triangle: options.samples_per_triangle,
-        codec_stats: encoded.stats,
+        codec_stats,
         levels,
     };
     Ok(RunOutput {

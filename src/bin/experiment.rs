@@ -55,6 +55,13 @@ enum Command {
         #[command(flatten)]
         settings: Settings,
     },
+    /// Time simplification + PM construction on meshes from 5k to 3M faces (shared meshes,
+    /// subdivided); writes results/pm/decimation.json.
+    Decimation {
+        /// Folder for results.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
     /// Regenerate the papers' tables and figures in paper-tables/ from results/.
     Tables {
         /// Folder of result files.
@@ -100,6 +107,7 @@ fn main() -> ExitCode {
     let outcome = match &cli.command {
         Some(Command::Run { file, settings }) => run_set(file, settings),
         Some(Command::Tables { results, out }) => tables(results, out),
+        Some(Command::Decimation { out }) => decimation(out),
         None => match (&cli.codec, &cli.mesh) {
             (Some(codec), Some(mesh)) => run_one(codec, mesh, &cli.settings).map(|_| ()),
             _ => Err(anyhow::anyhow!(
@@ -228,14 +236,29 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
         let mut runs = Vec::new();
         for &codec in &codecs {
             for &quant in &quants {
-                runs.push(run_codec(
-                    codec,
-                    path,
-                    &run_options(&settings, quant),
-                    &settings.out,
-                    settings.keep_stream,
-                )?);
+                let options = run_options(&settings, quant);
+                match run_codec(codec, path, &options, &settings.out, settings.keep_stream) {
+                    Ok(run) => runs.push(run),
+                    // A codec that cannot take a mesh says why; the set goes on, and the reason
+                    // is kept beside the results for the tables.
+                    Err(e) if is_refusal(&e) => {
+                        let name = mesh_name(path);
+                        let dir = settings.out.join(codec.name());
+                        std::fs::create_dir_all(&dir)?;
+                        let why = format!("{e:#}");
+                        let file = dir.join(format!("{name}.refused.txt"));
+                        meshcodec::mesh::io::write_atomically(
+                            &file,
+                            format!("{why}\n").as_bytes(),
+                        )?;
+                        println!("{} refused {name}: {why}", codec.name());
+                    }
+                    Err(e) => return Err(e),
+                }
             }
+        }
+        if runs.is_empty() {
+            continue;
         }
         let dir = settings.out.join("compare").join(&set_name);
         std::fs::create_dir_all(&dir)?;
@@ -265,6 +288,15 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
     Ok(())
 }
 
+fn is_refusal(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        matches!(
+            c.downcast_ref::<meshcodec::Error>(),
+            Some(meshcodec::Error::Unsupported(_))
+        )
+    })
+}
+
 fn tables(results: &Path, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
     let (written, missing) = meshcodec::tables::regenerate(results, out);
@@ -277,5 +309,72 @@ fn tables(results: &Path, out: &Path) -> Result<()> {
     if written.is_empty() {
         anyhow::bail!("no table could be made from {}", results.display());
     }
+    Ok(())
+}
+
+/// Meshes of the decimation table: a shared mesh and how many times it is subdivided (×4 faces).
+const DECIMATION_MESHES: [(&str, u32); 6] = [
+    ("spot", 0),
+    ("dragon-50k", 0),
+    ("fandisk", 2),
+    ("bunny-closed-35k", 2),
+    ("armadillo-43k", 2),
+    ("feline-26k", 3),
+];
+
+fn decimation(out: &Path) -> Result<()> {
+    use meshcodec::hierarchy::simplify::{progressive_mesh, simplify, Placement};
+    let mut rows = Vec::new();
+    for (name, times) in DECIMATION_MESHES {
+        let path = resolve(name).with_context(|| name.to_string())?;
+        let mut mesh =
+            meshcodec::mesh::io::read_mesh(&path).with_context(|| path.display().to_string())?;
+        for _ in 0..times {
+            mesh = meshcodec::mesh::generate::subdivide(&mesh);
+        }
+        // 24 bits: fine enough that subdivision midpoints never weld.
+        let options = codecs::EncodeOptions {
+            quant_bits: 24,
+            grid: GridShape::Cubic,
+        };
+        let canonical = codecs::canonical_for(&mesh, &options)?;
+        let cells: Vec<[i32; 3]> = canonical
+            .cells
+            .iter()
+            .map(|c| c.map(|x| x as i32))
+            .collect();
+        let started = std::time::Instant::now();
+        let simplified = simplify(&cells, &canonical.faces, Placement::Optimal);
+        let simplify_seconds = started.elapsed().as_secs_f64();
+        let pm = progressive_mesh(&canonical.faces, &simplified);
+        let total_seconds = started.elapsed().as_secs_f64();
+        let faces = canonical.face_count();
+        println!(
+            "{name} x{}: {faces} faces -> base {} vertices; simplify {simplify_seconds:.2} s, with PM construction {total_seconds:.2} s ({:.0} faces/s)",
+            4u32.pow(times),
+            pm.base.positions.len(),
+            faces as f64 / total_seconds
+        );
+        rows.push(serde_json::json!({
+            "mesh": name,
+            "subdivisions": times,
+            "faces": faces,
+            "vertices": canonical.vertex_count(),
+            "base_vertices": pm.base.positions.len(),
+            "vsplits": pm.vsplits.len(),
+            "simplify_seconds": simplify_seconds,
+            "total_seconds": total_seconds,
+            "faces_per_second": faces as f64 / total_seconds,
+        }));
+    }
+    let dir = out.join("pm");
+    std::fs::create_dir_all(&dir)?;
+    let report = serde_json::json!({ "threads": rayon::current_num_threads(), "rows": rows });
+    let path = dir.join("decimation.json");
+    meshcodec::mesh::io::write_atomically(
+        &path,
+        format!("{}\n", serde_json::to_string_pretty(&report)?).as_bytes(),
+    )?;
+    println!("wrote {}", path.display());
     Ok(())
 }

@@ -78,6 +78,11 @@ pub trait Codec: Send + Sync {
     fn encode(&self, mesh: &CanonicalMesh, options: &EncodeOptions) -> Result<Encoded>;
     /// A decoder positioned before the first level of `stream` (whose header names this codec).
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>>;
+    /// Codec-specific measurements of an encoded stream (PM: iteration rates), stored with the
+    /// run's results.
+    fn measure(&self, _stream: &[u8]) -> Result<std::collections::BTreeMap<String, f64>> {
+        Ok(Default::default())
+    }
 }
 
 /// Walks a stream level by level.

@@ -221,7 +221,7 @@ pub struct ArithDecoder {
 impl ArithDecoder {
     /// Reads a level's bytes (a multiple of 4; `None` otherwise).
     pub fn new(bytes: &[u8]) -> Option<ArithDecoder> {
-        if bytes.len() % 4 != 0 {
+        if !bytes.len().is_multiple_of(4) {
             return None;
         }
         let words: Vec<u32> = bytes

@@ -591,9 +591,9 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
     let n = s.vertex_alive.len();
     let mut new_id = vec![NIL; n];
     let mut vertex_origin = Vec::with_capacity(n);
-    for v in 0..n {
+    for (v, id) in new_id.iter_mut().enumerate() {
         if s.vertex_alive[v] {
-            new_id[v] = vertex_origin.len() as u32;
+            *id = vertex_origin.len() as u32;
             vertex_origin.push(v as u32);
         }
     }
@@ -742,79 +742,6 @@ fn locate_split(
     (f0, i, rot)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::mesh::generate;
-
-    fn cells_of(mesh: &crate::mesh::TriMesh) -> Vec<[i32; 3]> {
-        mesh.positions
-            .iter()
-            .map(|p| {
-                [
-                    (p.x * 1000.0) as i32,
-                    (p.y * 1000.0) as i32,
-                    (p.z * 1000.0) as i32,
-                ]
-            })
-            .collect()
-    }
-
-    fn check_round_trip(mesh: &crate::mesh::TriMesh, placement: Placement) {
-        let cells = cells_of(mesh);
-        let s = simplify(&cells, &mesh.faces, placement);
-        let pm = progressive_mesh(&mesh.faces, &s);
-        let mut m = pm.base.clone();
-        m.check_invariants().unwrap();
-        for (i, split) in pm.vsplits.iter().enumerate() {
-            m.vsplit(split).unwrap();
-            if i % 7 == 0 {
-                m.check_invariants().unwrap();
-            }
-        }
-        m.check_invariants().unwrap();
-        // Same faces and positions as the original, through the vertex order.
-        let mut got: Vec<[u32; 3]> = m
-            .triangles()
-            .iter()
-            .map(|t| {
-                crate::mesh::canonical::rotate_to_smallest(t.map(|v| pm.vertex_origin[v as usize]))
-            })
-            .collect();
-        let mut want: Vec<[u32; 3]> = mesh
-            .faces
-            .iter()
-            .map(|t| crate::mesh::canonical::rotate_to_smallest(*t))
-            .collect();
-        got.sort_unstable();
-        want.sort_unstable();
-        assert_eq!(got, want);
-        for (v, &o) in pm.vertex_origin.iter().enumerate() {
-            assert_eq!(m.positions[v], cells[o as usize]);
-        }
-        for split in pm.vsplits.iter().rev() {
-            m.ecol(split);
-        }
-        assert_eq!(m, pm.base);
-    }
-
-    #[test]
-    fn closed_and_open_meshes_simplify_and_rebuild_exactly() {
-        for placement in [Placement::Optimal, Placement::EndpointOrMidpoint] {
-            check_round_trip(&generate::icosphere(3), placement);
-            check_round_trip(&generate::torus(2.0, 0.6, 24, 12), placement);
-            check_round_trip(&generate::terrain(400, 5), placement);
-        }
-        let sphere = generate::icosphere(3);
-        let s = simplify(&cells_of(&sphere), &sphere.faces, Placement::Optimal);
-        assert_eq!(
-            s.vertex_alive.iter().filter(|&&a| a).count(),
-            4,
-            "a sphere ends as a tetrahedron"
-        );
-    }
-}
-
 /// The progressive mesh of a simplification with its splits reordered so that successive
 /// records name nearby faces (Hoppe §6.2, Table 4): among the splits whose dependencies are met,
 /// always the one whose `flclw` is the next highest after the previous record's (circularly).
@@ -940,4 +867,77 @@ pub fn reordered_progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -
     }
     debug_assert_eq!(order.len(), n, "the dependency graph is acyclic");
     build(original_faces, s, &order)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate;
+
+    fn cells_of(mesh: &crate::mesh::TriMesh) -> Vec<[i32; 3]> {
+        mesh.positions
+            .iter()
+            .map(|p| {
+                [
+                    (p.x * 1000.0) as i32,
+                    (p.y * 1000.0) as i32,
+                    (p.z * 1000.0) as i32,
+                ]
+            })
+            .collect()
+    }
+
+    fn check_round_trip(mesh: &crate::mesh::TriMesh, placement: Placement) {
+        let cells = cells_of(mesh);
+        let s = simplify(&cells, &mesh.faces, placement);
+        let pm = progressive_mesh(&mesh.faces, &s);
+        let mut m = pm.base.clone();
+        m.check_invariants().unwrap();
+        for (i, split) in pm.vsplits.iter().enumerate() {
+            m.vsplit(split).unwrap();
+            if i % 7 == 0 {
+                m.check_invariants().unwrap();
+            }
+        }
+        m.check_invariants().unwrap();
+        // Same faces and positions as the original, through the vertex order.
+        let mut got: Vec<[u32; 3]> = m
+            .triangles()
+            .iter()
+            .map(|t| {
+                crate::mesh::canonical::rotate_to_smallest(t.map(|v| pm.vertex_origin[v as usize]))
+            })
+            .collect();
+        let mut want: Vec<[u32; 3]> = mesh
+            .faces
+            .iter()
+            .map(|t| crate::mesh::canonical::rotate_to_smallest(*t))
+            .collect();
+        got.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(got, want);
+        for (v, &o) in pm.vertex_origin.iter().enumerate() {
+            assert_eq!(m.positions[v], cells[o as usize]);
+        }
+        for split in pm.vsplits.iter().rev() {
+            m.ecol(split);
+        }
+        assert_eq!(m, pm.base);
+    }
+
+    #[test]
+    fn closed_and_open_meshes_simplify_and_rebuild_exactly() {
+        for placement in [Placement::Optimal, Placement::EndpointOrMidpoint] {
+            check_round_trip(&generate::icosphere(3), placement);
+            check_round_trip(&generate::torus(2.0, 0.6, 24, 12), placement);
+            check_round_trip(&generate::terrain(400, 5), placement);
+        }
+        let sphere = generate::icosphere(3);
+        let s = simplify(&cells_of(&sphere), &sphere.faces, Placement::Optimal);
+        assert_eq!(
+            s.vertex_alive.iter().filter(|&&a| a).count(),
+            4,
+            "a sphere ends as a tetrahedron"
+        );
+    }
 }

@@ -74,6 +74,26 @@ pub fn icosphere(subdivisions: u32) -> TriMesh {
     TriMesh::new(positions, faces)
 }
 
+/// Midpoint subdivision: each triangle split into four at its edge midpoints (shared edges share
+/// their midpoint), so a closed manifold stays one. Used to make large test meshes.
+pub fn subdivide(mesh: &TriMesh) -> TriMesh {
+    let mut positions = mesh.positions.clone();
+    let mut midpoint: HashMap<(VertexId, VertexId), VertexId> =
+        HashMap::with_capacity(mesh.faces.len() * 2);
+    let mut faces = Vec::with_capacity(mesh.faces.len() * 4);
+    for &[a, b, c] in &mesh.faces {
+        let mut mid = |u: VertexId, v: VertexId| {
+            *midpoint.entry((u.min(v), u.max(v))).or_insert_with(|| {
+                positions.push((positions[u as usize] + positions[v as usize]) * 0.5);
+                (positions.len() - 1) as VertexId
+            })
+        };
+        let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+        faces.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+    }
+    TriMesh::new(positions, faces)
+}
+
 /// A torus of radii `major` and `minor` with `u` × `v` quads split into triangles (2uv faces,
 /// closed, genus 1).
 pub fn torus(major: f64, minor: f64, u: u32, v: u32) -> TriMesh {

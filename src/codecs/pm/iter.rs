@@ -2,7 +2,7 @@
 //! read on demand from a stream (or held in memory) and backwards over those already read; and
 //! Geomorph (§5), which blends a finer mesh towards its ancestors in a coarser one.
 
-use super::syntax::{self, FlclwCoding, SplitContexts};
+use super::syntax::{self, Layout, SplitContexts};
 use super::PmParams;
 use crate::codecs::LevelMesh;
 use crate::coding::arith::ArithDecoder;
@@ -21,8 +21,7 @@ struct SplitReader<'a> {
     level_start: usize,
     levels_read: usize,
     previous_flclw: u32,
-    flclw: FlclwCoding,
-    with_vad_s: bool,
+    layout: Layout,
 }
 
 impl SplitReader<'_> {
@@ -59,8 +58,7 @@ impl SplitReader<'_> {
             &mut self.contexts,
             faces,
             self.previous_flclw,
-            self.flclw,
-            self.with_vad_s,
+            self.layout,
             tangent,
         )
         .ok_or_else(|| {
@@ -78,6 +76,7 @@ impl SplitReader<'_> {
 
 /// An iterator over the meshes M⁰ … Mⁿ of a progressive mesh.
 pub struct PMeshIter<'a> {
+    base: PmMesh,
     mesh: PmMesh,
     records: Vec<Vsplit>,
     applied: usize,
@@ -98,6 +97,7 @@ impl<'a> PMeshIter<'a> {
         let mesh = super::read_base(&header, base.bytes)
             .ok_or_else(|| Error::malformed(1, base.start, "base mesh cannot be read"))?;
         Ok(PMeshIter {
+            base: mesh.clone(),
             mesh,
             records: Vec::new(),
             applied: 0,
@@ -111,8 +111,10 @@ impl<'a> PMeshIter<'a> {
                 level_start: 0,
                 levels_read: 1,
                 previous_flclw: 0,
-                flclw: params.flclw_coding(),
-                with_vad_s: params.with_vad_s(),
+                layout: Layout {
+                    flclw: params.flclw_coding(),
+                    with_vad_s: params.with_vad_s(),
+                },
             }),
         })
     }
@@ -121,12 +123,18 @@ impl<'a> PMeshIter<'a> {
     pub fn from_records(base: PmMesh, records: Vec<Vsplit>, header: Header) -> PMeshIter<'static> {
         PMeshIter {
             full_vertices: (base.positions.len() + records.len()) as u64,
-            mesh: base,
+            mesh: base.clone(),
+            base,
             records,
             applied: 0,
             reader: None,
             header,
         }
+    }
+
+    /// The base mesh M⁰ and the records read so far: a PMesh in memory.
+    pub fn pmesh(&self) -> (&PmMesh, &[Vsplit]) {
+        (&self.base, &self.records)
     }
 
     /// The current mesh.
@@ -205,6 +213,8 @@ impl<'a> PMeshIter<'a> {
     }
 
     /// Applies the next vertex split; `Ok(false)` at the end of the sequence (or of the bytes).
+    /// Hoppe's PMeshIter::next: it can fail on a corrupt stream, so this is no `Iterator`.
+    #[allow(clippy::should_implement_trait)]
     pub fn next(&mut self) -> Result<bool> {
         match self.peek_record(true)? {
             Some(split) => self.apply(split).map(|_| true),

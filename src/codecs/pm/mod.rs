@@ -80,6 +80,13 @@ impl PmParams {
         Ok(PmParams { ordering })
     }
 
+    fn layout(self) -> syntax::Layout {
+        syntax::Layout {
+            flclw: self.flclw_coding(),
+            with_vad_s: self.with_vad_s(),
+        }
+    }
+
     fn flclw_coding(self) -> FlclwCoding {
         match self.ordering {
             Ordering::Natural => FlclwCoding::Index,
@@ -207,6 +214,42 @@ impl Codec for Pm {
         Ok(encode_pm(self.id(), params, mesh, &pm))
     }
 
+    fn measure(&self, stream: &[u8]) -> Result<BTreeMap<String, f64>> {
+        // Hoppe's Table 2: iteration rates over a PMesh in memory, forwards to Mⁿ and back to
+        // M⁰ (best of a few passes), and the full stream decode rate.
+        let started = std::time::Instant::now();
+        let mut iter = PMeshIter::from_stream(stream)?;
+        while iter.next()? {}
+        let decode = started.elapsed().as_secs_f64();
+        let header = iter.header().clone();
+        let (base, records) = iter.pmesh();
+        let mut memory = PMeshIter::from_records(base.clone(), records.to_vec(), header);
+        let n = records.len() as f64;
+        let (mut forward, mut backward) = (f64::INFINITY, f64::INFINITY);
+        for _ in 0..5 {
+            let t = std::time::Instant::now();
+            memory.goto_nvertices(usize::MAX)?;
+            forward = forward.min(t.elapsed().as_secs_f64());
+            let t = std::time::Instant::now();
+            memory.goto_nvertices(0)?;
+            backward = backward.min(t.elapsed().as_secs_f64());
+        }
+        let mut out = BTreeMap::new();
+        out.insert(
+            "goto_full_vertices_per_second".into(),
+            n / forward.max(1e-9),
+        );
+        out.insert(
+            "goto_base_vertices_per_second".into(),
+            n / backward.max(1e-9),
+        );
+        out.insert(
+            "stream_decode_vertices_per_second".into(),
+            n / decode.max(1e-9),
+        );
+        Ok(out)
+    }
+
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
         let header = stream.header().clone();
         PmParams::from_header(&header)?;
@@ -305,8 +348,7 @@ fn encode_pm(
                 split,
                 faces,
                 previous,
-                params.flclw_coding(),
-                params.with_vad_s(),
+                params.layout(),
                 tangent,
             );
             previous = split.flclw;

@@ -111,6 +111,16 @@ impl Tangent {
     }
 }
 
+/// Which optional parts a record has, from the stream's parameters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// How flclw is written.
+    pub flclw: FlclwCoding,
+    /// Whether vad_s is present (zero otherwise).
+    pub with_vad_s: bool,
+}
+
+/// How `flclw` is written.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FlclwCoding {
     /// As a face index: ⌈log2 F⌉ bits at probability ½ (Table 3).
@@ -154,11 +164,10 @@ pub fn put_split(
     s: &Vsplit,
     faces: u32,
     previous: u32,
-    flclw: FlclwCoding,
-    with_vad_s: bool,
+    layout: Layout,
     tangent: Tangent,
 ) {
-    match flclw {
+    match layout.flclw {
         FlclwCoding::Index => enc.raw(
             s.flclw as u64,
             index_bits(faces as u64),
@@ -209,7 +218,7 @@ pub fn put_split(
     );
     let residual = s.vad_l[k] as i64 - tangent.predict(s.vad_l[i], s.vad_l[j]);
     enc.int(&mut ctx.vad_l[2], residual, Geometry, "vad_l");
-    if with_vad_s {
+    if layout.with_vad_s {
         let step = vad_s_step(s.vad_l);
         for a in 0..3 {
             enc.int(
@@ -228,11 +237,10 @@ pub fn get_split(
     ctx: &mut SplitContexts,
     faces: u32,
     previous: u32,
-    flclw: FlclwCoding,
-    with_vad_s: bool,
+    layout: Layout,
     tangent: impl Fn(&Vsplit) -> Tangent,
 ) -> Option<Vsplit> {
-    let flclw = match flclw {
+    let flclw = match layout.flclw {
         FlclwCoding::Index => dec.raw(index_bits(faces as u64))?.min(u32::MAX as u64),
         FlclwCoding::Delta => {
             let delta = dec.uint(&mut ctx.delta_flclw)?;
@@ -270,12 +278,10 @@ pub fn get_split(
     let residual = dec.int(&mut ctx.vad_l[2])?;
     vad_l[k] = i32::try_from(residual.checked_add(tangent.predict(vad_l[i], vad_l[j]))?).ok()?;
     let mut vad_s = [0i32; 3];
-    if with_vad_s {
+    if layout.with_vad_s {
         let step = vad_s_step(vad_l);
-        for a in 0..3 {
-            vad_s[a] = i32::try_from(dec.int(&mut ctx.vad_s[a])?)
-                .ok()?
-                .checked_mul(step)?;
+        for (value, context) in vad_s.iter_mut().zip(ctx.vad_s.iter_mut()) {
+            *value = i32::try_from(dec.int(context)?).ok()?.checked_mul(step)?;
         }
     }
     Some(Vsplit {
