@@ -9,10 +9,10 @@
 //! whole pass collapses nothing: the base mesh is then as small as these rules allow.
 
 use super::pmesh::{anchor, PmMesh, Rotation, Vsplit, NIL};
+use dary_heap::QuaternaryHeap as BinaryHeap;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 
 /// Where a collapse puts the remaining vertex.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -127,12 +127,14 @@ pub struct Simplified {
     pub faces: Vec<[u32; 3]>,
 }
 
+/// A queued collapse: 16 bytes, so the heap of a million-face mesh stays cache-friendly. The
+/// cost is an f32 (ordering only), the stamps wrap (a wrapped stale entry is only re-checked).
 #[derive(PartialEq)]
 struct Candidate {
-    cost: f64,
+    cost: f32,
     a: u32,
     b: u32,
-    stamps: (u32, u32),
+    stamps: (u16, u16),
 }
 impl Eq for Candidate {}
 impl PartialOrd for Candidate {
@@ -170,7 +172,7 @@ struct State {
     vertex_alive: Vec<bool>,
     vfaces: Vec<Vec<u32>>,
     quadrics: Vec<Quadric>,
-    stamp: Vec<u32>,
+    stamp: Vec<u16>,
     placement: Placement,
     /// Box of the input cells: placements stay inside it, hence on the grid.
     bounds: ([i32; 3], [i32; 3]),
@@ -455,7 +457,7 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
             .map(|&(a, b)| {
                 let (_, cost) = state.place(a, b);
                 Candidate {
-                    cost,
+                    cost: cost as f32,
                     a,
                     b,
                     stamps: (state.stamp[a as usize], state.stamp[b as usize]),
@@ -526,12 +528,12 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
             let qt = state.quadrics[vt as usize];
             state.quadrics[vs as usize].add(&qt);
             state.cells[vs as usize] = p;
-            state.stamp[vs as usize] += 1;
+            state.stamp[vs as usize] = state.stamp[vs as usize].wrapping_add(1);
             state.neighbours(vs, &mut neighbours);
             for &w in &neighbours {
                 let (_, cost) = state.place(vs, w);
                 heap.push(Candidate {
-                    cost,
+                    cost: cost as f32,
                     a: vs,
                     b: w,
                     stamps: (state.stamp[vs as usize], state.stamp[w as usize]),
