@@ -83,3 +83,16 @@ impl Error {
 
 /// Result with the crate's error.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Ends a binary: exit status 0, or 1 with the error on one line of stderr (DESIGN.md A6),
+/// whatever line breaks the error's text holds.
+pub fn exit_code(outcome: anyhow::Result<()>) -> std::process::ExitCode {
+    match outcome {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            let message = format!("{e:#}").replace(['\n', '\t'], " ");
+            eprintln!("error: {message}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

@@ -78,6 +78,18 @@ pub struct RunResult {
     pub levels: Vec<LevelRow>,
 }
 
+impl RunResult {
+    /// Whole-stream bits per vertex of the canonical mesh.
+    pub fn bits_per_vertex(&self) -> f64 {
+        self.bytes as f64 * 8.0 / self.vertices as f64
+    }
+
+    /// Whole-stream bits per triangle of the canonical mesh.
+    pub fn bits_per_triangle(&self) -> f64 {
+        self.bytes as f64 * 8.0 / self.triangles as f64
+    }
+}
+
 /// What to run with; `None` fields take the codec's defaults.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunOptions {

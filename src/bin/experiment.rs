@@ -115,15 +115,7 @@ fn main() -> ExitCode {
             )),
         },
     };
-    match outcome {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            // One line, whatever the error's text holds (DESIGN.md A6).
-            let message = format!("{e:#}").replace(['\n', '\t'], " ");
-            eprintln!("error: {message}");
-            ExitCode::FAILURE
-        }
-    }
+    meshcodec::error::exit_code(outcome)
 }
 
 fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
@@ -166,8 +158,8 @@ fn run_codec(
         result.triangles,
         result.quant_bits,
         result.bytes,
-        result.bytes as f64 * 8.0 / result.vertices as f64,
-        result.bytes as f64 * 8.0 / result.triangles as f64,
+        result.bits_per_vertex(),
+        result.bits_per_triangle(),
     );
     print!("{}", harness::level_table(&result));
     println!(
@@ -280,8 +272,8 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
             r.mesh,
             r.quant_bits,
             r.bytes,
-            r.bytes as f64 * 8.0 / r.vertices as f64,
-            r.bytes as f64 * 8.0 / r.triangles as f64,
+            r.bits_per_vertex(),
+            r.bits_per_triangle(),
             r.lossless
         );
     }

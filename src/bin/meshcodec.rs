@@ -116,15 +116,7 @@ fn main() -> ExitCode {
             write_samples,
         } => distance(&a, &b, samples, seed, json, write_samples.as_deref()),
     };
-    match outcome {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            // One line, whatever the error's text holds (DESIGN.md A6).
-            let message = format!("{e:#}").replace(['\n', '\t'], " ");
-            eprintln!("error: {message}");
-            ExitCode::FAILURE
-        }
-    }
+    meshcodec::error::exit_code(outcome)
 }
 
 fn load(name: &str) -> Result<(PathBuf, meshcodec::mesh::TriMesh)> {

@@ -169,6 +169,18 @@ pub struct FaceCorrections {
     pub orientation_exceptions: Vec<u32>,
 }
 
+impl FaceCorrections {
+    /// Which of `n` cliques the orientation propagation leaves out: false triangles and
+    /// double-sided faces.
+    pub fn skipped(&self, n: usize) -> Vec<bool> {
+        let mut skipped = vec![false; n];
+        for &i in self.false_triangles.iter().chain(&self.double_sided) {
+            skipped[i as usize] = true;
+        }
+        skipped
+    }
+}
+
 /// Applies `corrections` to the cliques of the final state: the faces of the full mesh.
 pub fn final_faces(
     cliques: &[[u32; 3]],
@@ -176,14 +188,7 @@ pub fn final_faces(
     positions: &[DVec3],
     corrections: &FaceCorrections,
 ) -> Vec<[u32; 3]> {
-    let mut skipped = vec![false; cliques.len()];
-    for &i in corrections
-        .false_triangles
-        .iter()
-        .chain(&corrections.double_sided)
-    {
-        skipped[i as usize] = true;
-    }
+    let skipped = corrections.skipped(cliques.len());
     let mut exceptions = corrections.orientation_exceptions.iter().peekable();
     let flipped = propagate_orientation(
         cliques,

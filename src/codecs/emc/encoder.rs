@@ -254,14 +254,7 @@ fn face_corrections(
         faces.len(),
         "every face is a 3-clique of its own edges"
     );
-    let mut skipped = vec![false; cliques.len()];
-    for &i in corrections
-        .false_triangles
-        .iter()
-        .chain(&corrections.double_sided)
-    {
-        skipped[i as usize] = true;
-    }
+    let skipped = corrections.skipped(cliques.len());
     let positions: Vec<_> = (0..state.len())
         .map(|v| mesh.grid.dequantize(state.cells[v]))
         .collect();
