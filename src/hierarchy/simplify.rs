@@ -234,7 +234,10 @@ impl State {
                 }
             }
         }
-        (best.0, best.1.max(0.0))
+        // Where the quadrics cannot tell edges apart (flat regions: error 0), shorter edges go
+        // first; without this a vertex keeps winning ties and its valence explodes.
+        let length2 = (to_f(ca) - to_f(cb)).length_squared();
+        (best.0, best.1.max(0.0) + 1e-3 * length2)
     }
 
     /// The collapse of (a, b) to `p` if it keeps the mesh valid: (vs, vt, fl, fr, vl, vr).
