@@ -1,0 +1,124 @@
+"""Draco as a single-rate anchor, measured on this machine, written as result files.
+
+For each mesh and quantization, encodes the mesh's referenced vertices and faces with DracoPy
+(compression_level 10, quantization_bits Q — both set), decodes it, times both (best of five),
+measures the decoded mesh against the original with `meshcodec distance`, and writes
+results/draco/<mesh>-q<Q>.json in the schema of DESIGN.md A5 (one level), with bits per vertex
+over the canonical mesh's vertex count at Q bits (from `meshcodec info`), as every other codec.
+
+Run (after tests/run.sh has made the venv and the release build):
+    .venv/bin/pip install -r experiments/requirements.txt
+    .venv/bin/python experiments/draco_anchor.py bunny armadillo-43k --quant 8 9 10 11 12 13 14 15 16
+"""
+
+import argparse
+import json
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import DracoPy
+import numpy as np
+import open3d as o3d
+
+ROOT = Path(__file__).resolve().parent.parent
+BIN = ROOT / "target" / "release" / "meshcodec"
+MESHES = ROOT.parent / "shared" / "meshes"
+
+
+def resolve(name):
+    for ext in ("ply", "obj", "off", "m", "stl"):
+        path = MESHES / f"{name}.{ext}"
+        if path.is_file():
+            return path
+    raise SystemExit(f"unknown mesh {name}")
+
+
+def canonical_counts(path, quant, tmp):
+    stream = tmp / "raw.mc"
+    subprocess.run([str(BIN), "encode", "--codec", "raw", "--quant", str(quant), str(path), str(stream)],
+                   check=True, capture_output=True)
+    info = json.loads(subprocess.run([str(BIN), "info", str(stream), "--json"], check=True,
+                                     capture_output=True, text=True).stdout)
+    return info["vertices"], info["triangles"]
+
+
+def write_ply(path, points, faces):
+    header = (f"ply\nformat binary_little_endian 1.0\nelement vertex {len(points)}\n"
+              "property double x\nproperty double y\nproperty double z\n"
+              f"element face {len(faces)}\nproperty list uchar int vertex_indices\nend_header\n")
+    body = bytearray()
+    body += np.asarray(points, dtype="<f8").tobytes()
+    tri = np.empty((len(faces), 13), dtype=np.uint8)
+    tri[:, 0] = 3
+    tri[:, 1:] = np.asarray(faces, dtype="<i4").view(np.uint8).reshape(len(faces), 12)
+    body += tri.tobytes()
+    path.write_bytes(header.encode() + bytes(body))
+
+
+def best_of(fn, runs=5):
+    best, out = float("inf"), None
+    for _ in range(runs):
+        start = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - start)
+    return best, out
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("meshes", nargs="+")
+    parser.add_argument("--quant", nargs="+", type=int, default=[12])
+    parser.add_argument("--samples", type=int, default=10)
+    parser.add_argument("--out", default=str(ROOT / "results"))
+    args = parser.parse_args()
+    out = Path(args.out) / "draco"
+    out.mkdir(parents=True, exist_ok=True)
+    for name in args.meshes:
+        path = resolve(name)
+        # Our own reader's counts matter; Open3D only supplies the arrays (it keeps all vertices).
+        mesh = o3d.io.read_triangle_mesh(str(path))
+        faces = np.asarray(mesh.triangles, dtype=np.int64)
+        used = np.unique(faces)
+        remap = np.full(len(mesh.vertices), -1)
+        remap[used] = np.arange(len(used))
+        points = np.asarray(mesh.vertices, dtype=np.float64)[used]
+        faces = remap[faces]
+        for q in args.quant:
+            with tempfile.TemporaryDirectory() as tmp:
+                tmp = Path(tmp)
+                vertices, triangles = canonical_counts(path, q, tmp)
+                enc_s, data = best_of(lambda: DracoPy.encode(points.astype(np.float32), faces.astype(np.uint32),
+                                                             quantization_bits=q, compression_level=10))
+                dec_s, decoded = best_of(lambda: DracoPy.decode(data))
+                decoded_path = tmp / "decoded.ply"
+                write_ply(decoded_path, np.asarray(decoded.points, dtype=np.float64),
+                          np.asarray(decoded.faces, dtype=np.int64).reshape(-1, 3))
+                report = json.loads(subprocess.run(
+                    [str(BIN), "distance", str(path), str(decoded_path), "--samples", str(args.samples), "--json"],
+                    check=True, capture_output=True, text=True).stdout)
+            bits = len(data) * 8
+            result = {
+                "codec": "draco", "mesh": name, "source": str(path),
+                "vertices": vertices, "triangles": triangles, "quant_bits": q, "bytes": len(data),
+                "encode_seconds": enc_s, "decode_seconds": dec_s, "lossless": False,
+                "lossless_error": "Draco is single-rate and quantizes on its own grid; not checked against DESIGN.md A2",
+                "draco": {"compression_level": 10, "quantization_bits": q, "version": getattr(DracoPy, "__version__", "")},
+                "levels": [{
+                    "level": 1, "bits": bits, "connectivity_bits": 0, "geometry_bits": 0,
+                    "vertices": len(np.asarray(decoded.points).reshape(-1, 3)),
+                    "triangles": len(np.asarray(decoded.faces).reshape(-1, 3)),
+                    "bits_per_vertex": bits / vertices, "bits_per_triangle": bits / triangles,
+                    "hausdorff": report["hausdorff_relative"], "rms": report["rms_relative"],
+                    "hausdorff_paper": report["hausdorff_paper"] / report["diagonal"],
+                }],
+            }
+            target = out / f"{name}-q{q}.json"
+            target.write_text(json.dumps(result, indent=2) + "\n")
+            print(f"draco {name} q{q}: {len(data)} bytes = {bits / vertices:.2f} bits/vertex, "
+                  f"decode {vertices / dec_s / 1e6:.2f} M v/s, Hausdorff {report['hausdorff_relative']:.3e}")
+
+
+if __name__ == "__main__":
+    main()
