@@ -15,6 +15,7 @@ use crate::coding::varint;
 use crate::error::{Error, Result};
 use crate::limits;
 use crate::mesh::Grid;
+use std::io::Read as _;
 
 /// First bytes of every stream.
 pub const MAGIC: [u8; 4] = *b"MshC";
@@ -325,5 +326,122 @@ mod tests {
         let mut bytes = Vec::new();
         big.write(&mut bytes);
         assert!(matches!(Header::read(&bytes), Err(Error::Limit(_))));
+    }
+}
+
+/// A level's payload read from any source.
+#[derive(Clone, Debug)]
+pub struct OwnedLevel {
+    /// Level number, from 0.
+    pub index: usize,
+    /// Offset of the payload's first byte in the stream.
+    pub start: usize,
+    /// The payload.
+    pub bytes: Vec<u8>,
+}
+
+/// Where levels come from: bytes in memory, or an input stream read as levels are needed.
+pub trait LevelSource {
+    /// The stream's header.
+    fn header(&self) -> &Header;
+    /// The next complete level, or `None` when no complete level follows (end or cut).
+    fn next_owned_level(&mut self) -> Result<Option<OwnedLevel>>;
+}
+
+impl LevelSource for StreamReader<'_> {
+    fn header(&self) -> &Header {
+        StreamReader::header(self)
+    }
+
+    fn next_owned_level(&mut self) -> Result<Option<OwnedLevel>> {
+        Ok(self.next_level()?.map(|l| OwnedLevel {
+            index: l.index,
+            start: l.start,
+            bytes: l.bytes.to_vec(),
+        }))
+    }
+}
+
+/// Reads a stream's levels from an input stream (a file, a socket), one level at a time, so a
+/// decoder can start before the rest has arrived.
+pub struct ReadLevels<R: std::io::Read> {
+    reader: R,
+    header: Header,
+    offset: usize,
+    next_level: usize,
+}
+
+impl<R: std::io::Read> ReadLevels<R> {
+    /// Reads the header (and nothing beyond it) from `reader`.
+    pub fn open(mut reader: R) -> Result<Self> {
+        // The header's length is only known once it parses: read a byte at a time.
+        let mut bytes = Vec::new();
+        loop {
+            match Header::read(&bytes) {
+                Ok((header, _)) => {
+                    return Ok(ReadLevels {
+                        offset: bytes.len(),
+                        reader,
+                        header,
+                        next_level: 0,
+                    })
+                }
+                Err(Error::Truncated(what)) => {
+                    let mut byte = [0u8];
+                    if reader.read(&mut byte)? == 0 {
+                        return Err(Error::Truncated(what));
+                    }
+                    bytes.push(byte[0]);
+                }
+                Err(e) => return Err(e),
+            }
+        }
+    }
+}
+
+impl<R: std::io::Read> LevelSource for ReadLevels<R> {
+    fn header(&self) -> &Header {
+        &self.header
+    }
+
+    fn next_owned_level(&mut self) -> Result<Option<OwnedLevel>> {
+        if self.next_level as u64 >= self.header.levels {
+            return Ok(None);
+        }
+        let mut length_bytes = Vec::new();
+        let len = loop {
+            let mut byte = [0u8];
+            if self.reader.read(&mut byte)? == 0 {
+                return Ok(None);
+            }
+            length_bytes.push(byte[0]);
+            let mut pos = 0;
+            match varint::get(&length_bytes, &mut pos) {
+                Ok(len) => break len,
+                Err(varint::VarintFault::Truncated) => continue,
+                Err(varint::VarintFault::Overflow) => {
+                    return Err(Error::malformed(
+                        self.next_level,
+                        self.offset,
+                        "level length overflows",
+                    ))
+                }
+            }
+        };
+        self.offset += length_bytes.len();
+        // Read what arrives rather than allocating what the length claims.
+        let mut bytes = Vec::new();
+        (&mut self.reader).take(len).read_to_end(&mut bytes)?;
+        if (bytes.len() as u64) < len {
+            return Ok(None);
+        }
+        let level = OwnedLevel {
+            index: self.next_level,
+            start: self.offset,
+            bytes,
+        };
+        self.offset += len as usize;
+        self.next_level += 1;
+        Ok(Some(level))
     }
 }

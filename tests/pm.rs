@@ -167,3 +167,46 @@ fn corrupt_streams_fail_cleanly() {
         }
     }
 }
+
+/// A reader that hands out a few bytes per call, as a network would.
+struct Trickle<'a> {
+    bytes: &'a [u8],
+    step: usize,
+}
+
+impl std::io::Read for Trickle<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        self.step = self.step % 7 + 1;
+        let n = self.step.min(buf.len()).min(self.bytes.len());
+        buf[..n].copy_from_slice(&self.bytes[..n]);
+        self.bytes = &self.bytes[n..];
+        Ok(n)
+    }
+}
+
+#[test]
+fn an_input_stream_gives_the_same_sequence_as_bytes_in_memory() {
+    let (_, encoded) = encode(21, "pm-reordered", 16).unwrap();
+    let mut memory = PMeshIter::from_stream(&encoded.bytes).unwrap();
+    let mut stream = PMeshIter::from_reader(Trickle {
+        bytes: &encoded.bytes,
+        step: 0,
+    })
+    .unwrap();
+    assert!(memory.mesh() == stream.mesh());
+    while memory.next().unwrap() {
+        assert!(stream.next().unwrap());
+        assert!(memory.mesh() == stream.mesh());
+    }
+    assert!(!stream.next().unwrap());
+    assert!(
+        stream.prev(),
+        "records read from the stream are kept for prev()"
+    );
+    // A stream cut inside a level yields the complete levels before it.
+    let k = encoded.levels.len() - 2;
+    let cut = encoded.levels[k].end_byte + 3;
+    let mut partial = PMeshIter::from_reader(&encoded.bytes[..cut]).unwrap();
+    while partial.next().unwrap() {}
+    assert_eq!(partial.nvertices(), encoded.levels[k].vertices);
+}

@@ -6,7 +6,7 @@ use super::syntax::{self, Layout, SplitContexts};
 use super::PmParams;
 use crate::codecs::LevelMesh;
 use crate::coding::arith::ArithDecoder;
-use crate::container::{Header, StreamReader};
+use crate::container::{Header, LevelSource, ReadLevels, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::pmesh::{PmMesh, Vsplit};
 use crate::mesh::{Grid, TriMesh};
@@ -14,7 +14,7 @@ use glam::DVec3;
 
 /// Reads vsplit records one at a time from a stream's levels.
 struct SplitReader<'a> {
-    stream: StreamReader<'a>,
+    source: Box<dyn LevelSource + 'a>,
     contexts: SplitContexts,
     coder: Option<ArithDecoder>,
     left_in_level: u64,
@@ -27,7 +27,7 @@ struct SplitReader<'a> {
 impl SplitReader<'_> {
     /// Opens the next level; `Ok(false)` when there is none (complete) in the stream.
     fn open_level(&mut self) -> Result<bool> {
-        let Some(level) = self.stream.next_level()? else {
+        let Some(level) = self.source.next_owned_level()? else {
             return Ok(false);
         };
         let fault = || {
@@ -37,7 +37,7 @@ impl SplitReader<'_> {
                 "level is not an arithmetic-coded payload",
             )
         };
-        let mut coder = ArithDecoder::new(level.bytes).ok_or_else(fault)?;
+        let mut coder = ArithDecoder::new(&level.bytes).ok_or_else(fault)?;
         self.left_in_level = syntax::get_count(&mut coder, &mut self.contexts).ok_or_else(fault)?;
         self.level_start = level.start;
         self.coder = Some(coder);
@@ -88,13 +88,22 @@ pub struct PMeshIter<'a> {
 impl<'a> PMeshIter<'a> {
     /// An iterator at M⁰ of the stream `bytes` (its first level must be present).
     pub fn from_stream(bytes: &'a [u8]) -> Result<PMeshIter<'a>> {
-        let mut stream = StreamReader::open(bytes)?;
+        Self::from_source(Box::new(StreamReader::open(bytes)?))
+    }
+
+    /// An iterator at M⁰ of a stream read from `reader` (a file, a socket) as records are needed:
+    /// Hoppe's PMeshRStream over an input stream. Records read are kept, so `prev` works.
+    pub fn from_reader(reader: impl std::io::Read + 'a) -> Result<PMeshIter<'a>> {
+        Self::from_source(Box::new(ReadLevels::open(reader)?))
+    }
+
+    fn from_source(mut stream: Box<dyn LevelSource + 'a>) -> Result<PMeshIter<'a>> {
         let header = stream.header().clone();
         let params = PmParams::from_header(&header)?;
         let base = stream
-            .next_level()?
+            .next_owned_level()?
             .ok_or_else(|| Error::Truncated("the stream ends before its base mesh".into()))?;
-        let mesh = super::read_base(&header, base.bytes)
+        let mesh = super::read_base(&header, &base.bytes)
             .ok_or_else(|| Error::malformed(1, base.start, "base mesh cannot be read"))?;
         Ok(PMeshIter {
             base: mesh.clone(),
@@ -104,7 +113,7 @@ impl<'a> PMeshIter<'a> {
             full_vertices: header.vertices,
             header,
             reader: Some(SplitReader {
-                stream,
+                source: stream,
                 contexts: SplitContexts::default(),
                 coder: None,
                 left_in_level: 0,
