@@ -7,6 +7,8 @@ use meshcodec::mesh::quantize::GridShape;
 use meshcodec::Error;
 use proptest::prelude::*;
 
+mod common;
+
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES")
         .ok()
@@ -120,15 +122,8 @@ fn a_cut_inside_a_level_decodes_the_operations_before_it() {
 fn corrupt_streams_fail_cleanly() {
     let (_, encoded) = encode(11, 12, false).unwrap();
     let mut x = 0x9e37_79b9_u32;
-    for trial in 0..2000 {
-        let mut bytes = encoded.bytes.clone();
-        for _ in 0..1 + trial % 4 {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            let i = x as usize % bytes.len();
-            bytes[i] ^= 1 << (x >> 29);
-        }
+    for _ in 0..2000 {
+        let bytes = common::flip_bits(&encoded.bytes, &mut x, 4);
         if let Ok((level, _)) = codecs::decode(&bytes, Stop::All) {
             assert_valid(&level);
         }

@@ -9,6 +9,8 @@ use meshcodec::mesh::{CanonicalMesh, TriMesh};
 use meshcodec::Error;
 use proptest::prelude::*;
 
+mod common;
+
 fn cases() -> u32 {
     std::env::var("PROPTEST_CASES")
         .ok()
@@ -152,15 +154,8 @@ fn non_manifold_meshes_are_refused_with_counts() {
 fn corrupt_streams_fail_cleanly() {
     let (_, encoded) = encode(9, "pm", 14).unwrap();
     let mut x = 0x1234_5678_u32;
-    for trial in 0..1000 {
-        let mut bytes = encoded.bytes.clone();
-        for _ in 0..1 + trial % 3 {
-            x ^= x << 13;
-            x ^= x >> 17;
-            x ^= x << 5;
-            let i = x as usize % bytes.len();
-            bytes[i] ^= 1 << (x >> 29);
-        }
+    for _ in 0..1000 {
+        let bytes = common::flip_bits(&encoded.bytes, &mut x, 3);
         if let Ok((level, _)) = codecs::decode(&bytes, Stop::All) {
             let n = level.mesh.positions.len() as u32;
             assert!(level.mesh.faces.iter().flatten().all(|&v| v < n));

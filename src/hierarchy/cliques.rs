@@ -7,6 +7,23 @@
 
 use glam::DVec3;
 
+/// The edge graph of `faces` over `n` vertices, as sorted adjacency lists.
+pub fn adjacency(n: usize, faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
+    let mut adj = vec![Vec::new(); n];
+    for f in faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            adj[a as usize].push(b);
+            adj[b as usize].push(a);
+        }
+    }
+    for list in &mut adj {
+        list.sort_unstable();
+        list.dedup();
+    }
+    adj
+}
+
 /// All 3-cliques of an undirected graph given as sorted adjacency lists, each as an ascending
 /// triple, in lexicographic order.
 pub fn triangles(adjacency: &[Vec<u32>]) -> Vec<[u32; 3]> {
@@ -221,26 +238,10 @@ mod tests {
     use super::*;
     use crate::mesh::generate;
 
-    fn adjacency_of(n: usize, faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
-        let mut adj = vec![Vec::new(); n];
-        for f in faces {
-            for k in 0..3 {
-                let (a, b) = (f[k], f[(k + 1) % 3]);
-                adj[a as usize].push(b);
-                adj[b as usize].push(a);
-            }
-        }
-        for list in &mut adj {
-            list.sort_unstable();
-            list.dedup();
-        }
-        adj
-    }
-
     #[test]
     fn a_sphere_is_rebuilt_with_outward_orientation() {
         let sphere = generate::icosphere(2);
-        let adj = adjacency_of(sphere.positions.len(), &sphere.faces);
+        let adj = adjacency(sphere.positions.len(), &sphere.faces);
         let tris = triangles(&adj);
         assert_eq!(tris.len(), sphere.faces.len());
         let skipped = vec![false; tris.len()];

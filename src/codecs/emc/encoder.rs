@@ -70,18 +70,7 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
     let order = params.order;
     let trie = KeyTrie::new(order, &mesh.cells);
     let n = mesh.vertex_count();
-    let mut neighbours = vec![Vec::new(); n];
-    for f in &mesh.faces {
-        for k in 0..3 {
-            let (a, b) = (f[k], f[(k + 1) % 3]);
-            neighbours[a as usize].push(b);
-            neighbours[b as usize].push(a);
-        }
-    }
-    for list in &mut neighbours {
-        list.sort_unstable();
-        list.dedup();
-    }
+    let neighbours = crate::hierarchy::cliques::adjacency(n, &mesh.faces);
 
     let mut state = EmcState::new(order, n as u64);
     let mut ranges: Vec<Range<usize>> = std::iter::once(0..n).collect();
