@@ -129,3 +129,30 @@ fn corrupt_streams_fail_cleanly() {
         }
     }
 }
+
+#[test]
+fn decoding_stops_after_any_pass() {
+    let (_, encoded) = encode(5, 12, false).unwrap();
+    for level in 1..12 {
+        let at_level = codecs::decode(&encoded.bytes, Stop::Levels(level))
+            .unwrap()
+            .0;
+        let at_passes = codecs::decode(&encoded.bytes, Stop::Passes(3 * level))
+            .unwrap()
+            .0;
+        assert!(at_level == at_passes, "3 passes are a level ({level})");
+        let next = codecs::decode(&encoded.bytes, Stop::Levels(level + 1))
+            .unwrap()
+            .0;
+        let mut previous = at_level.mesh.vertex_count();
+        for extra in 1..3 {
+            let mid = codecs::decode(&encoded.bytes, Stop::Passes(3 * level + extra))
+                .unwrap()
+                .0;
+            assert_valid(&mid);
+            let n = mid.mesh.vertex_count();
+            assert!(previous <= n && n <= next.mesh.vertex_count());
+            previous = n;
+        }
+    }
+}

@@ -53,6 +53,9 @@ enum Command {
         /// Use only the first N bytes of the stream.
         #[arg(long)]
         bytes: Option<usize>,
+        /// Stop after this many passes (EMC: three per level, one per direction).
+        #[arg(long, conflicts_with_all = ["level", "bytes"])]
+        passes: Option<usize>,
     },
     /// Describe a stream: header, grid, levels.
     Info {
@@ -105,7 +108,8 @@ fn main() -> ExitCode {
             output,
             level,
             bytes,
-        } => decode(&input, &output, level, bytes),
+            passes,
+        } => decode(&input, &output, level, bytes, passes),
         Command::Info { input, json } => info(&input, json),
         Command::Distance {
             a,
@@ -167,10 +171,20 @@ fn read_stream(input: &Path) -> Result<Vec<u8>> {
     std::fs::read(input).with_context(|| input.display().to_string())
 }
 
-fn decode(input: &Path, output: &Path, level: Option<usize>, bytes: Option<usize>) -> Result<()> {
+fn decode(
+    input: &Path,
+    output: &Path,
+    level: Option<usize>,
+    bytes: Option<usize>,
+    passes: Option<usize>,
+) -> Result<()> {
     let stream = read_stream(input)?;
     let prefix = &stream[..bytes.unwrap_or(stream.len()).min(stream.len())];
-    let stop = level.map_or(Stop::All, Stop::Levels);
+    let stop = match (level, passes) {
+        (Some(l), _) => Stop::Levels(l),
+        (_, Some(p)) => Stop::Passes(p),
+        _ => Stop::All,
+    };
     let (decoded, levels) =
         codecs::decode(prefix, stop).with_context(|| input.display().to_string())?;
     if decoded.mesh.positions.is_empty() {

@@ -94,6 +94,12 @@ pub trait LevelDecoder {
     /// Decodes the next complete level; `Ok(false)` when none is left (the stream's end, or the
     /// prefix ends inside the next level).
     fn advance(&mut self) -> Result<bool>;
+    /// Decodes only the first `passes` passes of the next level and stops there (EMC: a pass is
+    /// one direction of one octree level); `Ok(false)` for codecs without passes. No level can
+    /// be decoded after it.
+    fn advance_passes(&mut self, _passes: usize) -> Result<bool> {
+        Ok(false)
+    }
     /// Decodes what is present of a level the stream was cut in, where the codec's syntax allows
     /// it; `Ok(false)` when nothing more could be decoded.
     fn advance_partial(&mut self) -> Result<bool> {
@@ -165,6 +171,8 @@ pub enum Stop {
     All,
     /// After this many levels (or all present, if fewer).
     Levels(usize),
+    /// After this many passes (EMC: three a level).
+    Passes(usize),
 }
 
 /// Decodes `bytes` (a whole stream or any prefix) up to `stop`; returns the mesh and the number
@@ -174,10 +182,17 @@ pub fn decode(bytes: &[u8], stop: Stop) -> Result<(LevelMesh, usize)> {
     let wanted = match stop {
         Stop::All => usize::MAX,
         Stop::Levels(n) => n,
+        Stop::Passes(n) => n / 3,
     };
     while decoder.levels_decoded() < wanted && decoder.advance()? {}
-    if stop == Stop::All {
-        decoder.advance_partial()?;
+    match stop {
+        Stop::All => {
+            decoder.advance_partial()?;
+        }
+        Stop::Passes(n) if n % 3 > 0 && decoder.levels_decoded() == n / 3 => {
+            decoder.advance_passes(n % 3)?;
+        }
+        _ => {}
     }
     Ok((decoder.mesh(), decoder.levels_decoded()))
 }

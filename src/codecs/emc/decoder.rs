@@ -42,11 +42,17 @@ impl<'a> EmcDecoder<'a> {
 
     /// Decodes the steps of level `levels_done + 1` from `payload`.
     fn decode_level(&mut self, payload: &LevelPayload) -> Result<(), Stop> {
+        self.decode_passes(payload, 3)
+    }
+
+    /// Decodes the first `passes` (1..=3) passes of level `levels_done + 1` from `payload`; the
+    /// last level's face corrections only after all three.
+    fn decode_passes(&mut self, payload: &LevelPayload, passes: usize) -> Result<(), Stop> {
         let order = self.state.order;
         let level = self.levels_done + 1;
         let mut source = BitSource::new(payload.bytes);
         let fault = |what: String| Stop::Fault(Error::malformed(level, payload.start, what));
-        for step in 3 * (level - 1)..3 * level {
+        for step in 3 * (level - 1)..3 * (level - 1) + passes.min(3) {
             // Vertices that were present before the pass; a cut pass resumes nowhere, so each
             // vertex is checked by its depth.
             let present = self.state.len();
@@ -85,7 +91,7 @@ impl<'a> EmcDecoder<'a> {
                 self.state.split(v, step, connecting, &codes, next);
             }
         }
-        if level == order.levels as usize {
+        if level == order.levels as usize && passes >= 3 {
             self.read_corrections(&mut source, payload)?;
         }
         Ok(())
@@ -166,6 +172,21 @@ impl LevelDecoder for EmcDecoder<'_> {
                 self.levels_done += 1;
                 Ok(true)
             }
+            Err(Stop::Fault(e)) => Err(e),
+            Err(Stop::OutOfBits) => Err(Error::malformed(
+                self.levels_done + 1,
+                payload.start,
+                "level payload ends before its last operation",
+            )),
+        }
+    }
+
+    fn advance_passes(&mut self, passes: usize) -> Result<bool> {
+        let Some(payload) = self.stream.next_level()? else {
+            return Ok(false);
+        };
+        match self.decode_passes(&payload, passes) {
+            Ok(()) => Ok(true),
             Err(Stop::Fault(e)) => Err(e),
             Err(Stop::OutOfBits) => Err(Error::malformed(
                 self.levels_done + 1,

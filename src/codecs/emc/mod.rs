@@ -37,7 +37,8 @@
 //! neighbour (ascending list ids), and two split distances (old vertex, new vertex). The first
 //! vertex needs no distance: it always splits at step 0, since the longest axis spans the whole
 //! grid. Each level is flushed to a byte boundary and carries its length (the container), so any
-//! prefix decodes; inside a cut level, every complete operation is applied.
+//! prefix decodes; inside a cut level, every complete operation is applied, and decoding can also
+//! stop after any pass (`Stop::Passes`, `meshcodec decode --passes`).
 //!
 //! # Encoder
 //! The paper builds the merge list bottom-up and writes it reversed. The splits it produces are
