@@ -335,7 +335,7 @@ pub fn level_table(result: &RunResult) -> String {
         "rms",
         "paper"
     );
-    let (v, t) = (result.vertices as f64, result.triangles as f64);
+    let v = result.vertices as f64;
     for r in &result.levels {
         out.push_str(&format!(
             "{:>5} {:>9} {:>9} {:>11} {:>8.3} {:>8.3} {:>9.3} {:>9.3} {:>10} {:>10} {:>10}\n",
@@ -343,8 +343,8 @@ pub fn level_table(result: &RunResult) -> String {
             r.vertices,
             r.triangles,
             r.bits,
-            r.bits as f64 / v,
-            r.bits as f64 / t,
+            r.bits_per_vertex,
+            r.bits_per_triangle,
             r.connectivity_bits as f64 / v,
             r.geometry_bits as f64 / v,
             opt(r.hausdorff),

@@ -6,7 +6,7 @@
 //! which keeps one drawing path for both kinds of chart.
 
 use crate::error::{Error, Result};
-use crate::harness::RunResult;
+use crate::harness::{LevelRow, RunResult};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -60,18 +60,7 @@ pub fn rate_resolution(runs: &[RunResult], title: &str) -> Chart {
         x_log: false,
         y_log: false,
         legend: SeriesLabelPosition::UpperLeft,
-        series: runs
-            .iter()
-            .map(|r| Series {
-                label: run_label(r, runs),
-                points: r
-                    .levels
-                    .iter()
-                    .map(|l| (l.level as f64, l.bits_per_vertex))
-                    .collect(),
-                mark: Mark::Line,
-            })
-            .collect(),
+        series: series(runs, |l| Some((l.level as f64, l.bits_per_vertex))),
     }
 }
 
@@ -84,23 +73,24 @@ pub fn rate_distortion(runs: &[RunResult], title: &str) -> Chart {
         x_log: true,
         y_log: true,
         legend: SeriesLabelPosition::UpperRight,
-        series: runs
-            .iter()
-            .map(|r| Series {
-                label: run_label(r, runs),
-                points: r
-                    .levels
-                    .iter()
-                    .filter_map(|l| Some((l.bits as f64, l.hausdorff?)))
-                    .collect(),
-                mark: if r.levels.len() == 1 {
-                    Mark::Points
-                } else {
-                    Mark::Line
-                },
-            })
-            .collect(),
+        series: series(runs, |l| Some((l.bits as f64, l.hausdorff?))),
     }
+}
+
+/// One series per run, of the points `point` gives for its levels; a single-level run (a
+/// single-rate codec) is drawn as a point, not a line.
+fn series(runs: &[RunResult], point: impl Fn(&LevelRow) -> Option<(f64, f64)>) -> Vec<Series> {
+    runs.iter()
+        .map(|r| Series {
+            label: run_label(r, runs),
+            points: r.levels.iter().filter_map(&point).collect(),
+            mark: if r.levels.len() == 1 {
+                Mark::Points
+            } else {
+                Mark::Line
+            },
+        })
+        .collect()
 }
 
 /// Legend text of a run: the codec, plus what tells it apart from the other runs.
