@@ -113,7 +113,8 @@ pub trait LevelDecoder {
 pub fn registry() -> Vec<&'static dyn Codec> {
     vec![
         &raw::Raw,
-        &emc::Emc,
+        &emc::paper::EmcPaper,
+        &emc::modelled::Emc,
         &pm::Pm {
             ordering: pm::Ordering::Natural,
         },

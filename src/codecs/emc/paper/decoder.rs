@@ -2,7 +2,7 @@
 //! from a cut payload too: every vertex operation is read whole before it is applied, so a cut
 //! leaves the state after the last complete operation.
 
-use super::context::{final_faces, EmcState, FaceCorrections, NO_SPLIT};
+use super::super::state::{final_faces, EmcState, FaceCorrections, NO_SPLIT};
 use super::syntax;
 use crate::codecs::{LevelDecoder, LevelMesh};
 use crate::coding::BitSource;

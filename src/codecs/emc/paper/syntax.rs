@@ -4,24 +4,7 @@ use crate::coding::huffman::{get_gamma, put_gamma, Huffman};
 use crate::coding::{BitSink, BitSource, SyntaxClass};
 use std::sync::OnceLock;
 
-/// What happens to an edge of a splitting vertex.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum EdgeCode {
-    /// Stays with the old vertex.
-    Stay,
-    /// Moves to the new vertex.
-    Move,
-    /// Both vertices keep an edge to the neighbour.
-    Duplicate,
-}
-
-impl EdgeCode {
-    const ALL: [EdgeCode; 3] = [EdgeCode::Stay, EdgeCode::Move, EdgeCode::Duplicate];
-
-    fn symbol(self) -> usize {
-        self as usize
-    }
-}
+pub use super::super::state::EdgeCode;
 
 /// Code lengths of STAY, MOVE, DUPLICATE. See the module docs of `emc` for the measurement
 /// behind the choice.
@@ -48,17 +31,17 @@ fn distance_code() -> &'static Huffman {
 
 /// Writes an edge code.
 pub fn put_edge(sink: &mut BitSink, code: EdgeCode) {
-    edge_code().put(sink, SyntaxClass::Connectivity, code.symbol());
+    edge_code().put(sink, SyntaxClass::Connectivity, code as usize);
 }
 
 /// Reads an edge code.
 pub fn get_edge(source: &mut BitSource) -> Option<EdgeCode> {
-    edge_code().get(source).map(|s| EdgeCode::ALL[s])
+    edge_code().get(source).map(|s| [EdgeCode::Stay, EdgeCode::Move, EdgeCode::Duplicate][s])
 }
 
 /// Bits of an edge code.
 pub fn edge_bits(code: EdgeCode) -> u64 {
-    EDGE_CODE_LENGTHS[code.symbol()] as u64
+    EDGE_CODE_LENGTHS[code as usize] as u64
 }
 
 /// Writes the distance from `step` to `next` (a later step, or `None` for no further split).

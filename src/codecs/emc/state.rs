@@ -2,12 +2,28 @@
 //! vertex's cell prefix, its next split step and its edge list, and the triangles rebuilt from
 //! the edges.
 
-use super::syntax::EdgeCode;
 use crate::codecs::LevelMesh;
 use crate::hierarchy::cliques::{loose_edges, oriented, propagate_orientation, triangles};
+use crate::hierarchy::octree::KeyTrie;
+use crate::mesh::canonical::rotate_to_smallest;
+use crate::mesh::CanonicalMesh;
+use std::collections::HashMap;
+use std::ops::Range;
 use crate::hierarchy::octree::StepOrder;
 use crate::mesh::{Grid, TriMesh};
 use glam::DVec3;
+
+/// What happens to an edge of a splitting vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EdgeCode {
+    /// Stays with the old vertex.
+    Stay,
+    /// Moves to the new vertex.
+    Move,
+    /// Both vertices keep an edge to the neighbour.
+    Duplicate,
+}
+
 
 /// "No further split".
 pub const NO_SPLIT: u16 = u16::MAX;
@@ -219,4 +235,84 @@ pub fn final_faces(
         }
     }
     faces
+}
+
+/// Compares the cliques of the final edge graph with the mesh's faces and lists what the decoder
+/// must correct: false triangles, faces present in both orientations, and orientations that the
+/// propagation predicts wrongly.
+pub fn face_corrections(
+    mesh: &CanonicalMesh,
+    state: &EmcState,
+    ranges: &[Range<usize>],
+    trie: &KeyTrie,
+) -> FaceCorrections {
+    // Every cluster is a single mesh vertex by now.
+    let mut list_id = vec![0u32; mesh.vertex_count()];
+    for (v, range) in ranges.iter().enumerate() {
+        debug_assert_eq!(range.len(), 1);
+        list_id[trie.vertices[range.start] as usize] = v as u32;
+    }
+    // Oriented faces in list ids, keyed by their ascending triple.
+    let mut faces: HashMap<[u32; 3], u8> = HashMap::new(); // bit 0: unflipped, bit 1: flipped
+    for f in &mesh.faces {
+        let f = f.map(|u| list_id[u as usize]);
+        let mut sorted = f;
+        sorted.sort_unstable();
+        let unflipped = rotate_to_smallest(f) == sorted;
+        *faces.entry(sorted).or_default() |= if unflipped { 1 } else { 2 };
+    }
+    let cliques = state.cliques();
+    let mut corrections = FaceCorrections::default();
+    for (i, t) in cliques.iter().enumerate() {
+        match faces.get(t) {
+            None => corrections.false_triangles.push(i as u32),
+            Some(3) => corrections.double_sided.push(i as u32),
+            Some(_) => {}
+        }
+    }
+    debug_assert_eq!(
+        cliques.len() - corrections.false_triangles.len(),
+        faces.len(),
+        "every face is a 3-clique of its own edges"
+    );
+    let skipped = corrections.skipped(cliques.len());
+    let positions: Vec<_> = (0..state.len())
+        .map(|v| mesh.grid.dequantize(state.cells[v]))
+        .collect();
+    // Let the propagation follow the true orientations and note where they were not predicted.
+    let is_flipped = |t: usize| faces.get(&cliques[t]).copied() == Some(2);
+    let centre = centroid(&positions);
+    propagate_orientation(
+        &cliques,
+        &skipped,
+        &state.adjacency,
+        &positions,
+        centre,
+        |visit, t, predicted| {
+            if is_flipped(t) != predicted {
+                corrections.orientation_exceptions.push(visit as u32);
+            }
+            is_flipped(t)
+        },
+    );
+    debug_assert_eq!(
+        {
+            let mut got: Vec<_> = final_faces(&cliques, &state.adjacency, &positions, &corrections)
+                .into_iter()
+                .map(rotate_to_smallest)
+                .collect();
+            got.sort_unstable();
+            got
+        },
+        {
+            let mut want: Vec<_> = mesh
+                .faces
+                .iter()
+                .map(|f| rotate_to_smallest(f.map(|u| list_id[u as usize])))
+                .collect();
+            want.sort_unstable();
+            want
+        }
+    );
+    corrections
 }

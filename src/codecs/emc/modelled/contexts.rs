@@ -1,0 +1,109 @@
+//! The adaptive contexts of the modelled coder and how each question picks one. Measurements
+//! behind the choices are in the module docs of [`super`].
+
+use crate::coding::arith::{BitContext, UintContext};
+
+/// First index of `x` in ascending `thresholds` that `x` is below; `thresholds.len()` if none.
+fn bin(x: f64, thresholds: &[f64]) -> usize {
+    thresholds
+        .iter()
+        .position(|&t| x < t)
+        .unwrap_or(thresholds.len())
+}
+
+/// Levels still to come after the current one, capped.
+const REMAINING: usize = 8;
+/// Valences told apart.
+const VALENCES: usize = 16;
+
+/// Distance of the neighbours' mean from the split plane, in half-widths of the cell.
+const HALF_OFFSET: [f64; 6] = [1.0 / 16.0, 1.0 / 8.0, 0.25, 0.5, 1.0, 2.0];
+/// Standard deviation of the neighbours along the axis, in half-widths (compared squared).
+const HALF_SPREAD: [f64; 5] = [0.25, 0.5, 1.0, 2.0, 4.0];
+const HALF_CONTEXTS: usize = 2 * (HALF_OFFSET.len() + 1) * (HALF_SPREAD.len() + 1) + 2;
+
+/// Distance of a neighbour from the split plane, in half-widths of the splitting cell (the two
+/// halves' centres are at ±0.5).
+const EDGE_ALONG: [f64; 8] = [0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 5.0];
+/// Its largest distance across the axis, over its distance along it.
+const EDGE_ACROSS: [f64; 4] = [0.5, 1.0, 2.0, 4.0];
+/// Number of neighbour places an edge can be in.
+pub const EDGE_PLACES: usize = 2 * (EDGE_ALONG.len() + 1) * (EDGE_ACROSS.len() + 1);
+
+/// Every context of the coder, in their initial state.
+#[derive(Clone)]
+pub struct Contexts {
+    pub split: [BitContext; 4 * VALENCES * REMAINING],
+    pub half: [BitContext; HALF_CONTEXTS],
+    pub connecting: [BitContext; VALENCES * REMAINING],
+    pub duplicate: [BitContext; EDGE_PLACES * 3],
+    pub moves: [BitContext; EDGE_PLACES],
+    pub leaf: [BitContext; 2 * VALENCES * REMAINING],
+    /// Lengths and gaps of the three face-correction lists.
+    pub corrections: [UintContext; 3],
+}
+
+impl Default for Contexts {
+    fn default() -> Self {
+        Contexts {
+            split: [BitContext::default(); 4 * VALENCES * REMAINING],
+            half: [BitContext::default(); HALF_CONTEXTS],
+            connecting: [BitContext::default(); VALENCES * REMAINING],
+            duplicate: [BitContext::default(); EDGE_PLACES * 3],
+            moves: [BitContext::default(); EDGE_PLACES],
+            leaf: [BitContext::default(); 2 * VALENCES * REMAINING],
+            corrections: Default::default(),
+        }
+    }
+}
+
+/// Does a cluster split now: by steps since it was made, its valence (a bigger cluster has
+/// more neighbours) and the levels left.
+pub fn split(age: u8, valence: usize, remaining: usize) -> usize {
+    ((age.min(3) as usize * VALENCES) + valence.min(VALENCES - 1)) * REMAINING
+        + remaining.min(REMAINING - 1)
+}
+
+/// Which half, for a vertex with no neighbours.
+pub fn half_isolated(leaf: bool) -> usize {
+    HALF_CONTEXTS - 2 + leaf as usize
+}
+
+/// Which half: by the neighbours' mean offset and variance (both relative to the half-width,
+/// the variance to its square).
+pub fn half(leaf: bool, offset: f64, variance: f64) -> usize {
+    let o = bin(offset, &HALF_OFFSET);
+    let s = HALF_SPREAD
+        .iter()
+        .position(|&t| variance < t * t)
+        .unwrap_or(HALF_SPREAD.len());
+    ((leaf as usize * (HALF_OFFSET.len() + 1)) + o) * (HALF_SPREAD.len() + 1) + s
+}
+
+/// Is there an edge between the two halves.
+pub fn connecting(valence: usize, remaining: usize) -> usize {
+    valence.min(VALENCES - 1) * REMAINING + remaining.min(REMAINING - 1)
+}
+
+/// Where a neighbour lies relative to the split: `along` and `across` the axis in half-widths,
+/// and whether it is a single vertex.
+pub fn edge_place(along: f64, across: f64, leaf: bool) -> usize {
+    let a = bin(along, &EDGE_ALONG);
+    let ratio = if along > 0.0 {
+        across / along
+    } else {
+        f64::INFINITY
+    };
+    let c = bin(ratio, &EDGE_ACROSS);
+    ((a * (EDGE_ACROSS.len() + 1)) + c) * 2 + leaf as usize
+}
+
+/// Is the edge duplicated: by the neighbour's place and the duplicates so far in this split.
+pub fn duplicate(place: usize, duplicates_so_far: usize) -> usize {
+    place * 3 + duplicates_so_far.min(2)
+}
+
+/// Is a half a single vertex: by which half, its valence after the split and the levels left.
+pub fn leaf(half: usize, valence: usize, remaining: usize) -> usize {
+    ((half * VALENCES) + valence.min(VALENCES - 1)) * REMAINING + remaining.min(REMAINING - 1)
+}

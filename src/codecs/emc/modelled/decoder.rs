@@ -1,0 +1,185 @@
+//! The modelled coder's decoder: the walker's questions answered from the stream. Each level is
+//! its own arithmetic-coded block, so a stream cut inside a level decodes to the level before.
+
+use super::contexts::Contexts;
+use super::walk::{Question, Side, Stop, Walker};
+use crate::codecs::emc::state::{final_faces, FaceCorrections};
+use crate::codecs::{LevelDecoder, LevelMesh};
+use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
+use crate::container::{Header, StreamReader};
+use crate::error::{Error, Result};
+use crate::hierarchy::cliques::loose_edges;
+use crate::hierarchy::octree::StepOrder;
+use crate::mesh::TriMesh;
+
+struct DecoderSide {
+    coder: ArithDecoder,
+}
+
+impl Side for DecoderSide {
+    fn code(
+        &mut self,
+        context: &mut BitContext,
+        _question: Question,
+        flip: bool,
+        _v: usize,
+        _step: usize,
+    ) -> Result<bool, Stop> {
+        Ok(self.coder.bit(context).ok_or(Stop::OutOfBits)? ^ flip)
+    }
+}
+
+/// Reads a list written by [`super::encoder::put_list`]; every entry below `bound`.
+fn get_list(
+    coder: &mut ArithDecoder,
+    context: &mut UintContext,
+    bound: usize,
+) -> Result<Vec<u32>, Stop> {
+    let fault = || Stop::Fault("a face-correction list runs past the triangles".into());
+    let len = coder.uint(context).ok_or(Stop::OutOfBits)?;
+    if len > bound as u64 {
+        return Err(fault());
+    }
+    let mut list = Vec::with_capacity(len as usize);
+    let mut next = 0u64;
+    for _ in 0..len {
+        let x = next
+            .checked_add(coder.uint(context).ok_or(Stop::OutOfBits)?)
+            .filter(|&x| x < bound as u64)
+            .ok_or_else(fault)?;
+        list.push(x as u32);
+        next = x + 1;
+    }
+    Ok(list)
+}
+
+pub struct EmcDecoder<'a> {
+    stream: StreamReader<'a>,
+    header: Header,
+    walker: Walker,
+    levels_done: usize,
+    /// The full mesh once the last level's corrections are read.
+    final_mesh: Option<LevelMesh>,
+}
+
+impl<'a> EmcDecoder<'a> {
+    pub fn new(stream: StreamReader<'a>, order: StepOrder) -> Self {
+        let header = stream.header().clone();
+        EmcDecoder {
+            walker: Walker::new(order, header.vertices),
+            header,
+            stream,
+            levels_done: 0,
+            final_mesh: None,
+        }
+    }
+
+    /// Decodes the first `passes` (1..=3) passes of the next level.
+    fn decode_passes(&mut self, passes: usize) -> Result<bool> {
+        let Some(payload) = self.stream.next_level()? else {
+            return Ok(false);
+        };
+        let level = self.levels_done + 1;
+        let fault = |what: String| Error::malformed(level, payload.start, what);
+        let coder = ArithDecoder::new(payload.bytes)
+            .ok_or_else(|| fault("level payload is not whole 32-bit words".into()))?;
+        let mut side = DecoderSide { coder };
+        let outcome = (|| {
+            let order = self.walker.state.order;
+            for step in 3 * (level - 1)..3 * (level - 1) + passes.min(3) {
+                self.walker
+                    .pass(&mut side, step, self.header.vertices, self.header.triangles)?;
+            }
+            if level == order.levels as usize && passes >= 3 {
+                self.read_corrections(&mut side.coder)?;
+            }
+            Ok(())
+        })();
+        match outcome {
+            Ok(()) => Ok(true),
+            Err(Stop::Fault(what)) => Err(fault(what)),
+            Err(Stop::OutOfBits) => Err(fault("level payload ends before its last question".into())),
+        }
+    }
+
+    fn read_corrections(&mut self, coder: &mut ArithDecoder) -> Result<(), Stop> {
+        let state = &self.walker.state;
+        if state.len() as u64 != self.header.vertices {
+            return Err(Stop::Fault(format!(
+                "{} vertices decoded, the header declares {}",
+                state.len(),
+                self.header.vertices
+            )));
+        }
+        let cliques = state.cliques();
+        let contexts: &mut Contexts = &mut self.walker.contexts;
+        let [c0, c1, c2] = &mut contexts.corrections;
+        let false_triangles = get_list(coder, c0, cliques.len())?;
+        let double_sided = get_list(coder, c1, cliques.len())?;
+        let orientation_exceptions = get_list(coder, c2, cliques.len())?;
+        if false_triangles
+            .iter()
+            .any(|t| double_sided.binary_search(t).is_ok())
+        {
+            return Err(Stop::Fault(
+                "a triangle is listed both false and double-sided".into(),
+            ));
+        }
+        let corrections = FaceCorrections {
+            false_triangles,
+            double_sided,
+            orientation_exceptions,
+        };
+        let state = &self.walker.state;
+        let positions = state.positions(&self.header.grid);
+        let faces = final_faces(&cliques, &state.adjacency, &positions, &corrections);
+        if faces.len() as u64 != self.header.triangles {
+            return Err(Stop::Fault(format!(
+                "{} triangles decoded, the header declares {}",
+                faces.len(),
+                self.header.triangles
+            )));
+        }
+        let skipped = corrections.skipped(cliques.len());
+        let true_cliques: Vec<[u32; 3]> = cliques
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| {
+                !skipped[i] || corrections.double_sided.binary_search(&(i as u32)).is_ok()
+            })
+            .map(|(_, t)| *t)
+            .collect();
+        self.final_mesh = Some(LevelMesh {
+            loose_edges: loose_edges(&state.adjacency, &true_cliques),
+            mesh: TriMesh::new(positions, faces),
+        });
+        Ok(())
+    }
+}
+
+impl LevelDecoder for EmcDecoder<'_> {
+    fn header(&self) -> &Header {
+        &self.header
+    }
+
+    fn levels_decoded(&self) -> usize {
+        self.levels_done
+    }
+
+    fn advance(&mut self) -> Result<bool> {
+        let advanced = self.decode_passes(3)?;
+        self.levels_done += advanced as usize;
+        Ok(advanced)
+    }
+
+    fn advance_passes(&mut self, passes: usize) -> Result<bool> {
+        self.decode_passes(passes)
+    }
+
+    fn mesh(&self) -> LevelMesh {
+        match &self.final_mesh {
+            Some(mesh) => mesh.clone(),
+            None => self.walker.state.level_mesh(&self.header.grid),
+        }
+    }
+}

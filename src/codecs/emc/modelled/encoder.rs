@@ -1,0 +1,134 @@
+//! The modelled coder's encoder: the walker's questions answered from the key trie and the
+//! mesh's edges ([`Clusters`]), each answer arithmetic-coded under the walker's context.
+
+use super::walk::{Question, Side, Stop, Walker};
+use crate::codecs::emc::clusters::{Clusters, SplitPlan};
+use crate::codecs::emc::state::{face_corrections, EdgeCode, EmcState};
+use crate::codecs::emc::EmcParams;
+use crate::codecs::{Encoded, LevelRecord};
+use crate::coding::arith::{ArithEncoder, BitContext, UintContext};
+use crate::coding::{BitLedger, SyntaxClass};
+use crate::container::{Header, StreamWriter};
+use crate::hierarchy::octree::KeyTrie;
+use crate::mesh::CanonicalMesh;
+use std::collections::BTreeMap;
+
+struct EncoderSide {
+    coder: ArithEncoder,
+    clusters: Clusters,
+    plan: SplitPlan,
+}
+
+impl Side for EncoderSide {
+    fn code(
+        &mut self,
+        context: &mut BitContext,
+        question: Question,
+        flip: bool,
+        v: usize,
+        step: usize,
+    ) -> Result<bool, Stop> {
+        let answer = match question {
+            Question::Split => self.clusters.next_split(v) == Some(step),
+            Question::Half => self.clusters.bit(v, step) == 1,
+            Question::Connecting => self.plan.connecting,
+            Question::Duplicate(i) => self.plan.codes[i] == EdgeCode::Duplicate,
+            Question::Moves(i) => self.plan.codes[i] == EdgeCode::Move,
+            Question::Leaf(0) => self.plan.lower.len() == 1,
+            Question::Leaf(_) => self.plan.upper.len() == 1,
+        };
+        self.coder
+            .bit(context, answer ^ flip, question.class(), question.field());
+        Ok(answer)
+    }
+
+    fn begin_split(&mut self, state: &EmcState, v: usize, step: usize) {
+        self.clusters.plan(state, v, step, &mut self.plan);
+    }
+
+    fn end_split(&mut self, v: usize, _r: usize) {
+        self.clusters.commit(v, &self.plan);
+    }
+}
+
+/// Writes an ascending list of clique positions: its length, then the gaps.
+pub fn put_list(
+    coder: &mut ArithEncoder,
+    context: &mut UintContext,
+    list: &[u32],
+    field: &'static str,
+) {
+    coder.uint(context, list.len() as u64, SyntaxClass::Connectivity, field);
+    let mut next = 0u64;
+    for &x in list {
+        coder.uint(context, x as u64 - next, SyntaxClass::Connectivity, field);
+        next = x as u64 + 1;
+    }
+}
+
+pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encoded {
+    let order = params.order;
+    let n = mesh.vertex_count() as u64;
+    let mut walker = Walker::new(order, n);
+    let mut side = EncoderSide {
+        coder: ArithEncoder::default(),
+        clusters: Clusters::new(mesh, KeyTrie::new(order, &mesh.cells)),
+        plan: SplitPlan::default(),
+    };
+    let mut writer = StreamWriter::new(&header);
+    let mut stats: BTreeMap<String, f64> = BTreeMap::new();
+    let mut ledger = BitLedger::default();
+    let mut records = Vec::with_capacity(order.levels as usize);
+    for level in 1..=order.levels as usize {
+        for step in 3 * (level - 1)..3 * level {
+            walker
+                .pass(&mut side, step, n, mesh.face_count() as u64)
+                .expect("the encoder's answers agree with the header");
+        }
+        let mut coder = std::mem::take(&mut side.coder);
+        if level == order.levels as usize {
+            let corrections =
+                face_corrections(mesh, &walker.state, &side.clusters.ranges, &side.clusters.trie);
+            let lists = [
+                (&corrections.false_triangles, "false_triangles"),
+                (&corrections.double_sided, "double_sided"),
+                (&corrections.orientation_exceptions, "orientation_exceptions"),
+            ];
+            for (i, (list, field)) in lists.into_iter().enumerate() {
+                put_list(&mut coder, &mut walker.contexts.corrections[i], list, field);
+                *stats.entry(field.to_string()).or_default() += list.len() as f64;
+            }
+        }
+        for (field, bits) in &coder.field_bits {
+            *stats.entry(format!("{field}_bits")).or_default() += bits;
+        }
+        let (payload, level_ledger) = coder.finish();
+        writer.push_level(&payload);
+        ledger.connectivity += level_ledger.connectivity;
+        ledger.geometry += level_ledger.geometry;
+        records.push((ledger, walker.state.len()));
+    }
+    stats.insert("leaves".into(), walker.leaf.iter().filter(|&&l| l).count() as f64);
+    let (bytes, ends) = writer.finish();
+    let levels = records
+        .into_iter()
+        .zip(ends)
+        .enumerate()
+        .map(|(i, ((ledger, vertices), end_byte))| LevelRecord {
+            end_byte,
+            connectivity_bits: ledger.connectivity,
+            geometry_bits: ledger.geometry,
+            vertices,
+            triangles: if i + 1 == order.levels as usize {
+                mesh.face_count()
+            } else {
+                0
+            },
+        })
+        .collect();
+    Encoded {
+        bytes,
+        levels,
+        stats,
+    }
+}

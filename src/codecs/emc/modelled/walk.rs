@@ -1,0 +1,269 @@
+//! The passes of the modelled coder, written once for both sides: a [`Side`] answers each binary
+//! question (the encoder from the mesh, the decoder from the stream) and the [`Walker`] applies
+//! the answers to the shared state, choosing every question's context from what the decoder
+//! already knows.
+
+use super::contexts::{self, Contexts};
+use crate::codecs::emc::state::{EdgeCode, EmcState, NO_SPLIT};
+use crate::hierarchy::octree::StepOrder;
+
+/// A question the walker asks about vertex `v` at the current step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Question {
+    /// Does the (multi-vertex) cluster split now?
+    Split,
+    /// Which half does it take: 1 = upper.
+    Half,
+    /// Do the two halves share an edge?
+    Connecting,
+    /// Is the edge to the i-th neighbour duplicated?
+    Duplicate(usize),
+    /// Does the edge to the i-th neighbour move to the upper half (MOVE) or stay (STAY)?
+    Moves(usize),
+    /// Is the lower (0) or upper (1) half a single vertex?
+    Leaf(usize),
+}
+
+impl Question {
+    /// Name in the bit statistics.
+    pub fn field(self) -> &'static str {
+        match self {
+            Question::Split => "split",
+            Question::Half => "half",
+            Question::Connecting => "connecting",
+            Question::Duplicate(_) => "edge_duplicate",
+            Question::Moves(_) => "edge_moves",
+            Question::Leaf(_) => "leaf",
+        }
+    }
+
+    /// Positions (which cells are occupied, and where) or connectivity.
+    pub fn class(self) -> crate::coding::SyntaxClass {
+        use crate::coding::SyntaxClass::{Connectivity, Geometry};
+        match self {
+            Question::Split | Question::Half | Question::Leaf(_) => Geometry,
+            Question::Connecting | Question::Duplicate(_) | Question::Moves(_) => Connectivity,
+        }
+    }
+}
+
+/// Why a pass stopped early.
+#[derive(Debug)]
+pub enum Stop {
+    /// The level's bits ran out.
+    OutOfBits,
+    /// The stream contradicts itself or the header.
+    Fault(String),
+}
+
+/// One side of the coder.
+pub trait Side {
+    /// Codes (encoder) or reads (decoder) the answer to `question` about `v`, under `context`.
+    /// The bit coded is the answer XOR `flip`, so that 1 always means "as predicted".
+    fn code(
+        &mut self,
+        context: &mut crate::coding::arith::BitContext,
+        question: Question,
+        flip: bool,
+        v: usize,
+        step: usize,
+    ) -> Result<bool, Stop>;
+
+    /// Called when `v` is about to split at `step`, before its connectivity is coded.
+    fn begin_split(&mut self, _state: &EmcState, _v: usize, _step: usize) {}
+
+    /// Called after `v` split into `v` (lower half) and `r` (upper half).
+    fn end_split(&mut self, _v: usize, _r: usize) {}
+}
+
+/// The state both sides keep, with the modelled coder's extra knowledge of each vertex.
+pub struct Walker {
+    /// Cells, depths and edges (shared with the paper's coder).
+    pub state: EmcState,
+    /// Known to be a single mesh vertex (no further split).
+    pub leaf: Vec<bool>,
+    /// Steps since the vertex was created by a split (capped).
+    pub age: Vec<u8>,
+    /// Edges of the graph now (the decoder bounds it by the header's triangles).
+    pub edges: u64,
+    pub contexts: Box<Contexts>,
+    /// For each depth, the shift from the cell prefix to the full grid per axis.
+    shifts: Vec<[u8; 3]>,
+    codes: Vec<EdgeCode>,
+}
+
+/// Most edges a stream may build: every edge of a triangle mesh lies on a face.
+fn edge_limit(triangles: u64) -> u64 {
+    triangles.saturating_mul(3)
+}
+
+impl Walker {
+    pub fn new(order: StepOrder, vertices: u64) -> Walker {
+        let shifts = (0..=order.steps())
+            .map(|d| order.bits_per_axis(d).map(|b| order.levels - b))
+            .collect();
+        Walker {
+            state: EmcState::new(order, vertices),
+            leaf: vec![vertices <= 1],
+            age: vec![0],
+            edges: 0,
+            contexts: Box::default(),
+            shifts,
+            codes: Vec::new(),
+        }
+    }
+
+    /// Twice the centre of `v`'s cell along `axis`, in units of the full grid.
+    fn centre2(&self, v: usize, axis: usize) -> i64 {
+        let shift = self.shifts[self.state.depth[v] as usize][axis];
+        (((self.state.cells[v][axis] as i64) << 1) | 1) << shift
+    }
+
+    /// Half the width of `v`'s cell along `axis`, in the units of [`Self::centre2`].
+    fn half_width2(&self, v: usize, axis: usize) -> i64 {
+        1 << self.shifts[self.state.depth[v] as usize][axis]
+    }
+
+    /// Runs one pass (`step`) over the vertices present at its start. `max_vertices` and
+    /// `max_triangles` are the header's counts, which no stream may exceed.
+    pub fn pass<S: Side>(
+        &mut self,
+        side: &mut S,
+        step: usize,
+        max_vertices: u64,
+        max_triangles: u64,
+    ) -> Result<(), Stop> {
+        let order = self.state.order;
+        let axis = order.axis(step);
+        let remaining = order.levels as usize - order.level(step);
+        let present = self.state.len();
+        for v in 0..present {
+            let valence = self.state.adjacency[v].len();
+            let splits = !self.leaf[v] && {
+                let c = contexts::split(self.age[v], valence, remaining);
+                side.code(&mut self.contexts.split[c], Question::Split, false, v, step)?
+            };
+            self.age[v] = self.age[v].saturating_add(1);
+            if !splits {
+                let (c, flip) = self.half_context(v, axis);
+                let bit = side.code(&mut self.contexts.half[c], Question::Half, flip, v, step)?;
+                self.state.refine(v, step, bit as u32);
+                continue;
+            }
+            if self.state.len() as u64 >= max_vertices {
+                return Err(Stop::Fault(format!(
+                    "more splits than the {max_vertices} vertices the header declares"
+                )));
+            }
+            self.split(side, v, step, axis, remaining, max_triangles)?;
+        }
+        Ok(())
+    }
+
+    /// Context and flip of the half `v` takes: where its neighbours' mean lies relative to the
+    /// split plane, and how widely they spread, both in half-widths of the cell.
+    fn half_context(&self, v: usize, axis: usize) -> (usize, bool) {
+        let neighbours = &self.state.adjacency[v];
+        if neighbours.is_empty() {
+            return (contexts::half_isolated(self.leaf[v]), false);
+        }
+        let mid = self.centre2(v, axis);
+        let (mut sum, mut sum_sq) = (0f64, 0f64);
+        for &n in neighbours {
+            let d = (self.centre2(n as usize, axis) - mid) as f64;
+            sum += d;
+            sum_sq += d * d;
+        }
+        let k = neighbours.len() as f64;
+        let w = self.half_width2(v, axis) as f64;
+        let mean = sum / k;
+        let variance = (sum_sq / k - mean * mean).max(0.0);
+        (
+            contexts::half(self.leaf[v], mean.abs() / w, variance / (w * w)),
+            mean < 0.0,
+        )
+    }
+
+    fn split<S: Side>(
+        &mut self,
+        side: &mut S,
+        v: usize,
+        step: usize,
+        axis: usize,
+        remaining: usize,
+        max_triangles: u64,
+    ) -> Result<(), Stop> {
+        side.begin_split(&self.state, v, step);
+        let valence = self.state.adjacency[v].len();
+        let c = contexts::connecting(valence, remaining);
+        let connecting = side.code(
+            &mut self.contexts.connecting[c],
+            Question::Connecting,
+            false,
+            v,
+            step,
+        )?;
+        let mid = self.centre2(v, axis);
+        let w = self.half_width2(v, axis) as f64;
+        let centre = [0, 1, 2].map(|a| self.centre2(v, a));
+        let mut codes = std::mem::take(&mut self.codes);
+        codes.clear();
+        let mut duplicates = 0;
+        for i in 0..valence {
+            let n = self.state.adjacency[v][i] as usize;
+            let along = (self.centre2(n, axis) - mid) as f64 / w;
+            let mut across = 0f64;
+            for a in (0..3).filter(|&a| a != axis) {
+                across = across.max((self.centre2(n, a) - centre[a]).abs() as f64 / w);
+            }
+            let place = contexts::edge_place(along.abs(), across, self.leaf[n]);
+            let c = contexts::duplicate(place, duplicates);
+            let code = if side.code(
+                &mut self.contexts.duplicate[c],
+                Question::Duplicate(i),
+                false,
+                v,
+                step,
+            )? {
+                duplicates += 1;
+                EdgeCode::Duplicate
+            } else if side.code(
+                &mut self.contexts.moves[place],
+                Question::Moves(i),
+                along < 0.0,
+                v,
+                step,
+            )? {
+                EdgeCode::Move
+            } else {
+                EdgeCode::Stay
+            };
+            codes.push(code);
+        }
+        self.edges += duplicates as u64 + connecting as u64;
+        if self.edges > edge_limit(max_triangles) {
+            return Err(Stop::Fault(format!(
+                "more edges than the {max_triangles} triangles the header declares can have"
+            )));
+        }
+        let r = self
+            .state
+            .split(v, step, connecting, &codes, [NO_SPLIT, NO_SPLIT]);
+        self.codes = codes;
+        self.leaf.push(false);
+        self.age.push(0);
+        self.age[v] = 0;
+        for (half, vertex) in [(0, v), (1, r)] {
+            let c = contexts::leaf(half, self.state.adjacency[vertex].len(), remaining);
+            self.leaf[vertex] = side.code(
+                &mut self.contexts.leaf[c],
+                Question::Leaf(half),
+                false,
+                vertex,
+                step,
+            )?;
+        }
+        side.end_split(v, r);
+        Ok(())
+    }
+}

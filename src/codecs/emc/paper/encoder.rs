@@ -1,0 +1,168 @@
+//! EMC encoder. The paper builds a list of merges bottom-up and writes it reversed; the same
+//! splits fall out directly of the key trie (`hierarchy::octree`): a cluster is a range of
+//! key-sorted vertices and splits where its first and last keys differ. So the encoder runs the
+//! decoder's top-down passes, reading each decision off the trie and the original edges, and
+//! updates the shared [`EmcState`] exactly as the decoder will.
+
+use super::super::state::{face_corrections, EmcState, NO_SPLIT};
+use super::super::clusters::{Clusters, SplitPlan};
+use super::syntax::{self, EdgeCode};
+use super::super::EmcParams;
+use crate::codecs::{Encoded, LevelRecord};
+use crate::coding::{BitLedger, BitSink, SyntaxClass};
+use crate::container::{Header, StreamWriter};
+use crate::hierarchy::octree::KeyTrie;
+use crate::mesh::CanonicalMesh;
+use std::collections::BTreeMap;
+
+/// Bits and counts per syntax element, for the paper's table. The per-operation counters are
+/// plain fields (the encoder's inner loop touches them); the rest are named once.
+#[derive(Default)]
+struct Tally {
+    counts: BTreeMap<String, f64>,
+    refinement_bits: u64,
+    connecting_flag_bits: u64,
+    edge_code_bits: u64,
+    edge_codes: [u64; 3],
+    split_distance_bits: u64,
+    distances: Vec<u64>,
+    splits: u64,
+}
+
+impl Tally {
+    fn add(&mut self, key: &str, value: f64) {
+        *self.counts.entry(key.to_string()).or_default() += value;
+    }
+
+    fn into_counts(mut self) -> BTreeMap<String, f64> {
+        let fields = [
+            ("refinement_bits", self.refinement_bits),
+            ("connecting_flag_bits", self.connecting_flag_bits),
+            ("edge_code_bits", self.edge_code_bits),
+            ("split_distance_bits", self.split_distance_bits),
+            ("splits", self.splits),
+            ("edge_stay", self.edge_codes[EdgeCode::Stay as usize]),
+            ("edge_move", self.edge_codes[EdgeCode::Move as usize]),
+            (
+                "edge_duplicate",
+                self.edge_codes[EdgeCode::Duplicate as usize],
+            ),
+        ];
+        for (key, value) in fields {
+            self.add(key, value as f64);
+        }
+        let distances = std::mem::take(&mut self.distances);
+        for (d, &n) in distances.iter().enumerate().filter(|(_, &n)| n > 0) {
+            let key = if d == 0 {
+                "distance_none".to_string()
+            } else {
+                format!("distance_{d}")
+            };
+            self.add(&key, n as f64);
+        }
+        self.counts
+    }
+}
+
+pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encoded {
+    let order = params.order;
+    let n = mesh.vertex_count();
+    let mut clusters = Clusters::new(mesh, KeyTrie::new(order, &mesh.cells));
+    let mut plan = SplitPlan::default();
+    let mut state = EmcState::new(order, n as u64);
+    let mut tally = Tally {
+        distances: vec![0; syntax::MAX_DISTANCE + 1],
+        ..Tally::default()
+    };
+    let mut writer = StreamWriter::new(&header);
+    let mut header_bytes = Vec::new();
+    header.write(&mut header_bytes);
+    tally.add("header_bytes", header_bytes.len() as f64);
+    let mut levels = Vec::with_capacity(order.levels as usize);
+    let mut total = BitLedger::default();
+
+    for level in 1..=order.levels as usize {
+        let mut sink = BitSink::default();
+        for step in 3 * (level - 1)..3 * level {
+            let present = state.len();
+            for v in 0..present {
+                if state.next_split[v] as usize != step {
+                    let bit = clusters.bit(v, step);
+                    sink.put(SyntaxClass::Geometry, 1, bit);
+                    tally.refinement_bits += 1;
+                    state.refine(v, step, bit);
+                    continue;
+                }
+                clusters.plan(&state, v, step, &mut plan);
+                sink.put(SyntaxClass::Connectivity, 1, plan.connecting as u32);
+                tally.connecting_flag_bits += 1;
+                for &code in &plan.codes {
+                    syntax::put_edge(&mut sink, code);
+                    tally.edge_code_bits += syntax::edge_bits(code);
+                    tally.edge_codes[code as usize] += 1;
+                }
+                let next = [
+                    clusters.trie.next_split(plan.lower.clone()),
+                    clusters.trie.next_split(plan.upper.clone()),
+                ];
+                for next_step in next {
+                    let bits = syntax::put_distance(&mut sink, step, next_step);
+                    tally.split_distance_bits += bits;
+                    tally.distances[next_step.map_or(0, |s| s - step)] += 1;
+                }
+                tally.splits += 1;
+                let next = next.map(|s| s.map_or(NO_SPLIT, |s| s as u16));
+                state.split(v, step, plan.connecting, &plan.codes, next);
+                clusters.commit(v, &plan);
+            }
+        }
+        if level == order.levels as usize {
+            let corrections = face_corrections(mesh, &state, &clusters.ranges, &clusters.trie);
+            tally.add("cliques", state.cliques().len() as f64);
+            tally.add("false_triangles", corrections.false_triangles.len() as f64);
+            tally.add("double_sided_faces", corrections.double_sided.len() as f64);
+            tally.add(
+                "orientation_exceptions",
+                corrections.orientation_exceptions.len() as f64,
+            );
+            let before = sink_total(&sink);
+            syntax::put_list(&mut sink, &corrections.false_triangles);
+            syntax::put_list(&mut sink, &corrections.double_sided);
+            syntax::put_list(&mut sink, &corrections.orientation_exceptions);
+            tally.add("face_correction_bits", (sink_total(&sink) - before) as f64);
+        }
+        let (payload, ledger) = sink.finish();
+        writer.push_level(&payload);
+        total.connectivity += ledger.connectivity;
+        total.geometry += ledger.geometry;
+        levels.push((total, state.len(), 0usize));
+    }
+    let (bytes, ends) = writer.finish();
+    let final_triangles = mesh.face_count();
+    let levels = levels
+        .into_iter()
+        .zip(ends)
+        .enumerate()
+        .map(|(i, ((ledger, vertices, _), end_byte))| LevelRecord {
+            end_byte,
+            connectivity_bits: ledger.connectivity,
+            geometry_bits: ledger.geometry,
+            vertices,
+            triangles: if i + 1 == order.levels as usize {
+                final_triangles
+            } else {
+                0
+            },
+        })
+        .collect();
+    Encoded {
+        bytes,
+        levels,
+        stats: tally.into_counts(),
+    }
+}
+
+fn sink_total(sink: &BitSink) -> u64 {
+    sink.ledger().total()
+}
+
