@@ -23,20 +23,29 @@ const RATE: u32 = 5;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BitContext {
     p1: u32,
+    /// Symbols seen, up to the count where the rate settles.
+    seen: u32,
 }
 
 impl Default for BitContext {
     fn default() -> Self {
-        BitContext { p1: ONE / 2 }
+        BitContext {
+            p1: ONE / 2,
+            seen: 0,
+        }
     }
 }
 
 impl BitContext {
     fn update(&mut self, bit: bool) {
+        // A fresh context learns fast (rate 1/2, 1/3, …, as a frequency count would) and settles
+        // at 1/2^RATE, which follows drifting statistics.
+        let rate = self.seen.min(RATE) + 1;
+        self.seen += (self.seen < RATE) as u32;
         if bit {
-            self.p1 += (ONE - self.p1) >> RATE;
+            self.p1 += (ONE - self.p1) >> rate;
         } else {
-            self.p1 -= self.p1 >> RATE;
+            self.p1 -= self.p1 >> rate;
         }
         self.p1 = self.p1.clamp(32, ONE - 32);
     }

@@ -36,9 +36,9 @@ pub struct Contexts {
     pub split: [BitContext; 4 * VALENCES * REMAINING],
     pub half: [BitContext; HALF_CONTEXTS],
     pub connecting: [BitContext; VALENCES * REMAINING],
-    pub duplicate: [BitContext; EDGE_PLACES * 3],
-    pub moves: [BitContext; EDGE_PLACES],
-    pub leaf: [BitContext; 2 * VALENCES * REMAINING],
+    pub duplicate: [BitContext; EDGE_PLACES * 8 * 3],
+    pub moves: [BitContext; EDGE_PLACES * 8],
+    pub leaf: [BitContext; 3 * VALENCES * REMAINING],
     /// Lengths and gaps of the three face-correction lists.
     pub corrections: [UintContext; 3],
 }
@@ -49,9 +49,9 @@ impl Default for Contexts {
             split: [BitContext::default(); 4 * VALENCES * REMAINING],
             half: [BitContext::default(); HALF_CONTEXTS],
             connecting: [BitContext::default(); VALENCES * REMAINING],
-            duplicate: [BitContext::default(); EDGE_PLACES * 3],
-            moves: [BitContext::default(); EDGE_PLACES],
-            leaf: [BitContext::default(); 2 * VALENCES * REMAINING],
+            duplicate: [BitContext::default(); EDGE_PLACES * 8 * 3],
+            moves: [BitContext::default(); EDGE_PLACES * 8],
+            leaf: [BitContext::default(); 3 * VALENCES * REMAINING],
             corrections: Default::default(),
         }
     }
@@ -99,11 +99,23 @@ pub fn edge_place(along: f64, across: f64, leaf: bool) -> usize {
 }
 
 /// Is the edge duplicated: by the neighbour's place and the duplicates so far in this split.
-pub fn duplicate(place: usize, duplicates_so_far: usize) -> usize {
-    place * 3 + duplicates_so_far.min(2)
+pub fn duplicate(place: usize, ring: usize, duplicates_so_far: usize) -> usize {
+    (place * 8 + ring) * 3 + duplicates_so_far.min(2)
 }
 
-/// Is a half a single vertex: by which half, its valence after the split and the levels left.
-pub fn leaf(half: usize, valence: usize, remaining: usize) -> usize {
-    ((half * VALENCES) + valence.min(VALENCES - 1)) * REMAINING + remaining.min(REMAINING - 1)
+/// Does a (not duplicated) edge move to the upper half: by the neighbour's place and what its
+/// coded ring neighbours did, seen from the neighbour's side of the plane (`flip`: below it).
+pub fn moves(place: usize, ring: usize, flip: bool) -> usize {
+    let ring = if flip {
+        // Swap "stayed" and "moved" so that both read as "went to my side" / "the other".
+        (ring & 4) | ((ring & 1) << 1) | ((ring & 2) >> 1)
+    } else {
+        ring
+    };
+    place * 8 + ring
+}
+
+/// Is a half a single vertex: by which half (and for the upper, the lower's answer), its valence after the split and the levels left.
+pub fn leaf(kind: usize, valence: usize, remaining: usize) -> usize {
+    ((kind * VALENCES) + valence.min(VALENCES - 1)) * REMAINING + remaining.min(REMAINING - 1)
 }

@@ -76,6 +76,9 @@ pub trait Side {
     fn end_split(&mut self, _v: usize, _r: usize) {}
 }
 
+/// Steepest regression plane used for prediction (squared gradient).
+const SLOPE: f64 = 1.5;
+
 /// The state both sides keep, with the modelled coder's extra knowledge of each vertex.
 pub struct Walker {
     /// Cells, depths and edges (shared with the paper's coder).
@@ -160,28 +163,92 @@ impl Walker {
         Ok(())
     }
 
-    /// Context and flip of the half `v` takes: where its neighbours' mean lies relative to the
-    /// split plane, and how widely they spread, both in half-widths of the cell.
+    /// Context and flip of the half `v` takes. The prediction is the neighbours' regression
+    /// plane (the coordinate along the axis as a linear function of the other two, evaluated at
+    /// the vertex's own cell centre) where the neighbours span the other two axes, else their
+    /// mean; the context is its distance from the split plane and the expected error (the
+    /// neighbours' residual spread plus what the vertex's own cell leaves open), both in
+    /// half-widths of the cell.
     fn half_context(&self, v: usize, axis: usize) -> (usize, bool) {
         let neighbours = &self.state.adjacency[v];
         if neighbours.is_empty() {
             return (contexts::half_isolated(self.leaf[v]), false);
         }
-        let mid = self.centre2(v, axis);
-        let (mut sum, mut sum_sq) = (0f64, 0f64);
+        let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+        let own = [self.centre2(v, axis), self.centre2(v, b), self.centre2(v, c)];
+        // Sums of the neighbours' offsets from the vertex's centre: a, b, c and their products.
+        let mut s = [0f64; 9];
         for &n in neighbours {
-            let d = (self.centre2(n as usize, axis) - mid) as f64;
-            sum += d;
-            sum_sq += d * d;
+            let n = n as usize;
+            let da = (self.centre2(n, axis) - own[0]) as f64;
+            let db = (self.centre2(n, b) - own[1]) as f64;
+            let dc = (self.centre2(n, c) - own[2]) as f64;
+            s[0] += da;
+            s[1] += db;
+            s[2] += dc;
+            s[3] += da * da;
+            s[4] += db * db;
+            s[5] += dc * dc;
+            s[6] += db * dc;
+            s[7] += da * db;
+            s[8] += da * dc;
         }
         let k = neighbours.len() as f64;
+        let mean = [s[0] / k, s[1] / k, s[2] / k];
+        let var_a = (s[3] / k - mean[0] * mean[0]).max(0.0);
+        let (cbb, ccc) = (s[4] / k - mean[1] * mean[1], s[5] / k - mean[2] * mean[2]);
+        let cbc = s[6] / k - mean[1] * mean[2];
+        let (cab, cac) = (s[7] / k - mean[0] * mean[1], s[8] / k - mean[0] * mean[2]);
+        let det = cbb * ccc - cbc * cbc;
         let w = self.half_width2(v, axis) as f64;
-        let mean = sum / k;
-        let variance = (sum_sq / k - mean * mean).max(0.0);
+        let plane = (neighbours.len() >= 4 && det > 1e-2 * (cbb + ccc) * (cbb + ccc)).then(|| {
+            ((cab * ccc - cac * cbc) / det, (cac * cbb - cab * cbc) / det)
+        });
+        let (prediction, variance) = if let Some((beta_b, beta_c)) =
+            plane.filter(|&(beta_b, beta_c)| beta_b * beta_b + beta_c * beta_c <= SLOPE)
+        {
+            let residual = (var_a - beta_b * cab - beta_c * cac).max(0.0);
+            // The vertex's own place across the axis: the neighbours' mean, kept inside its cell.
+            let (wb, wc) = (self.half_width2(v, b) as f64, self.half_width2(v, c) as f64);
+            let (eb, ec) = (mean[1].clamp(-wb, wb), mean[2].clamp(-wc, wc));
+            let own_cell = beta_b * beta_b * (wb * wb / 3.0).min(cbb)
+                + beta_c * beta_c * (wc * wc / 3.0).min(ccc);
+            (
+                mean[0] + beta_b * (eb - mean[1]) + beta_c * (ec - mean[2]),
+                residual + own_cell,
+            )
+        } else {
+            (mean[0], var_a)
+        };
         (
-            contexts::half(self.leaf[v], mean.abs() / w, variance / (w * w)),
-            mean < 0.0,
+            contexts::half(self.leaf[v], prediction.abs() / w, variance / (w * w)),
+            prediction < 0.0,
         )
+    }
+
+    /// What the already coded neighbours of `v` that are also neighbours of `n` (the `i`-th
+    /// neighbour) did: bit 0 some stayed, bit 1 some moved, bit 2 some were duplicated. Around a
+    /// manifold vertex the duplicated edges are where the stayed arc meets the moved one.
+    fn coded_ring(&self, v: usize, i: usize, n: usize, codes: &[EdgeCode]) -> usize {
+        let coded = &self.state.adjacency[v][..i];
+        let around = &self.state.adjacency[n];
+        let (mut x, mut y, mut seen) = (0, 0, 0);
+        while x < coded.len() && y < around.len() {
+            match coded[x].cmp(&around[y]) {
+                std::cmp::Ordering::Less => x += 1,
+                std::cmp::Ordering::Greater => y += 1,
+                std::cmp::Ordering::Equal => {
+                    seen |= match codes[x] {
+                        EdgeCode::Stay => 1,
+                        EdgeCode::Move => 2,
+                        EdgeCode::Duplicate => 4,
+                    };
+                    x += 1;
+                    y += 1;
+                }
+            }
+        }
+        seen
     }
 
     fn split<S: Side>(
@@ -217,7 +284,8 @@ impl Walker {
                 across = across.max((self.centre2(n, a) - centre[a]).abs() as f64 / w);
             }
             let place = contexts::edge_place(along.abs(), across, self.leaf[n]);
-            let c = contexts::duplicate(place, duplicates);
+            let ring = self.coded_ring(v, i, n, &codes);
+            let c = contexts::duplicate(place, ring, duplicates);
             let code = if side.code(
                 &mut self.contexts.duplicate[c],
                 Question::Duplicate(i),
@@ -228,7 +296,7 @@ impl Walker {
                 duplicates += 1;
                 EdgeCode::Duplicate
             } else if side.code(
-                &mut self.contexts.moves[place],
+                &mut self.contexts.moves[contexts::moves(place, ring, along < 0.0)],
                 Question::Moves(i),
                 along < 0.0,
                 v,
@@ -254,7 +322,10 @@ impl Walker {
         self.age.push(0);
         self.age[v] = 0;
         for (half, vertex) in [(0, v), (1, r)] {
-            let c = contexts::leaf(half, self.state.adjacency[vertex].len(), remaining);
+            let valence = self.state.adjacency[vertex].len();
+            // The upper half's question knows the lower half's answer.
+            let kind = if half == 0 { 0 } else { 1 + self.leaf[v] as usize };
+            let c = contexts::leaf(kind, valence, remaining);
             self.leaf[vertex] = side.code(
                 &mut self.contexts.leaf[c],
                 Question::Leaf(half),
