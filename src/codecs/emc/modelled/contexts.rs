@@ -33,7 +33,7 @@ pub const EDGE_PLACES: usize = 2 * (EDGE_ALONG.len() + 1) * (EDGE_ACROSS.len() +
 /// Every context of the coder, in their initial state.
 #[derive(Clone)]
 pub struct Contexts {
-    pub split: [BitContext; 4 * VALENCES * REMAINING],
+    pub split: [BitContext; (OFFSETS + 1) * VALENCES * REMAINING],
     pub half: [BitContext; HALF_CONTEXTS],
     pub connecting: [BitContext; VALENCES * REMAINING],
     pub duplicate: [BitContext; EDGE_PLACES * 8 * 3],
@@ -46,7 +46,7 @@ pub struct Contexts {
 impl Default for Contexts {
     fn default() -> Self {
         Contexts {
-            split: [BitContext::default(); 4 * VALENCES * REMAINING],
+            split: [BitContext::default(); (OFFSETS + 1) * VALENCES * REMAINING],
             half: [BitContext::default(); HALF_CONTEXTS],
             connecting: [BitContext::default(); VALENCES * REMAINING],
             duplicate: [BitContext::default(); EDGE_PLACES * 8 * 3],
@@ -57,27 +57,46 @@ impl Default for Contexts {
     }
 }
 
-/// Does a cluster split now: by steps since it was made, its valence (a bigger cluster has
-/// more neighbours) and the levels left.
-pub fn split(age: u8, valence: usize, remaining: usize) -> usize {
-    ((age.min(3) as usize * VALENCES) + valence.min(VALENCES - 1)) * REMAINING
+/// Does a cluster split now: by how close its neighbours' predicted place is to the split plane
+/// (a cluster straddles the plane where its surface crosses it), its valence (a bigger cluster
+/// has more neighbours) and the levels left.
+pub fn split(offset: usize, valence: usize, remaining: usize) -> usize {
+    ((offset * VALENCES) + valence.min(VALENCES - 1)) * REMAINING
         + remaining.min(REMAINING - 1)
 }
 
+/// The context of a "which half" question and the bins it is made of.
+#[derive(Clone, Copy, Debug)]
+pub struct HalfContext {
+    /// Index into [`Contexts::half`].
+    pub index: usize,
+    /// Bin of the prediction's distance from the split plane (`OFFSETS` without neighbours).
+    pub offset: usize,
+}
+
+/// Offset bins, and one for "no neighbours".
+pub const OFFSETS: usize = HALF_OFFSET.len() + 1;
+
 /// Which half, for a vertex with no neighbours.
-pub fn half_isolated(leaf: bool) -> usize {
-    HALF_CONTEXTS - 2 + leaf as usize
+pub fn half_isolated(leaf: bool) -> HalfContext {
+    HalfContext {
+        index: HALF_CONTEXTS - 2 + leaf as usize,
+        offset: OFFSETS,
+    }
 }
 
 /// Which half: by the neighbours' mean offset and variance (both relative to the half-width,
 /// the variance to its square).
-pub fn half(leaf: bool, offset: f64, variance: f64) -> usize {
+pub fn half(leaf: bool, offset: f64, variance: f64) -> HalfContext {
     let o = bin(offset, &HALF_OFFSET);
     let s = HALF_SPREAD
         .iter()
         .position(|&t| variance < t * t)
         .unwrap_or(HALF_SPREAD.len());
-    ((leaf as usize * (HALF_OFFSET.len() + 1)) + o) * (HALF_SPREAD.len() + 1) + s
+    HalfContext {
+        index: ((leaf as usize * OFFSETS) + o) * (HALF_SPREAD.len() + 1) + s,
+        offset: o,
+    }
 }
 
 /// Is there an edge between the two halves.

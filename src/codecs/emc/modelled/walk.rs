@@ -85,8 +85,6 @@ pub struct Walker {
     pub state: EmcState,
     /// Known to be a single mesh vertex (no further split).
     pub leaf: Vec<bool>,
-    /// Steps since the vertex was created by a split (capped).
-    pub age: Vec<u8>,
     /// Edges of the graph now (the decoder bounds it by the header's triangles).
     pub edges: u64,
     pub contexts: Box<Contexts>,
@@ -108,7 +106,6 @@ impl Walker {
         Walker {
             state: EmcState::new(order, vertices),
             leaf: vec![vertices <= 1],
-            age: vec![0],
             edges: 0,
             contexts: Box::default(),
             shifts,
@@ -142,13 +139,13 @@ impl Walker {
         let present = self.state.len();
         for v in 0..present {
             let valence = self.state.adjacency[v].len();
+            let (half, flip) = self.half_context(v, axis);
             let splits = !self.leaf[v] && {
-                let c = contexts::split(self.age[v], valence, remaining);
+                let c = contexts::split(half.offset, valence, remaining);
                 side.code(&mut self.contexts.split[c], Question::Split, false, v, step)?
             };
-            self.age[v] = self.age[v].saturating_add(1);
             if !splits {
-                let (c, flip) = self.half_context(v, axis);
+                let c = half.index;
                 let bit = side.code(&mut self.contexts.half[c], Question::Half, flip, v, step)?;
                 self.state.refine(v, step, bit as u32);
                 continue;
@@ -169,7 +166,7 @@ impl Walker {
     /// mean; the context is its distance from the split plane and the expected error (the
     /// neighbours' residual spread plus what the vertex's own cell leaves open), both in
     /// half-widths of the cell.
-    fn half_context(&self, v: usize, axis: usize) -> (usize, bool) {
+    fn half_context(&self, v: usize, axis: usize) -> (contexts::HalfContext, bool) {
         let neighbours = &self.state.adjacency[v];
         if neighbours.is_empty() {
             return (contexts::half_isolated(self.leaf[v]), false);
@@ -319,8 +316,6 @@ impl Walker {
             .split(v, step, connecting, &codes, [NO_SPLIT, NO_SPLIT]);
         self.codes = codes;
         self.leaf.push(false);
-        self.age.push(0);
-        self.age[v] = 0;
         for (half, vertex) in [(0, v), (1, r)] {
             let valence = self.state.adjacency[vertex].len();
             // The upper half's question knows the lower half's answer.
