@@ -16,14 +16,19 @@ use std::num::NonZeroU32;
 /// Probability precision in bits.
 pub const PRECISION: usize = 16;
 const ONE: u32 = 1 << PRECISION;
-/// Adaptation speed: each symbol moves the probability 1/2^RATE of the way.
-const RATE: u32 = 5;
+/// Adaptation speeds of the two estimates a context mixes: each symbol moves the fast one
+/// 1/2^FAST_RATE of the way, the slow one 1/2^SLOW_RATE.
+const FAST_RATE: u32 = 4;
+const SLOW_RATE: u32 = 7;
 
-/// An adaptive probability that the next bit is 1.
+/// An adaptive probability that the next bit is 1: the mean of a fast estimate (follows drifting
+/// statistics) and a slow one (precise where they hold still).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BitContext {
     p1: u32,
-    /// Symbols seen, up to the count where the rate settles.
+    fast: u32,
+    slow: u32,
+    /// Symbols seen, up to the count where the slow rate settles.
     seen: u32,
 }
 
@@ -31,23 +36,29 @@ impl Default for BitContext {
     fn default() -> Self {
         BitContext {
             p1: ONE / 2,
+            fast: ONE / 2,
+            slow: ONE / 2,
             seen: 0,
         }
     }
 }
 
+fn adapt(p: u32, bit: bool, rate: u32) -> u32 {
+    if bit {
+        p + ((ONE - p) >> rate)
+    } else {
+        p - (p >> rate)
+    }
+}
+
 impl BitContext {
     fn update(&mut self, bit: bool) {
-        // A fresh context learns fast (rate 1/2, 1/3, …, as a frequency count would) and settles
-        // at 1/2^RATE, which follows drifting statistics.
-        let rate = self.seen.min(RATE) + 1;
-        self.seen += (self.seen < RATE) as u32;
-        if bit {
-            self.p1 += (ONE - self.p1) >> rate;
-        } else {
-            self.p1 -= self.p1 >> rate;
-        }
-        self.p1 = self.p1.clamp(32, ONE - 32);
+        // A fresh context learns fast (rates 1/2, 1/4, … as if counting) before settling.
+        let warm = self.seen + 1;
+        self.seen += (self.seen < SLOW_RATE) as u32;
+        self.fast = adapt(self.fast, bit, warm.min(FAST_RATE));
+        self.slow = adapt(self.slow, bit, warm.min(SLOW_RATE));
+        self.p1 = ((self.fast + self.slow) / 2).clamp(32, ONE - 32);
     }
 
     /// Bits an ideal coder spends on `bit` under this context.

@@ -17,9 +17,9 @@ const REMAINING: usize = 8;
 const VALENCES: usize = 16;
 
 /// Distance of the neighbours' mean from the split plane, in half-widths of the cell.
-const HALF_OFFSET: [f64; 6] = [1.0 / 16.0, 1.0 / 8.0, 0.25, 0.5, 1.0, 2.0];
+const HALF_OFFSET: [f64; 10] = [1.0 / 32.0, 1.0 / 16.0, 1.0 / 8.0, 0.1875, 0.25, 0.375, 0.5, 0.75, 1.0, 2.0];
 /// Standard deviation of the neighbours along the axis, in half-widths (compared squared).
-const HALF_SPREAD: [f64; 5] = [0.25, 0.5, 1.0, 2.0, 4.0];
+const HALF_SPREAD: [f64; 7] = [0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
 const HALF_CONTEXTS: usize = 2 * (HALF_OFFSET.len() + 1) * (HALF_SPREAD.len() + 1) + 2;
 
 /// Distance of a neighbour from the split plane, in half-widths of the splitting cell (the two
