@@ -5,13 +5,13 @@
 use crate::codecs::LevelMesh;
 use crate::hierarchy::cliques::{loose_edges, oriented, propagate_orientation, triangles};
 use crate::hierarchy::octree::KeyTrie;
+use crate::hierarchy::octree::StepOrder;
 use crate::mesh::canonical::rotate_to_smallest;
 use crate::mesh::CanonicalMesh;
-use std::collections::HashMap;
-use std::ops::Range;
-use crate::hierarchy::octree::StepOrder;
 use crate::mesh::{Grid, TriMesh};
 use glam::DVec3;
+use std::collections::HashMap;
+use std::ops::Range;
 
 /// What happens to an edge of a splitting vertex.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -23,7 +23,6 @@ pub enum EdgeCode {
     /// Both vertices keep an edge to the neighbour.
     Duplicate,
 }
-
 
 /// "No further split".
 pub const NO_SPLIT: u16 = u16::MAX;

@@ -17,10 +17,22 @@ const REMAINING: usize = 8;
 const VALENCES: usize = 16;
 
 /// Distance of the neighbours' mean from the split plane, in half-widths of the cell.
-const HALF_OFFSET: [f64; 10] = [1.0 / 32.0, 1.0 / 16.0, 1.0 / 8.0, 0.1875, 0.25, 0.375, 0.5, 0.75, 1.0, 2.0];
+const HALF_OFFSET: [f64; 10] = [
+    1.0 / 32.0,
+    1.0 / 16.0,
+    1.0 / 8.0,
+    0.1875,
+    0.25,
+    0.375,
+    0.5,
+    0.75,
+    1.0,
+    2.0,
+];
 /// Standard deviation of the neighbours along the axis, in half-widths (compared squared).
 const HALF_SPREAD: [f64; 7] = [0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
-const HALF_CONTEXTS: usize = 2 * (HALF_OFFSET.len() + 1) * (HALF_SPREAD.len() + 1) + 2;
+const HALF_KINDS: usize = 4;
+const HALF_CONTEXTS: usize = HALF_KINDS * (HALF_OFFSET.len() + 1) * (HALF_SPREAD.len() + 1) + 2;
 
 /// Distance of a neighbour from the split plane, in half-widths of the splitting cell (the two
 /// halves' centres are at ±0.5).
@@ -61,8 +73,7 @@ impl Default for Contexts {
 /// (a cluster straddles the plane where its surface crosses it), its valence (a bigger cluster
 /// has more neighbours) and the levels left.
 pub fn split(offset: usize, valence: usize, remaining: usize) -> usize {
-    ((offset * VALENCES) + valence.min(VALENCES - 1)) * REMAINING
-        + remaining.min(REMAINING - 1)
+    ((offset * VALENCES) + valence.min(VALENCES - 1)) * REMAINING + remaining.min(REMAINING - 1)
 }
 
 /// The context of a "which half" question and the bins it is made of.
@@ -87,14 +98,19 @@ pub fn half_isolated(leaf: bool) -> HalfContext {
 
 /// Which half: by the neighbours' mean offset and variance (both relative to the half-width,
 /// the variance to its square).
-pub fn half(leaf: bool, offset: f64, variance: f64) -> HalfContext {
+pub fn half(leaf: bool, valence: usize, offset: f64, variance: f64) -> HalfContext {
+    let kind = if leaf {
+        1 + (valence >= 5) as usize + (valence >= 7) as usize
+    } else {
+        0
+    };
     let o = bin(offset, &HALF_OFFSET);
     let s = HALF_SPREAD
         .iter()
         .position(|&t| variance < t * t)
         .unwrap_or(HALF_SPREAD.len());
     HalfContext {
-        index: ((leaf as usize * OFFSETS) + o) * (HALF_SPREAD.len() + 1) + s,
+        index: ((kind * OFFSETS) + o) * (HALF_SPREAD.len() + 1) + s,
         offset: o,
     }
 }

@@ -98,7 +98,9 @@ impl<'a> EmcDecoder<'a> {
         match outcome {
             Ok(()) => Ok(true),
             Err(Stop::Fault(what)) => Err(fault(what)),
-            Err(Stop::OutOfBits) => Err(fault("level payload ends before its last question".into())),
+            Err(Stop::OutOfBits) => {
+                Err(fault("level payload ends before its last question".into()))
+            }
         }
     }
 

@@ -37,8 +37,14 @@ impl Side for EncoderSide {
             Question::Leaf(0) => self.plan.lower.len() == 1,
             Question::Leaf(_) => self.plan.upper.len() == 1,
         };
-        const NAMES: [&str; 12] = ["h0","h1","h2","h3","h4","h5","h6","h7","h8","h9","h10","h11"];
-        let field = if question == Question::Half && std::env::var("EMC_DEBUG").is_ok() { NAMES[step / 3] } else { question.field() };
+        const NAMES: [&str; 12] = [
+            "h0", "h1", "h2", "h3", "h4", "h5", "h6", "h7", "h8", "h9", "h10", "h11",
+        ];
+        let field = if question == Question::Half && std::env::var("EMC_DEBUG").is_ok() {
+            NAMES[step / 3]
+        } else {
+            question.field()
+        };
         self.coder
             .bit(context, answer ^ flip, question.class(), field);
         Ok(answer)
@@ -89,12 +95,19 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
         }
         let mut coder = std::mem::take(&mut side.coder);
         if level == order.levels as usize {
-            let corrections =
-                face_corrections(mesh, &walker.state, &side.clusters.ranges, &side.clusters.trie);
+            let corrections = face_corrections(
+                mesh,
+                &walker.state,
+                &side.clusters.ranges,
+                &side.clusters.trie,
+            );
             let lists = [
                 (&corrections.false_triangles, "false_triangles"),
                 (&corrections.double_sided, "double_sided"),
-                (&corrections.orientation_exceptions, "orientation_exceptions"),
+                (
+                    &corrections.orientation_exceptions,
+                    "orientation_exceptions",
+                ),
             ];
             for (i, (list, field)) in lists.into_iter().enumerate() {
                 put_list(&mut coder, &mut walker.contexts.corrections[i], list, field);
@@ -110,7 +123,10 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
         ledger.geometry += level_ledger.geometry;
         records.push((ledger, walker.state.len()));
     }
-    stats.insert("leaves".into(), walker.leaf.iter().filter(|&&l| l).count() as f64);
+    stats.insert(
+        "leaves".into(),
+        walker.leaf.iter().filter(|&&l| l).count() as f64,
+    );
     let (bytes, ends) = writer.finish();
     let levels = records
         .into_iter()

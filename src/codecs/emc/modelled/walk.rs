@@ -172,7 +172,11 @@ impl Walker {
             return (contexts::half_isolated(self.leaf[v]), false);
         }
         let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
-        let own = [self.centre2(v, axis), self.centre2(v, b), self.centre2(v, c)];
+        let own = [
+            self.centre2(v, axis),
+            self.centre2(v, b),
+            self.centre2(v, c),
+        ];
         // Sums of the neighbours' offsets from the vertex's centre: a, b, c and their products.
         let mut s = [0f64; 9];
         for &n in neighbours {
@@ -198,9 +202,8 @@ impl Walker {
         let (cab, cac) = (s[7] / k - mean[0] * mean[1], s[8] / k - mean[0] * mean[2]);
         let det = cbb * ccc - cbc * cbc;
         let w = self.half_width2(v, axis) as f64;
-        let plane = (neighbours.len() >= 4 && det > 1e-2 * (cbb + ccc) * (cbb + ccc)).then(|| {
-            ((cab * ccc - cac * cbc) / det, (cac * cbb - cab * cbc) / det)
-        });
+        let plane = (neighbours.len() >= 4 && det > 1e-2 * (cbb + ccc) * (cbb + ccc))
+            .then(|| ((cab * ccc - cac * cbc) / det, (cac * cbb - cab * cbc) / det));
         let (prediction, variance) = if let Some((beta_b, beta_c)) =
             plane.filter(|&(beta_b, beta_c)| beta_b * beta_b + beta_c * beta_c <= SLOPE)
         {
@@ -218,7 +221,12 @@ impl Walker {
             (mean[0], var_a)
         };
         (
-            contexts::half(self.leaf[v], prediction.abs() / w, variance / (w * w)),
+            contexts::half(
+                self.leaf[v],
+                neighbours.len(),
+                prediction.abs() / w,
+                variance / (w * w),
+            ),
             prediction < 0.0,
         )
     }
@@ -319,7 +327,11 @@ impl Walker {
         for (half, vertex) in [(0, v), (1, r)] {
             let valence = self.state.adjacency[vertex].len();
             // The upper half's question knows the lower half's answer.
-            let kind = if half == 0 { 0 } else { 1 + self.leaf[v] as usize };
+            let kind = if half == 0 {
+                0
+            } else {
+                1 + self.leaf[v] as usize
+            };
             let c = contexts::leaf(kind, valence, remaining);
             self.leaf[vertex] = side.code(
                 &mut self.contexts.leaf[c],

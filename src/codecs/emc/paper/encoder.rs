@@ -4,10 +4,10 @@
 //! decoder's top-down passes, reading each decision off the trie and the original edges, and
 //! updates the shared [`EmcState`] exactly as the decoder will.
 
-use super::super::state::{face_corrections, EmcState, NO_SPLIT};
 use super::super::clusters::{Clusters, SplitPlan};
-use super::syntax::{self, EdgeCode};
+use super::super::state::{face_corrections, EmcState, NO_SPLIT};
 use super::super::EmcParams;
+use super::syntax::{self, EdgeCode};
 use crate::codecs::{Encoded, LevelRecord};
 use crate::coding::{BitLedger, BitSink, SyntaxClass};
 use crate::container::{Header, StreamWriter};
@@ -165,4 +165,3 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
 fn sink_total(sink: &BitSink) -> u64 {
     sink.ledger().total()
 }
-

@@ -36,7 +36,9 @@ pub fn put_edge(sink: &mut BitSink, code: EdgeCode) {
 
 /// Reads an edge code.
 pub fn get_edge(source: &mut BitSource) -> Option<EdgeCode> {
-    edge_code().get(source).map(|s| [EdgeCode::Stay, EdgeCode::Move, EdgeCode::Duplicate][s])
+    edge_code()
+        .get(source)
+        .map(|s| [EdgeCode::Stay, EdgeCode::Move, EdgeCode::Duplicate][s])
 }
 
 /// Bits of an edge code.
