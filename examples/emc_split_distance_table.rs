@@ -1,9 +1,9 @@
 //! Derives EMC's fixed split-distance Huffman table from the distance histogram pooled over a
 //! training set of shared meshes that are *not* in the paper's Table 1 (no bunny, Beethoven or
 //! car), at 24 levels on the cubic grid, and prints the code lengths in the form of
-//! src/codecs/emc/split_distance_lengths.in.
+//! src/codecs/emc/paper/split_distance_lengths.in.
 //!
-//! Run: cargo run --release --example emc_split_distance_table > src/codecs/emc/split_distance_lengths.in
+//! Run: cargo run --release --example emc_split_distance_table > src/codecs/emc/paper/split_distance_lengths.in
 
 use meshcodec::codecs::{self, EncodeOptions};
 use meshcodec::coding::huffman::Huffman;
@@ -26,8 +26,8 @@ const TRAINING: [&str; 12] = [
 ];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let emc = codecs::by_name("emc")?;
-    let mut counts = vec![0u64; codecs::emc::syntax::MAX_DISTANCE + 1];
+    let emc = codecs::by_name("emc-paper")?;
+    let mut counts = vec![0u64; codecs::emc::paper::syntax::MAX_DISTANCE + 1];
     for name in TRAINING {
         let mesh = read_mesh(&resolve(name)?)?;
         for grid in [GridShape::Cubic, GridShape::PerAxis] {

@@ -18,7 +18,7 @@ fn main() {
         x ^= x << 17;
         x
     };
-    for name in ["raw", "emc", "pm", "pm-reordered"] {
+    for name in ["raw", "emc", "emc-paper", "pm", "pm-reordered"] {
         let codec = codecs::by_name(name).unwrap();
         let options = EncodeOptions {
             quant_bits: 12,

@@ -102,13 +102,13 @@ pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
         "# EMC, Table 1 — Magnor & Girod, *Fully Embedded Coding of Triangle Meshes*\n"
     );
     let _ = writeln!(md, "Regenerate: `{EMC_TABLE1_COMMAND}`\n");
-    let _ = writeln!(md, "Codec `emc`, 24 levels on the paper's per-axis box. Columns as in the paper: PM bytes from its Eq. 2 (17 bytes a vertex); EMC bytes of the stream at level 24 without the header (the paper leaves out its 24-byte header); Conn. bits = connecting-edge flags + STAY/MOVE/DUPLICATE codes; V.Pos. bits = refinement bits + split-distance codes; bits/Δ = Conn. bits over Δ#; bits/vertex = V.Pos. bits over Vertex#. Δ# counts triangles as the paper's decoder rebuilds them: the 3-cliques of the edge graph.\n");
+    let _ = writeln!(md, "Codec `emc-paper`, 24 levels on the paper's per-axis box. Columns as in the paper: PM bytes from its Eq. 2 (17 bytes a vertex); EMC bytes of the stream at level 24 without the header (the paper leaves out its 24-byte header); Conn. bits = connecting-edge flags + STAY/MOVE/DUPLICATE codes; V.Pos. bits = refinement bits + split-distance codes; bits/Δ = Conn. bits over Δ#; bits/vertex = V.Pos. bits over Vertex#. Δ# counts triangles as the paper's decoder rebuilds them: the 3-cliques of the edge graph.\n");
     let _ = writeln!(md, "| Data set | Vertex# | Δ# | PM bytes | EMC bytes | Conn. bits | V.Pos. bits | bits/Δ | bits/Vertex |");
     let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     let mut extras = String::new();
     let mut why = String::new();
     for (paper, (file, stem)) in EMC_TABLE1.iter().zip(EMC_TABLE1_MESHES) {
-        let r = load(results, "emc", stem)?;
+        let r = load(results, "emc-paper", stem)?;
         let cliques = stat(&r, "cliques");
         let conn = stat(&r, "connecting_flag_bits") + stat(&r, "edge_code_bits");
         let pos = stat(&r, "refinement_bits") + stat(&r, "split_distance_bits");
@@ -149,7 +149,7 @@ pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
     let _ = writeln!(md, "| model | level 6 | level 8 | level 10 | level 24 |");
     let _ = writeln!(md, "|---|---:|---:|---:|---:|");
     for (paper, (file, stem)) in EMC_TABLE1.iter().zip(EMC_TABLE1_MESHES) {
-        let r = load(results, "emc", stem)?;
+        let r = load(results, "emc-paper", stem)?;
         let at = |l: usize| r.levels[l - 1].bits / 8;
         let p = FIG5_BYTES
             .iter()
@@ -172,7 +172,7 @@ pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
     }
     let _ = writeln!(md, "\nThe rendered levels are in [emc-fig5.png](emc-fig5.png); the rate-resolution curves (Fig. 4) in [emc-fig4.png](emc-fig4.png).");
     let _ = writeln!(md, "\n## What exact losslessness costs beyond the paper\n");
-    let _ = writeln!(md, "The paper's decoder outputs every 3-clique; ours then applies three correction lists coded in the last level (see `src/codecs/emc/mod.rs`), so that the full decode equals the canonical mesh exactly (DESIGN.md A2). They are connectivity bits, not included in Conn. bits above.\n");
+    let _ = writeln!(md, "The paper's decoder outputs every 3-clique; ours then applies three correction lists coded in the last level (see `src/codecs/emc/paper/mod.rs`), so that the full decode equals the canonical mesh exactly (DESIGN.md A2). They are connectivity bits, not included in Conn. bits above.\n");
     let _ = writeln!(md, "| mesh | faces | 3-cliques | false triangles | double-sided faces | orientation exceptions | correction bits | header bytes | stream bytes | lossless |");
     let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     md.push_str(&extras);
@@ -190,7 +190,7 @@ pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
 pub fn emc_fig4(results: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     let runs = EMC_TABLE1_MESHES
         .iter()
-        .map(|(_, stem)| load(results, "emc", stem))
+        .map(|(_, stem)| load(results, "emc-paper", stem))
         .collect::<Result<Vec<_>>>()?;
     let mut chart = plot::rate_resolution(&runs, "EMC, 24 levels (Magnor & Girod Fig. 4)");
     chart.title = "EMC: resolution level vs bits per vertex (cf. Magnor & Girod, Fig. 4)".into();
@@ -232,8 +232,8 @@ pub fn emc_fig5(results: &Path, out: &Path) -> Result<PathBuf> {
     let fail = |e: &dyn std::fmt::Display| Error::Io(std::io::Error::other(format!("plot: {e}")));
     root.fill(&WHITE).map_err(|e| fail(&e))?;
     for (col, (file, stem)) in EMC_TABLE1_MESHES.iter().enumerate() {
-        let result = load(results, "emc", stem)?;
-        let stream_path = results.join("emc").join(format!("{stem}.mc"));
+        let result = load(results, "emc-paper", stem)?;
+        let stream_path = results.join("emc-paper").join(format!("{stem}.mc"));
         let stream = std::fs::read(&stream_path).map_err(|e| {
             Error::Unsupported(format!(
                 "{}: {e} (make it with: {EMC_TABLE1_COMMAND})",

@@ -1,5 +1,5 @@
-//! EMC: lossless on messy meshes, prefixes equal levels, every cut decodes or fails cleanly,
-//! encoding is deterministic.
+//! EMC, both coders (`emc` and the paper's `emc-paper`): lossless on messy meshes, prefixes
+//! equal levels, every cut decodes or fails cleanly, encoding is deterministic.
 
 use meshcodec::codecs::{self, EncodeOptions, LevelMesh, Stop};
 use meshcodec::mesh::generate;
@@ -35,7 +35,11 @@ fn assert_valid(level: &LevelMesh) {
     assert!(level.mesh.positions.iter().all(|p| p.is_finite()));
 }
 
+/// The two EMC coders.
+const CODERS: [&str; 2] = ["emc", "emc-paper"];
+
 fn encode(
+    codec: &str,
     seed: u64,
     bits: u8,
     per_axis: bool,
@@ -51,7 +55,7 @@ fn encode(
         grid,
     };
     let canonical = codecs::canonical_for(&mesh, &options).ok()?;
-    let encoded = codecs::by_name("emc")
+    let encoded = codecs::by_name(codec)
         .unwrap()
         .encode(&canonical, &options)
         .unwrap();
@@ -62,9 +66,9 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(cases()))]
 
     #[test]
-    fn full_decode_is_lossless_and_deterministic(seed in any::<u64>(), bits in 1u8..=24, per_axis in any::<bool>()) {
-        let Some((canonical, encoded)) = encode(seed, bits, per_axis) else { return Ok(()) };
-        let (_, again) = encode(seed, bits, per_axis).unwrap();
+    fn full_decode_is_lossless_and_deterministic(codec in prop::sample::select(&CODERS[..]), seed in any::<u64>(), bits in 1u8..=24, per_axis in any::<bool>()) {
+        let Some((canonical, encoded)) = encode(codec, seed, bits, per_axis) else { return Ok(()) };
+        let (_, again) = encode(codec, seed, bits, per_axis).unwrap();
         prop_assert_eq!(&encoded.bytes, &again.bytes);
         let (decoded, levels) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
         prop_assert_eq!(levels, bits as usize);
@@ -72,8 +76,8 @@ proptest! {
     }
 
     #[test]
-    fn a_stream_cut_after_level_k_is_level_k(seed in any::<u64>(), bits in 2u8..=16, per_axis in any::<bool>()) {
-        let Some((_, encoded)) = encode(seed, bits, per_axis) else { return Ok(()) };
+    fn a_stream_cut_after_level_k_is_level_k(codec in prop::sample::select(&CODERS[..]), seed in any::<u64>(), bits in 2u8..=16, per_axis in any::<bool>()) {
+        let Some((_, encoded)) = encode(codec, seed, bits, per_axis) else { return Ok(()) };
         let mut decoder = codecs::open(&encoded.bytes).unwrap();
         for record in &encoded.levels {
             prop_assert!(decoder.advance().unwrap());
@@ -88,8 +92,8 @@ proptest! {
     }
 
     #[test]
-    fn every_cut_decodes_to_a_valid_mesh_or_a_clean_error(seed in any::<u64>(), bits in 1u8..=10) {
-        let Some((_, encoded)) = encode(seed, bits, false) else { return Ok(()) };
+    fn every_cut_decodes_to_a_valid_mesh_or_a_clean_error(codec in prop::sample::select(&CODERS[..]), seed in any::<u64>(), bits in 1u8..=10) {
+        let Some((_, encoded)) = encode(codec, seed, bits, false) else { return Ok(()) };
         let mut vertices = 0;
         let (_, header_len) = meshcodec::container::Header::read(&encoded.bytes).unwrap();
         for cut in 0..encoded.bytes.len() {
@@ -109,7 +113,8 @@ proptest! {
 
 #[test]
 fn a_cut_inside_a_level_decodes_the_operations_before_it() {
-    let (_, encoded) = encode(7, 12, false).unwrap();
+    // The paper's syntax is a plain bit string: every complete operation of a cut level applies.
+    let (_, encoded) = encode("emc-paper", 7, 12, false).unwrap();
     let (end5, end6) = (encoded.levels[4].end_byte, encoded.levels[5].end_byte);
     let at = |cut: usize| codecs::decode(&encoded.bytes[..cut], Stop::All).unwrap().0;
     let (l5, mid, l6) = (at(end5), at((end5 + end6) / 2), at(end6));
@@ -119,20 +124,39 @@ fn a_cut_inside_a_level_decodes_the_operations_before_it() {
 }
 
 #[test]
+fn a_cut_inside_an_arithmetic_coded_level_decodes_the_level_before() {
+    // A range coder's cut block would decode garbage, so `emc` stops at the last whole level.
+    let (_, encoded) = encode("emc", 7, 12, false).unwrap();
+    let (end5, end6) = (encoded.levels[4].end_byte, encoded.levels[5].end_byte);
+    let at = |cut: usize| codecs::decode(&encoded.bytes[..cut], Stop::All).unwrap();
+    let (l5, mid) = (at(end5), at((end5 + end6) / 2));
+    assert_eq!(mid.1, 5);
+    assert!(mid.0 == l5.0);
+}
+
+#[test]
 fn corrupt_streams_fail_cleanly() {
-    let (_, encoded) = encode(11, 12, false).unwrap();
-    let mut x = 0x9e37_79b9_u32;
-    for _ in 0..2000 {
-        let bytes = common::flip_bits(&encoded.bytes, &mut x, 4);
-        if let Ok((level, _)) = codecs::decode(&bytes, Stop::All) {
-            assert_valid(&level);
+    for codec in CODERS {
+        let (_, encoded) = encode(codec, 11, 12, false).unwrap();
+        let mut x = 0x9e37_79b9_u32;
+        for _ in 0..2000 {
+            let bytes = common::flip_bits(&encoded.bytes, &mut x, 4);
+            if let Ok((level, _)) = codecs::decode(&bytes, Stop::All) {
+                assert_valid(&level);
+            }
         }
     }
 }
 
 #[test]
 fn decoding_stops_after_any_pass() {
-    let (_, encoded) = encode(5, 12, false).unwrap();
+    for codec in CODERS {
+        decoding_stops_after_any_pass_of(codec);
+    }
+}
+
+fn decoding_stops_after_any_pass_of(codec: &str) {
+    let (_, encoded) = encode(codec, 5, 12, false).unwrap();
     for level in 1..12 {
         let at_level = codecs::decode(&encoded.bytes, Stop::Levels(level))
             .unwrap()

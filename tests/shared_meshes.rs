@@ -79,7 +79,7 @@ fn every_shared_mesh_round_trips_losslessly() {
             let all_bits: &[u8] = if pm { &[16] } else { &[12, 24] };
             for &bits in all_bits {
                 for grid in [GridShape::Cubic, GridShape::PerAxis] {
-                    if grid == GridShape::PerAxis && codec.name() != "emc" {
+                    if grid == GridShape::PerAxis && !codec.name().starts_with("emc") {
                         continue;
                     }
                     let options = EncodeOptions {
