@@ -41,7 +41,7 @@ impl Clusters {
         let n = mesh.vertex_count();
         Clusters {
             trie,
-            ranges: vec![0..n],
+            ranges: std::iter::once(0..n).collect(),
             neighbours: crate::hierarchy::cliques::adjacency(n, &mesh.faces),
             cluster_of: vec![0; n],
             stamp_lower: vec![0],
