@@ -90,6 +90,9 @@ pub struct Walker {
     pub contexts: Box<Contexts>,
     /// For each depth, the shift from the cell prefix to the full grid per axis.
     shifts: Vec<[u8; 3]>,
+    /// Twice each vertex's cell centre, in units of the full grid (kept with the cells: the
+    /// contexts read the neighbours' centres over and over).
+    centres: Vec<[i64; 3]>,
     codes: Vec<EdgeCode>,
 }
 
@@ -103,23 +106,39 @@ impl Walker {
         let shifts = (0..=order.steps())
             .map(|d| order.bits_per_axis(d).map(|b| order.levels - b))
             .collect();
-        Walker {
+        let mut walker = Walker {
             state: EmcState::new(order, vertices),
             leaf: vec![vertices <= 1],
             edges: 0,
             contexts: Box::default(),
             shifts,
+            centres: Vec::new(),
             codes: Vec::new(),
-        }
+        };
+        walker.refresh(0);
+        walker
     }
 
     /// Twice the centre of `v`'s cell along `axis`, in units of the full grid.
+    #[inline]
     fn centre2(&self, v: usize, axis: usize) -> i64 {
-        let shift = self.shifts[self.state.depth[v] as usize][axis];
-        (((self.state.cells[v][axis] as i64) << 1) | 1) << shift
+        self.centres[v][axis]
+    }
+
+    /// Recomputes the cached centre of `v` from its cell.
+    fn refresh(&mut self, v: usize) {
+        let shifts = self.shifts[self.state.depth[v] as usize];
+        let centre = [0, 1, 2]
+            .map(|a| (((self.state.cells[v][a] as i64) << 1) | 1) << shifts[a]);
+        if v == self.centres.len() {
+            self.centres.push(centre);
+        } else {
+            self.centres[v] = centre;
+        }
     }
 
     /// Half the width of `v`'s cell along `axis`, in the units of [`Self::centre2`].
+    #[inline]
     fn half_width2(&self, v: usize, axis: usize) -> i64 {
         1 << self.shifts[self.state.depth[v] as usize][axis]
     }
@@ -148,6 +167,7 @@ impl Walker {
                 let c = half.index;
                 let bit = side.code(&mut self.contexts.half[c], Question::Half, flip, v, step)?;
                 self.state.refine(v, step, bit as u32);
+                self.refresh(v);
                 continue;
             }
             if self.state.len() as u64 >= max_vertices {
@@ -322,6 +342,8 @@ impl Walker {
         let r = self
             .state
             .split(v, step, connecting, &codes, [NO_SPLIT, NO_SPLIT]);
+        self.refresh(v);
+        self.refresh(r);
         self.codes = codes;
         self.leaf.push(false);
         for (half, vertex) in [(0, v), (1, r)] {
