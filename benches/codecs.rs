@@ -1,5 +1,6 @@
 //! Codec throughput in vertices per second, one thread: encode (canonical mesh → bytes) and full
-//! decode (bytes → mesh) of bunny.ply and armadillo-43k.obj at 12 and 24 levels.
+//! decode (bytes → mesh) of bunny.ply and armadillo-43k.obj at 12 and 24 levels, for both EMC
+//! coders (`emc`, `emc-paper`).
 //! Run: cargo bench --bench codecs
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
@@ -9,11 +10,17 @@ use meshcodec::mesh::quantize::GridShape;
 use std::time::Duration;
 
 fn codec_throughput(c: &mut Criterion) {
-    let mut group = c.benchmark_group("emc");
+    for codec in ["emc", "emc-paper"] {
+        throughput_of(c, codec);
+    }
+}
+
+fn throughput_of(c: &mut Criterion, codec: &str) {
+    let mut group = c.benchmark_group(codec);
     group
         .sample_size(20)
         .measurement_time(Duration::from_secs(8));
-    let emc = codecs::by_name("emc").unwrap();
+    let emc = codecs::by_name(codec).unwrap();
     for name in ["bunny", "armadillo-43k"] {
         let mesh = read_mesh(&resolve(name).unwrap()).unwrap();
         for bits in [12u8, 24] {
