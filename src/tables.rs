@@ -573,7 +573,10 @@ fn optional(x: Option<f64>, digits: usize) -> String {
 /// progressive coders.
 pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
     let mut md = String::new();
-    let _ = writeln!(md, "# EMC against the anchors: lossless bits per vertex at 12 bits\n");
+    let _ = writeln!(
+        md,
+        "# EMC against the anchors: lossless bits per vertex at 12 bits\n"
+    );
     let _ = writeln!(md, "Regenerate: `{ANCHORS_COMMAND}` (our codecs, then Draco through DracoPy in the same run, then this table).\n");
     let _ = writeln!(md, "Every row of ours is the full decode of the stream on the 12-bit cubic grid of DESIGN.md A2 (bits over the canonical mesh's vertex count; bunny.ply has 34,834 referenced vertices). Draco (DracoPy, compression_level 10, quantization_bits 12) is single-rate, quantizes on its own grid and is not checked for losslessness; its split between connectivity and geometry is not reported by DracoPy. Decode rates are one thread on this machine (Draco's from Python, best of five).\n");
     for mesh in ["bunny", "armadillo-43k"] {
@@ -676,6 +679,7 @@ pub fn emc_rate_distortion(results: &Path, out: &Path) -> Result<Vec<PathBuf>> {
         points: draco,
         mark: plot::Mark::Points,
     });
-    chart.title = "Rate vs distortion — bunny.ply: progressive levels at 12 bits, Draco at 8–16 bits".into();
+    chart.title =
+        "Rate vs distortion — bunny.ply: progressive levels at 12 bits, Draco at 8–16 bits".into();
     chart.draw(&out.join("emc-rate-distortion"))
 }

@@ -128,8 +128,7 @@ impl Walker {
     /// Recomputes the cached centre of `v` from its cell.
     fn refresh(&mut self, v: usize) {
         let shifts = self.shifts[self.state.depth[v] as usize];
-        let centre = [0, 1, 2]
-            .map(|a| (((self.state.cells[v][a] as i64) << 1) | 1) << shifts[a]);
+        let centre = [0, 1, 2].map(|a| (((self.state.cells[v][a] as i64) << 1) | 1) << shifts[a]);
         if v == self.centres.len() {
             self.centres.push(centre);
         } else {
