@@ -527,21 +527,19 @@ pub fn hoppe_tables(results: &Path, out: &Path) -> Result<PathBuf> {
 /// Command that regenerates paper-tables/emc-vs-anchors.md and emc-rate-distortion.{png,svg}.
 const ANCHORS_COMMAND: &str = "bash experiments/anchors.sh";
 
-/// Published progressive coders on bunny.ply at 12 bits, bits per vertex: (coder, connectivity,
-/// geometry, total).
-const PUBLISHED_ANCHORS: [(&str, Option<f64>, Option<f64>, Option<f64>); 3] = [
+/// Connectivity, geometry and total bits per vertex, where published.
+type Rates = (Option<f64>, Option<f64>, Option<f64>);
+
+/// Published progressive coders on bunny.ply at 12 bits: (coder, rates).
+const PUBLISHED_ANCHORS: [(&str, Rates); 3] = [
     (
         "Lee, Lavoué & Dupont 2012, valence-driven progressive coder (MEPP2, measured on this bunny)",
-        Some(4.23),
-        Some(14.58),
-        Some(18.81),
+        (Some(4.23), Some(14.58), Some(18.81)),
     ),
-    ("CPM (compressed progressive meshes)", None, None, Some(22.6)),
+    ("CPM (compressed progressive meshes)", (None, None, Some(22.6))),
     (
         "Peng & Kuo, geometry-guided octree coding (geometry, average)",
-        None,
-        Some(16.6),
-        None,
+        (None, Some(16.6), None),
     ),
 ];
 
@@ -632,7 +630,7 @@ pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
             );
         }
         if mesh == "bunny" {
-            for (name, conn, geom, total) in PUBLISHED_ANCHORS {
+            for (name, (conn, geom, total)) in PUBLISHED_ANCHORS {
                 let _ = writeln!(
                     md,
                     "| {name} (published) | yes | {} | {} | {} | | |",
