@@ -138,6 +138,58 @@ impl EmcState {
         triangles(&self.adjacency)
     }
 
+    /// The cliques of the final state, once every vertex is decoded (`vertices`: the header's
+    /// count); the face-correction lists index them.
+    pub fn final_cliques(&self, vertices: u64) -> Result<Vec<[u32; 3]>, String> {
+        if self.len() as u64 != vertices {
+            return Err(format!(
+                "{} vertices decoded, the header declares {vertices}",
+                self.len()
+            ));
+        }
+        Ok(self.cliques())
+    }
+
+    /// The full mesh: `cliques` (from [`Self::final_cliques`]) with `corrections` applied,
+    /// checked against the header's `triangles`.
+    pub fn corrected_mesh(
+        &self,
+        grid: &Grid,
+        cliques: &[[u32; 3]],
+        corrections: &FaceCorrections,
+        triangles: u64,
+    ) -> Result<LevelMesh, String> {
+        if corrections
+            .false_triangles
+            .iter()
+            .any(|t| corrections.double_sided.binary_search(t).is_ok())
+        {
+            return Err("a triangle is listed both false and double-sided".into());
+        }
+        let positions = self.positions(grid);
+        let faces = final_faces(cliques, &self.adjacency, &positions, corrections);
+        if faces.len() as u64 != triangles {
+            return Err(format!(
+                "{} triangles decoded, the header declares {triangles}",
+                faces.len()
+            ));
+        }
+        let mut is_false = vec![false; cliques.len()];
+        for &i in &corrections.false_triangles {
+            is_false[i as usize] = true;
+        }
+        let true_cliques: Vec<[u32; 3]> = cliques
+            .iter()
+            .zip(&is_false)
+            .filter(|(_, &f)| !f)
+            .map(|(t, _)| *t)
+            .collect();
+        Ok(LevelMesh {
+            loose_edges: loose_edges(&self.adjacency, &true_cliques),
+            mesh: TriMesh::new(positions, faces),
+        })
+    }
+
     /// The mesh as the paper's decoder shows it between levels: every 3-clique a triangle,
     /// oriented by propagation from outward-facing guesses (no bits are spent on it).
     pub fn level_mesh(&self, grid: &Grid) -> LevelMesh {

@@ -1,16 +1,13 @@
 //! The modelled coder's decoder: the walker's questions answered from the stream. Each level is
 //! its own arithmetic-coded block, so a stream cut inside a level decodes to the level before.
 
-use super::contexts::Contexts;
 use super::walk::{Question, Side, Stop, Walker};
-use crate::codecs::emc::state::{final_faces, FaceCorrections};
+use crate::codecs::emc::state::FaceCorrections;
 use crate::codecs::{LevelDecoder, LevelMesh};
 use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
-use crate::hierarchy::cliques::loose_edges;
 use crate::hierarchy::octree::StepOrder;
-use crate::mesh::TriMesh;
 
 struct DecoderSide {
     coder: ArithDecoder,
@@ -106,55 +103,26 @@ impl<'a> EmcDecoder<'a> {
 
     fn read_corrections(&mut self, coder: &mut ArithDecoder) -> Result<(), Stop> {
         let state = &self.walker.state;
-        if state.len() as u64 != self.header.vertices {
-            return Err(Stop::Fault(format!(
-                "{} vertices decoded, the header declares {}",
-                state.len(),
-                self.header.vertices
-            )));
-        }
-        let cliques = state.cliques();
-        let contexts: &mut Contexts = &mut self.walker.contexts;
-        let [c0, c1, c2] = &mut contexts.corrections;
-        let false_triangles = get_list(coder, c0, cliques.len())?;
-        let double_sided = get_list(coder, c1, cliques.len())?;
-        let orientation_exceptions = get_list(coder, c2, cliques.len())?;
-        if false_triangles
-            .iter()
-            .any(|t| double_sided.binary_search(t).is_ok())
-        {
-            return Err(Stop::Fault(
-                "a triangle is listed both false and double-sided".into(),
-            ));
-        }
+        let cliques = state
+            .final_cliques(self.header.vertices)
+            .map_err(Stop::Fault)?;
+        let [c0, c1, c2] = &mut self.walker.contexts.corrections;
         let corrections = FaceCorrections {
-            false_triangles,
-            double_sided,
-            orientation_exceptions,
+            false_triangles: get_list(coder, c0, cliques.len())?,
+            double_sided: get_list(coder, c1, cliques.len())?,
+            orientation_exceptions: get_list(coder, c2, cliques.len())?,
         };
-        let state = &self.walker.state;
-        let positions = state.positions(&self.header.grid);
-        let faces = final_faces(&cliques, &state.adjacency, &positions, &corrections);
-        if faces.len() as u64 != self.header.triangles {
-            return Err(Stop::Fault(format!(
-                "{} triangles decoded, the header declares {}",
-                faces.len(),
-                self.header.triangles
-            )));
-        }
-        let skipped = corrections.skipped(cliques.len());
-        let true_cliques: Vec<[u32; 3]> = cliques
-            .iter()
-            .enumerate()
-            .filter(|&(i, _)| {
-                !skipped[i] || corrections.double_sided.binary_search(&(i as u32)).is_ok()
-            })
-            .map(|(_, t)| *t)
-            .collect();
-        self.final_mesh = Some(LevelMesh {
-            loose_edges: loose_edges(&state.adjacency, &true_cliques),
-            mesh: TriMesh::new(positions, faces),
-        });
+        let mesh = self
+            .walker
+            .state
+            .corrected_mesh(
+                &self.header.grid,
+                &cliques,
+                &corrections,
+                self.header.triangles,
+            )
+            .map_err(Stop::Fault)?;
+        self.final_mesh = Some(mesh);
         Ok(())
     }
 }

@@ -37,16 +37,8 @@ impl Side for EncoderSide {
             Question::Leaf(0) => self.plan.lower.len() == 1,
             Question::Leaf(_) => self.plan.upper.len() == 1,
         };
-        const NAMES: [&str; 12] = [
-            "h0", "h1", "h2", "h3", "h4", "h5", "h6", "h7", "h8", "h9", "h10", "h11",
-        ];
-        let field = if question == Question::Half && std::env::var("EMC_DEBUG").is_ok() {
-            NAMES[step / 3]
-        } else {
-            question.field()
-        };
         self.coder
-            .bit(context, answer ^ flip, question.class(), field);
+            .bit(context, answer ^ flip, question.class(), question.field());
         Ok(answer)
     }
 

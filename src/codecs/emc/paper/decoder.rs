@@ -2,14 +2,12 @@
 //! from a cut payload too: every vertex operation is read whole before it is applied, so a cut
 //! leaves the state after the last complete operation.
 
-use super::super::state::{final_faces, EmcState, FaceCorrections, NO_SPLIT};
+use super::super::state::{EmcState, FaceCorrections, NO_SPLIT};
 use super::syntax;
 use crate::codecs::{LevelDecoder, LevelMesh};
 use crate::coding::BitSource;
 use crate::container::{Header, LevelPayload, StreamReader};
 use crate::error::{Error, Result};
-use crate::hierarchy::cliques::loose_edges;
-use crate::mesh::TriMesh;
 
 pub struct EmcDecoder<'a> {
     stream: StreamReader<'a>,
@@ -103,53 +101,30 @@ impl<'a> EmcDecoder<'a> {
         payload: &LevelPayload,
     ) -> Result<(), Stop> {
         let level = self.levels_done + 1;
-        let fault = |what: &str| Stop::Fault(Error::malformed(level, payload.start, what));
-        if self.state.len() as u64 != self.header.vertices {
-            return Err(fault(&format!(
-                "{} vertices decoded, the header declares {}",
-                self.state.len(),
-                self.header.vertices
-            )));
-        }
-        let cliques = self.state.cliques();
+        let fault = |what: String| Stop::Fault(Error::malformed(level, payload.start, what));
+        let cliques = self
+            .state
+            .final_cliques(self.header.vertices)
+            .map_err(fault)?;
         let false_triangles = syntax::get_list(source, cliques.len()).ok_or(Stop::OutOfBits)?;
         let double_sided = syntax::get_list(source, cliques.len()).ok_or(Stop::OutOfBits)?;
         let orientation_exceptions =
             syntax::get_list(source, cliques.len()).ok_or(Stop::OutOfBits)?;
-        if false_triangles
-            .iter()
-            .any(|t| double_sided.binary_search(t).is_ok())
-        {
-            return Err(fault("a triangle is listed both false and double-sided"));
-        }
         let corrections = FaceCorrections {
             false_triangles,
             double_sided,
             orientation_exceptions,
         };
-        let positions = self.state.positions(&self.header.grid);
-        let faces = final_faces(&cliques, &self.state.adjacency, &positions, &corrections);
-        if faces.len() as u64 != self.header.triangles {
-            return Err(fault(&format!(
-                "{} triangles decoded, the header declares {}",
-                faces.len(),
-                self.header.triangles
-            )));
-        }
-        let mut is_false = vec![false; cliques.len()];
-        for &i in &corrections.false_triangles {
-            is_false[i as usize] = true;
-        }
-        let true_cliques: Vec<[u32; 3]> = cliques
-            .iter()
-            .zip(&is_false)
-            .filter(|(_, &f)| !f)
-            .map(|(t, _)| *t)
-            .collect();
-        self.final_mesh = Some(LevelMesh {
-            loose_edges: loose_edges(&self.state.adjacency, &true_cliques),
-            mesh: TriMesh::new(positions, faces),
-        });
+        let mesh = self
+            .state
+            .corrected_mesh(
+                &self.header.grid,
+                &cliques,
+                &corrections,
+                self.header.triangles,
+            )
+            .map_err(fault)?;
+        self.final_mesh = Some(mesh);
         Ok(())
     }
 }
