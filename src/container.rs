@@ -120,6 +120,15 @@ impl Header {
         let vertices = count(&mut pos, "vertices", limits::MAX_VERTICES)?;
         let triangles = count(&mut pos, "triangles", limits::MAX_TRIANGLES)?;
         let levels = count(&mut pos, "levels", limits::MAX_LEVELS)?;
+        if vertices == 0 || triangles == 0 || levels == 0 {
+            // No encoder writes an empty mesh (empty input is refused before encoding).
+            return Err(bad(
+                pos,
+                &format!(
+                    "header declares {vertices} vertices, {triangles} triangles, {levels} levels"
+                ),
+            ));
+        }
         let header = Header {
             codec_id,
             params,

@@ -179,7 +179,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
                 encoded.levels.len()
             )));
         }
-        levels.push(measure_level(decoder.as_ref(), record, &reference, v, t));
+        levels.push(measure_level(decoder.as_ref(), record, &reference, v, t)?);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -216,11 +216,11 @@ fn measure_level(
     reference: &Reference,
     full_vertices: f64,
     full_triangles: f64,
-) -> LevelRow {
-    let level = decoder.mesh();
+) -> Result<LevelRow> {
+    let level = decoder.mesh()?;
     let distance = reference.compare(&level);
     let bits = record.end_byte as u64 * 8;
-    LevelRow {
+    Ok(LevelRow {
         level: decoder.levels_decoded(),
         bits,
         connectivity_bits: record.connectivity_bits,
@@ -232,7 +232,7 @@ fn measure_level(
         hausdorff: distance.map(|d| d.hausdorff),
         rms: distance.map(|d| d.rms),
         hausdorff_paper: distance.map(|d| d.hausdorff_paper),
-    }
+    })
 }
 
 fn progress_bar(show: bool, levels: usize, codec: &str, path: &Path) -> indicatif::ProgressBar {

@@ -81,7 +81,7 @@ proptest! {
         let mut decoder = codecs::open(&encoded.bytes).unwrap();
         for record in &encoded.levels {
             prop_assert!(decoder.advance().unwrap());
-            let full = decoder.mesh();
+            let full = decoder.mesh().unwrap();
             assert_valid(&full);
             prop_assert_eq!(full.mesh.vertex_count(), record.vertices);
             let (cut, k) = codecs::decode(&encoded.bytes[..record.end_byte], Stop::All).unwrap();

@@ -220,7 +220,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
     let mut levels = Vec::new();
     for &(start, len) in &sizes {
         decoder.advance().with_context(context)?;
-        let LevelMesh { mesh, loose_edges } = decoder.mesh();
+        let LevelMesh { mesh, loose_edges } = decoder.mesh()?;
         levels.push(serde_json::json!({
             "level": decoder.levels_decoded(),
             "end_byte": start + len,

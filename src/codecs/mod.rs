@@ -105,8 +105,8 @@ pub trait LevelDecoder {
     fn advance_partial(&mut self) -> Result<bool> {
         Ok(false)
     }
-    /// The mesh after the levels decoded so far.
-    fn mesh(&self) -> LevelMesh;
+    /// The mesh after the levels decoded so far (an error where showing it would pass a limit).
+    fn mesh(&self) -> Result<LevelMesh>;
 }
 
 /// Every codec of this build.
@@ -195,5 +195,5 @@ pub fn decode(bytes: &[u8], stop: Stop) -> Result<(LevelMesh, usize)> {
         }
         _ => {}
     }
-    Ok((decoder.mesh(), decoder.levels_decoded()))
+    Ok((decoder.mesh()?, decoder.levels_decoded()))
 }

@@ -3,9 +3,12 @@
 //! the edges.
 
 use crate::codecs::LevelMesh;
-use crate::hierarchy::cliques::{loose_edges, oriented, propagate_orientation, triangles};
+use crate::hierarchy::cliques::{
+    loose_edges, oriented, propagate_orientation, triangles as list_triangles,
+};
 use crate::hierarchy::octree::KeyTrie;
 use crate::hierarchy::octree::StepOrder;
+use crate::limits;
 use crate::mesh::canonical::rotate_to_smallest;
 use crate::mesh::CanonicalMesh;
 use crate::mesh::{Grid, TriMesh};
@@ -133,21 +136,26 @@ impl EmcState {
             .collect()
     }
 
-    /// The 3-cliques of the edge graph, ascending triples in lexicographic order.
-    pub fn cliques(&self) -> Vec<[u32; 3]> {
-        triangles(&self.adjacency)
+    /// The 3-cliques of the edge graph, ascending triples in lexicographic order; an error if
+    /// there are more than a stream of `triangles` (the header's count) may show
+    /// ([`limits::level_triangles`]).
+    pub fn cliques(&self, triangles: u64) -> Result<Vec<[u32; 3]>, String> {
+        let limit = limits::level_triangles(triangles);
+        list_triangles(&self.adjacency, limit).ok_or_else(|| {
+            format!("the edge graph has more than {limit} triangles ({triangles} declared)")
+        })
     }
 
-    /// The cliques of the final state, once every vertex is decoded (`vertices`: the header's
-    /// count); the face-correction lists index them.
-    pub fn final_cliques(&self, vertices: u64) -> Result<Vec<[u32; 3]>, String> {
+    /// The cliques of the final state, once every vertex is decoded (`vertices`, `triangles`:
+    /// the header's counts); the face-correction lists index them.
+    pub fn final_cliques(&self, vertices: u64, triangles: u64) -> Result<Vec<[u32; 3]>, String> {
         if self.len() as u64 != vertices {
             return Err(format!(
                 "{} vertices decoded, the header declares {vertices}",
                 self.len()
             ));
         }
-        Ok(self.cliques())
+        self.cliques(triangles)
     }
 
     /// The full mesh: `cliques` (from [`Self::final_cliques`]) with `corrections` applied,
@@ -192,9 +200,10 @@ impl EmcState {
 
     /// The mesh as the paper's decoder shows it between levels: every 3-clique a triangle,
     /// oriented by propagation from outward-facing guesses (no bits are spent on it).
-    pub fn level_mesh(&self, grid: &Grid) -> LevelMesh {
+    /// `triangles`: the header's count, which bounds the cliques listed.
+    pub fn level_mesh(&self, grid: &Grid, triangles: u64) -> Result<LevelMesh, String> {
+        let cliques = self.cliques(triangles)?;
         let positions = self.positions(grid);
-        let cliques = self.cliques();
         let skipped = vec![false; cliques.len()];
         let centre = centroid(&positions);
         let flipped = propagate_orientation(
@@ -210,10 +219,10 @@ impl EmcState {
             .zip(&flipped)
             .map(|(&t, &f)| oriented(t, f))
             .collect();
-        LevelMesh {
+        Ok(LevelMesh {
             loose_edges: loose_edges(&self.adjacency, &cliques),
             mesh: TriMesh::new(positions, faces),
-        }
+        })
     }
 }
 
@@ -291,12 +300,14 @@ pub fn final_faces(
 /// Compares the cliques of the final edge graph with the mesh's faces and lists what the decoder
 /// must correct: false triangles, faces present in both orientations, and orientations that the
 /// propagation predicts wrongly.
+/// Refuses a mesh whose edge graph has more 3-cliques than a decoder accepts
+/// ([`limits::level_triangles`]).
 pub fn face_corrections(
     mesh: &CanonicalMesh,
     state: &EmcState,
     ranges: &[Range<usize>],
     trie: &KeyTrie,
-) -> FaceCorrections {
+) -> crate::Result<FaceCorrections> {
     // Every cluster is a single mesh vertex by now.
     let mut list_id = vec![0u32; mesh.vertex_count()];
     for (v, range) in ranges.iter().enumerate() {
@@ -312,7 +323,9 @@ pub fn face_corrections(
         let unflipped = rotate_to_smallest(f) == sorted;
         *faces.entry(sorted).or_default() |= if unflipped { 1 } else { 2 };
     }
-    let cliques = state.cliques();
+    let cliques = state
+        .cliques(mesh.face_count() as u64)
+        .map_err(|why| crate::Error::Unsupported(format!("EMC cannot code this mesh: {why}")))?;
     let mut corrections = FaceCorrections::default();
     for (i, t) in cliques.iter().enumerate() {
         match faces.get(t) {
@@ -365,5 +378,5 @@ pub fn face_corrections(
             want
         }
     );
-    corrections
+    Ok(corrections)
 }

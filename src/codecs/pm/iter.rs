@@ -211,6 +211,8 @@ impl<'a> PMeshIter<'a> {
         let vt = self.mesh.positions.len() - 1;
         let vs = vs.unwrap_or(vt as u32) as usize;
         if out(self.mesh.positions[vt]) || out(self.mesh.positions[vs]) {
+            // Undone so that the mesh stays the one the records applied so far describe.
+            self.mesh.ecol(&split);
             return Err(Error::malformed(
                 self.levels_read(),
                 0,

@@ -164,7 +164,9 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<PmMesh> {
         }
         faces.push(t);
     }
-    PmMesh::from_triangles(positions, &faces)
+    // from_triangles links faces across shared edges; a base mesh whose vertices are not
+    // manifold (two fans meeting at one vertex) links but is no mesh PM can split.
+    PmMesh::from_triangles(positions, &faces).filter(|mesh| mesh.check_invariants().is_ok())
 }
 
 impl Codec for Pm {
@@ -418,10 +420,11 @@ impl LevelDecoder for PmDecoder<'_> {
         Ok(advanced)
     }
 
-    fn mesh(&self) -> LevelMesh {
-        self.iter
+    fn mesh(&self) -> Result<LevelMesh> {
+        Ok(self
+            .iter
             .as_ref()
             .map(|i| i.level_mesh())
-            .unwrap_or_default()
+            .unwrap_or_default())
     }
 }

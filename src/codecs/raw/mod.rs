@@ -154,11 +154,11 @@ impl LevelDecoder for RawDecoder<'_> {
         Ok(true)
     }
 
-    fn mesh(&self) -> LevelMesh {
-        LevelMesh {
+    fn mesh(&self) -> Result<LevelMesh> {
+        Ok(LevelMesh {
             mesh: self.mesh.clone(),
             loose_edges: Vec::new(),
-        }
+        })
     }
 }
 

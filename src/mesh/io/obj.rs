@@ -10,6 +10,7 @@ use glam::DVec3;
 use std::collections::HashMap;
 
 pub fn read(bytes: &[u8]) -> Result<TriMesh> {
+    check_face_indices(bytes)?;
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: true,
@@ -59,4 +60,50 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
         }
     }
     Ok(TriMesh::new(positions, faces))
+}
+
+/// tobj (4.0) turns a face index of 0, or a relative one reaching before the first element, into
+/// a huge unsigned index and then multiplies it unchecked, which can wrap onto a real vertex
+/// instead of failing. So every index of every `f` and `l` line is checked here first, reading
+/// the lines as tobj does: nonzero, relative ones within the elements read so far, absolute ones
+/// within the elements in the file.
+fn check_face_indices(bytes: &[u8]) -> Result<()> {
+    let mut so_far = [0usize; 3]; // v, vt, vn
+    let mut highest = [0usize; 3];
+    for (number, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line = String::from_utf8_lossy(line);
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => so_far[0] += 1,
+            Some("vt") => so_far[1] += 1,
+            Some("vn") => so_far[2] += 1,
+            Some("f") | Some("l") => {
+                for word in words {
+                    for (kind, part) in word.split('/').enumerate().take(3) {
+                        let bad =
+                            || Error::mesh(format!("OBJ line {}: face index '{part}'", number + 1));
+                        if part.is_empty() {
+                            continue;
+                        }
+                        let Ok(index) = part.parse::<isize>() else {
+                            continue; // tobj refuses it itself
+                        };
+                        if index == 0 || (index < 0 && index.unsigned_abs() > so_far[kind]) {
+                            return Err(bad());
+                        }
+                        highest[kind] = highest[kind].max(index.max(0) as usize);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    if let Some(kind) = (0..3).find(|&k| highest[k] > so_far[k]) {
+        let name = ["vertex", "texture coordinate", "normal"][kind];
+        return Err(Error::mesh(format!(
+            "OBJ: face index {} past the {} {name} lines",
+            highest[kind], so_far[kind]
+        )));
+    }
+    Ok(())
 }

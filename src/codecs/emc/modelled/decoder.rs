@@ -104,7 +104,7 @@ impl<'a> EmcDecoder<'a> {
     fn read_corrections(&mut self, coder: &mut ArithDecoder) -> Result<(), Stop> {
         let state = &self.walker.state;
         let cliques = state
-            .final_cliques(self.header.vertices)
+            .final_cliques(self.header.vertices, self.header.triangles)
             .map_err(Stop::Fault)?;
         let [c0, c1, c2] = &mut self.walker.contexts.corrections;
         let corrections = FaceCorrections {
@@ -146,10 +146,14 @@ impl LevelDecoder for EmcDecoder<'_> {
         self.decode_passes(passes)
     }
 
-    fn mesh(&self) -> LevelMesh {
+    fn mesh(&self) -> Result<LevelMesh> {
         match &self.final_mesh {
-            Some(mesh) => mesh.clone(),
-            None => self.walker.state.level_mesh(&self.header.grid),
+            Some(mesh) => Ok(mesh.clone()),
+            None => self
+                .walker
+                .state
+                .level_mesh(&self.header.grid, self.header.triangles)
+                .map_err(Error::Limit),
         }
     }
 }

@@ -66,7 +66,7 @@ pub fn put_list(
     }
 }
 
-pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encoded {
+pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate::Result<Encoded> {
     let order = params.order;
     let n = mesh.vertex_count() as u64;
     let mut walker = Walker::new(order, n);
@@ -92,7 +92,7 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
                 &walker.state,
                 &side.clusters.ranges,
                 &side.clusters.trie,
-            );
+            )?;
             let lists = [
                 (&corrections.false_triangles, "false_triangles"),
                 (&corrections.double_sided, "double_sided"),
@@ -136,9 +136,9 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
             },
         })
         .collect();
-    Encoded {
+    Ok(Encoded {
         bytes,
         levels,
         stats,
-    }
+    })
 }

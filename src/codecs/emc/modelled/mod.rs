@@ -98,7 +98,7 @@ impl Codec for Emc {
     fn encode(&self, mesh: &CanonicalMesh, _options: &EncodeOptions) -> Result<Encoded> {
         let params = EmcParams::for_mesh(mesh);
         let header = params.header(Syntax::Modelled, self.id(), mesh);
-        Ok(encoder::encode(mesh, &params, header))
+        encoder::encode(mesh, &params, header)
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {

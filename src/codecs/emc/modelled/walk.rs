@@ -96,11 +96,6 @@ pub struct Walker {
     codes: Vec<EdgeCode>,
 }
 
-/// Most edges a stream may build: every edge of a triangle mesh lies on a face.
-fn edge_limit(triangles: u64) -> u64 {
-    triangles.saturating_mul(3)
-}
-
 impl Walker {
     pub fn new(order: StepOrder, vertices: u64) -> Walker {
         let shifts = (0..=order.steps())
@@ -333,7 +328,7 @@ impl Walker {
             codes.push(code);
         }
         self.edges += duplicates as u64 + connecting as u64;
-        if self.edges > edge_limit(max_triangles) {
+        if self.edges > crate::limits::graph_edges(max_triangles) {
             return Err(Stop::Fault(format!(
                 "more edges than the {max_triangles} triangles the header declares can have"
             )));

@@ -2,18 +2,21 @@
 //! from a cut payload too: every vertex operation is read whole before it is applied, so a cut
 //! leaves the state after the last complete operation.
 
-use super::super::state::{EmcState, FaceCorrections, NO_SPLIT};
+use super::super::state::{EdgeCode, EmcState, FaceCorrections, NO_SPLIT};
 use super::syntax;
 use crate::codecs::{LevelDecoder, LevelMesh};
 use crate::coding::BitSource;
 use crate::container::{Header, LevelPayload, StreamReader};
 use crate::error::{Error, Result};
+use crate::limits;
 
 pub struct EmcDecoder<'a> {
     stream: StreamReader<'a>,
     header: Header,
     state: EmcState,
     levels_done: usize,
+    /// Edges of the graph now, bounded by the header's triangles.
+    edges: u64,
     /// The full mesh once the last level's corrections are read.
     final_mesh: Option<LevelMesh>,
 }
@@ -34,6 +37,7 @@ impl<'a> EmcDecoder<'a> {
             header,
             stream,
             levels_done: 0,
+            edges: 0,
             final_mesh: None,
         }
     }
@@ -75,6 +79,14 @@ impl<'a> EmcDecoder<'a> {
                 for _ in 0..degree {
                     codes.push(syntax::get_edge(&mut source).ok_or(Stop::OutOfBits)?);
                 }
+                let duplicates = codes.iter().filter(|&&c| c == EdgeCode::Duplicate).count();
+                self.edges += duplicates as u64 + connecting as u64;
+                if self.edges > limits::graph_edges(self.header.triangles) {
+                    return Err(fault(format!(
+                        "more edges than the {} triangles the header declares can have",
+                        self.header.triangles
+                    )));
+                }
                 let mut next = [NO_SPLIT; 2];
                 for slot in &mut next {
                     if let Some(d) = syntax::get_distance(&mut source).ok_or(Stop::OutOfBits)? {
@@ -104,7 +116,7 @@ impl<'a> EmcDecoder<'a> {
         let fault = |what: String| Stop::Fault(Error::malformed(level, payload.start, what));
         let cliques = self
             .state
-            .final_cliques(self.header.vertices)
+            .final_cliques(self.header.vertices, self.header.triangles)
             .map_err(fault)?;
         let false_triangles = syntax::get_list(source, cliques.len()).ok_or(Stop::OutOfBits)?;
         let double_sided = syntax::get_list(source, cliques.len()).ok_or(Stop::OutOfBits)?;
@@ -184,10 +196,13 @@ impl LevelDecoder for EmcDecoder<'_> {
         Ok(after > before)
     }
 
-    fn mesh(&self) -> LevelMesh {
+    fn mesh(&self) -> Result<LevelMesh> {
         match &self.final_mesh {
-            Some(mesh) => mesh.clone(),
-            None => self.state.level_mesh(&self.header.grid),
+            Some(mesh) => Ok(mesh.clone()),
+            None => self
+                .state
+                .level_mesh(&self.header.grid, self.header.triangles)
+                .map_err(Error::Limit),
         }
     }
 }

@@ -64,7 +64,7 @@ impl Tally {
     }
 }
 
-pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encoded {
+pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate::Result<Encoded> {
     let order = params.order;
     let n = mesh.vertex_count();
     let mut clusters = Clusters::new(mesh, KeyTrie::new(order, &mesh.cells));
@@ -117,8 +117,10 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
             }
         }
         if level == order.levels as usize {
-            let corrections = face_corrections(mesh, &state, &clusters.ranges, &clusters.trie);
-            tally.add("cliques", state.cliques().len() as f64);
+            let corrections = face_corrections(mesh, &state, &clusters.ranges, &clusters.trie)?;
+            let cliques = mesh.face_count() - corrections.double_sided.len()
+                + corrections.false_triangles.len();
+            tally.add("cliques", cliques as f64);
             tally.add("false_triangles", corrections.false_triangles.len() as f64);
             tally.add("double_sided_faces", corrections.double_sided.len() as f64);
             tally.add(
@@ -155,11 +157,11 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> Encod
             },
         })
         .collect();
-    Encoded {
+    Ok(Encoded {
         bytes,
         levels,
         stats: tally.into_counts(),
-    }
+    })
 }
 
 fn sink_total(sink: &BitSink) -> u64 {

@@ -83,7 +83,7 @@ impl Codec for EmcPaper {
     fn encode(&self, mesh: &CanonicalMesh, _options: &EncodeOptions) -> Result<Encoded> {
         let params = EmcParams::for_mesh(mesh);
         let header = params.header(Syntax::Paper, self.id(), mesh);
-        Ok(encoder::encode(mesh, &params, header))
+        encoder::encode(mesh, &params, header)
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {

@@ -1,0 +1,86 @@
+#!/usr/bin/env bash
+# Writes the seed corpus in fuzz/seeds/: small hand-shaped mesh files for each reader, then
+# streams of every codec made from them with the first six bytes (magic,
+# version, codec id) cut off, as the decode_* targets take them.
+# Run from the repository: bash fuzz/make_seeds.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release --bin meshcodec
+seeds=fuzz/seeds
+mkdir -p $seeds/{read_obj,read_ply,read_off,read_stl,read_m}
+python3 - "$seeds" <<'EOF'
+import math, struct, sys, os
+os.chdir(sys.argv[1])
+U, V = 8, 5
+pts = []
+for i in range(U):
+    for j in range(V):
+        a = 2 * math.pi * i / U; b = 2 * math.pi * j / V
+        r = 1 + 0.4 * math.cos(b)
+        pts.append((r * math.cos(a), r * math.sin(a), 0.4 * math.sin(b)))
+tris, quads = [], []
+for i in range(U):
+    for j in range(V):
+        a = i * V + j; b = ((i + 1) % U) * V + j; c = ((i + 1) % U) * V + (j + 1) % V; d = i * V + (j + 1) % V
+        quads.append((a, b, c, d)); tris += [(a, b, c), (a, c, d)]
+with open('read_obj/torus.obj', 'w') as f:
+    f.write('# torus\nmtllib none.mtl\no torus\n')
+    for p in pts: f.write('v %.6f %.6f %.6f\n' % p)
+    f.write('vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\ng ring\nusemtl a\ns 1\n')
+    for q in quads: f.write('f %d/1/1 %d/2/1 %d/3/1 %d/4/1\n' % tuple(x + 1 for x in q))
+with open('read_obj/negative.obj', 'w') as f:
+    f.write('v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 0 0 1 1.0\nf 1//1 2//1 4//1\nl 1 2\n')
+def ply_header(fmt, extra=''):
+    return ('ply\nformat %s 1.0\ncomment seed\nelement vertex %d\nproperty float x\nproperty float y\n'
+            'property float z\n%selement face %d\nproperty list uchar int vertex_indices\nend_header\n'
+            % (fmt, len(pts), extra, len(tris))).encode()
+with open('read_ply/torus-ascii.ply', 'wb') as f:
+    f.write(ply_header('ascii', 'property uchar red\n'))
+    for p in pts: f.write(b'%f %f %f 200\n' % p)
+    for t in tris: f.write(b'3 %d %d %d\n' % t)
+for name, end in (('le', '<'), ('be', '>')):
+    with open('read_ply/torus-binary-%s.ply' % name, 'wb') as f:
+        f.write(ply_header('binary_little_endian' if end == '<' else 'binary_big_endian'))
+        for p in pts: f.write(struct.pack(end + 'fff', *p))
+        for t in tris: f.write(struct.pack(end + 'Biii', 3, *t))
+with open('read_ply/quad-double.ply', 'wb') as f:
+    f.write(b'ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty double x\nproperty double y\n'
+            b'property double z\nelement face 1\nproperty list uint8 uint32 vertex_index\nend_header\n')
+    for p in ((0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)): f.write(struct.pack('<ddd', *p))
+    f.write(struct.pack('<BIIII', 4, 0, 1, 2, 3))
+with open('read_off/torus.off', 'w') as f:
+    f.write('OFF\n# comment\n%d %d 0\n' % (len(pts), len(quads)))
+    for p in pts: f.write('%f %f %f\n' % p)
+    for q in quads: f.write('4 %d %d %d %d\n' % q)
+with open('read_off/colour.off', 'w') as f:
+    f.write('COFF\n4 2 5\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n1 1 0 0 0 255 255\n0 1 0 9 9 9 255\n'
+            '3 0 1 2 1 0 0\n3 0 2 3\n')
+with open('read_stl/torus-binary.stl', 'wb') as f:
+    f.write(b'seed'.ljust(80, b' ')); f.write(struct.pack('<I', len(tris)))
+    for t in tris:
+        f.write(struct.pack('<fff', 0, 0, 1))
+        for v in t: f.write(struct.pack('<fff', *pts[v]))
+        f.write(b'\0\0')
+with open('read_stl/triangle-ascii.stl', 'w') as f:
+    f.write('solid seed\n')
+    for t in tris[:6]:
+        f.write('  facet normal 0 0 1\n    outer loop\n')
+        for v in t: f.write('      vertex %f %f %f\n' % pts[v])
+        f.write('    endloop\n  endfacet\n')
+    f.write('endsolid seed\n')
+with open('read_m/torus.m', 'w') as f:
+    f.write('# seed\n')
+    for k, p in enumerate(pts): f.write('Vertex %d %f %f %f {normal=(0 0 1)}\n' % ((k + 1,) + p))
+    for k, t in enumerate(tris): f.write('Face %d %d %d %d\n' % ((k + 1,) + tuple(x + 1 for x in t)))
+EOF
+stream=$(mktemp)
+for codec in raw emc emc-paper pm pm-reordered; do
+  dir=$seeds/decode_${codec//-/_}
+  mkdir -p "$dir"
+  for mesh in $seeds/read_obj/torus.obj $seeds/read_off/colour.off; do
+    name=$(basename "$mesh"); name=${name%.*}
+    target/release/meshcodec encode --codec "$codec" --quant 10 "$mesh" "$stream" >/dev/null
+    tail -c +7 "$stream" > "$dir/$name.body"
+  done
+done
+rm -f "$stream"

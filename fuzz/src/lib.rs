@@ -1,0 +1,308 @@
+//! What the fuzz targets do with their input. `tests/fuzz_regressions.rs` includes this file and
+//! replays every saved input through the same functions, so a crash found here stays a test.
+//!
+//! A target fails (panics) only when meshcodec breaks a promise: a decoder or reader panics, a
+//! decoded mesh is not a valid mesh within the header's counts, or an encode → decode round trip
+//! is not lossless (DESIGN.md A2). Errors returned for bad input are the expected outcome.
+
+use arbitrary::{Arbitrary, Result as ArbitraryResult, Unstructured};
+use meshcodec::codecs::pm::iter::PMeshIter;
+use meshcodec::codecs::{self, EncodeOptions, LevelMesh, Stop};
+use meshcodec::container::{Header, FORMAT_VERSION, MAGIC};
+use meshcodec::limits;
+use meshcodec::mesh::quantize::GridShape;
+use meshcodec::mesh::{generate, io, TriMesh};
+use std::sync::OnceLock;
+
+/// The codecs, in the order of their `decode_*` targets.
+pub const CODECS: [&str; 5] = ["raw", "emc", "emc-paper", "pm", "pm-reordered"];
+
+/// Decodes `body` as everything after the first six bytes (magic, version, codec id) of a stream
+/// of codec `name`, so the fuzzer spends its effort on that codec's syntax.
+pub fn decode_as(name: &str, body: &[u8]) {
+    let id = codecs::by_name(name).expect("a registered codec").id();
+    let mut bytes = Vec::with_capacity(body.len() + 6);
+    bytes.extend_from_slice(&MAGIC);
+    bytes.push(FORMAT_VERSION);
+    bytes.push(id);
+    bytes.extend_from_slice(body);
+    decode_every_way(&bytes);
+}
+
+/// Decodes `bytes` level by level, checking every intermediate mesh and what a cut inside the
+/// next level gives; then stopped after a number of passes (EMC's partial levels) that the input's
+/// length picks; then through the PM iterator where the stream is PM's.
+pub fn decode_every_way(bytes: &[u8]) {
+    let Ok(mut decoder) = codecs::open(bytes) else {
+        return;
+    };
+    let header = decoder.header().clone();
+    loop {
+        match decoder.advance() {
+            Ok(true) => {
+                if let Ok(mesh) = decoder.mesh() {
+                    check_level_mesh(&mesh, &header);
+                }
+            }
+            Ok(false) => break,
+            Err(_) => return,
+        }
+    }
+    if decoder.advance_partial().is_ok() {
+        if let Ok(mesh) = decoder.mesh() {
+            check_level_mesh(&mesh, &header);
+        }
+    }
+    if let Ok((mesh, _)) = codecs::decode(bytes, Stop::Passes(1 + bytes.len() % 8)) {
+        check_level_mesh(&mesh, &header);
+    }
+    if codecs::by_id(header.codec_id).is_ok_and(|c| c.name().starts_with("pm")) {
+        walk_pm_iterator(bytes);
+    }
+}
+
+/// Steps a PM iterator forward, back, and to vertex and face counts, checking the mesh's
+/// adjacency after each move.
+fn walk_pm_iterator(bytes: &[u8]) {
+    let Ok(mut iter) = PMeshIter::from_stream(bytes) else {
+        return;
+    };
+    for _ in 0..64 {
+        match iter.next() {
+            Ok(true) => {}
+            Ok(false) | Err(_) => break,
+        }
+    }
+    iter.mesh()
+        .check_invariants()
+        .expect("PM iterator mesh after next()");
+    let forward = iter.nvertices();
+    while iter.prev() {}
+    iter.mesh()
+        .check_invariants()
+        .expect("PM iterator mesh after prev()");
+    if iter.goto_nvertices(forward / 2 + 1).is_ok() {
+        iter.mesh()
+            .check_invariants()
+            .expect("after goto_nvertices");
+    }
+    if iter.goto_nfaces(usize::MAX).is_ok() {
+        iter.mesh().check_invariants().expect("after goto_nfaces");
+    }
+}
+
+/// A decoded mesh must index only its own vertices, have finite positions, no degenerate
+/// triangles, and stay within the counts its header declared (an EMC level may list a few more
+/// triangles than the full mesh has, up to [`limits::level_triangles`]).
+pub fn check_level_mesh(level: &LevelMesh, header: &Header) {
+    let mesh = &level.mesh;
+    let n = mesh.positions.len();
+    assert!(
+        n as u64 <= header.vertices,
+        "{n} vertices decoded, header declares {}",
+        header.vertices
+    );
+    assert!(
+        mesh.faces.len() <= limits::level_triangles(header.triangles),
+        "{} triangles decoded, header declares {}",
+        mesh.faces.len(),
+        header.triangles
+    );
+    assert!(mesh.positions.iter().all(|p| p.is_finite()));
+    for face in &mesh.faces {
+        assert!(face.iter().all(|&v| (v as usize) < n), "{face:?} of {n}");
+        assert!(
+            face[0] != face[1] && face[1] != face[2] && face[0] != face[2],
+            "degenerate triangle {face:?}"
+        );
+    }
+    for edge in &level.loose_edges {
+        assert!(edge.iter().all(|&v| (v as usize) < n) && edge[0] != edge[1]);
+    }
+}
+
+/// Reads `bytes` as a mesh file of `format`; a mesh that reads must be valid.
+pub fn read_as(format: &str, bytes: &[u8]) {
+    if let Ok(mesh) = io::read_mesh_bytes(bytes, format) {
+        mesh.validate().expect("a mesh the reader accepted");
+    }
+}
+
+/// One edit of a valid stream.
+#[derive(Arbitrary, Debug)]
+pub enum Mutation {
+    /// Flips one bit.
+    Flip { at: u32, bit: u8 },
+    /// Overwrites one byte.
+    Set { at: u32, byte: u8 },
+    /// Cuts the stream.
+    Cut { at: u32 },
+    /// Inserts bytes.
+    Insert { at: u32, bytes: Vec<u8> },
+    /// Removes a range.
+    Remove { at: u32, len: u16 },
+    /// Copies a range of another valid stream over this one (splices two codecs' syntax).
+    Splice {
+        from_stream: u8,
+        from: u32,
+        at: u32,
+        len: u16,
+    },
+}
+
+/// Input of `decode_mutated`: which valid stream, and what to do to it.
+#[derive(Arbitrary, Debug)]
+pub struct MutatedStream {
+    /// Index into [`valid_streams`].
+    pub stream: u8,
+    /// Edits applied in order.
+    pub mutations: Vec<Mutation>,
+}
+
+/// Valid streams of every codec for a few small meshes (a torus, a sphere, a bumpy terrain with
+/// a boundary, and a non-manifold mesh for the codecs that take one), encoded once.
+pub fn valid_streams() -> &'static [Vec<u8>] {
+    static STREAMS: OnceLock<Vec<Vec<u8>>> = OnceLock::new();
+    STREAMS.get_or_init(|| {
+        let meshes = [
+            generate::torus(1.0, 0.4, 8, 5),
+            generate::icosphere(0),
+            generate::terrain(24, 7),
+            generate::messy(2),
+        ];
+        let mut streams = Vec::new();
+        for name in CODECS {
+            let codec = codecs::by_name(name).expect("registered");
+            for (mesh, bits) in meshes.iter().zip([12, 8, 10, 12]) {
+                let options = EncodeOptions {
+                    quant_bits: bits,
+                    grid: GridShape::Cubic,
+                };
+                let canonical = codecs::canonical_for(mesh, &options).expect("generated meshes");
+                if let Ok(encoded) = codec.encode(&canonical, &options) {
+                    streams.push(encoded.bytes);
+                }
+            }
+        }
+        streams
+    })
+}
+
+/// Applies `input`'s edits to one of the valid streams and decodes the result every way.
+pub fn decode_mutated(input: &MutatedStream) {
+    let streams = valid_streams();
+    let mut bytes = streams[input.stream as usize % streams.len()].clone();
+    for mutation in &input.mutations {
+        let at = |at: u32, len: usize| at as usize % (len + 1);
+        match mutation {
+            Mutation::Flip { at: a, bit } => {
+                if !bytes.is_empty() {
+                    let k = *a as usize % bytes.len();
+                    bytes[k] ^= 1 << (bit % 8);
+                }
+            }
+            Mutation::Set { at: a, byte } => {
+                if !bytes.is_empty() {
+                    let k = *a as usize % bytes.len();
+                    bytes[k] = *byte;
+                }
+            }
+            Mutation::Cut { at: a } => bytes.truncate(at(*a, bytes.len())),
+            Mutation::Insert {
+                at: a,
+                bytes: extra,
+            } => {
+                let k = at(*a, bytes.len());
+                bytes.splice(k..k, extra.iter().copied());
+            }
+            Mutation::Remove { at: a, len } => {
+                let k = at(*a, bytes.len());
+                let end = (k + *len as usize).min(bytes.len());
+                bytes.drain(k..end);
+            }
+            Mutation::Splice {
+                from_stream,
+                from,
+                at: a,
+                len,
+            } => {
+                let other = &streams[*from_stream as usize % streams.len()];
+                let from = at(*from, other.len());
+                let end = (from + *len as usize).min(other.len());
+                let k = at(*a, bytes.len());
+                let end_here = (k + (end - from)).min(bytes.len());
+                bytes.splice(k..end_here, other[from..end].iter().copied());
+            }
+        }
+    }
+    decode_every_way(&bytes);
+}
+
+/// A mesh built from fuzz input: positions on a small integer lattice (so that coincident and
+/// collinear vertices are common) and triangles over them.
+#[derive(Debug)]
+pub struct GeneratedMesh {
+    /// Quantization bits to encode with.
+    pub quant_bits: u8,
+    /// Grid shape to encode with.
+    pub grid: GridShape,
+    /// The mesh.
+    pub mesh: TriMesh,
+}
+
+impl<'a> Arbitrary<'a> for GeneratedMesh {
+    fn arbitrary(u: &mut Unstructured<'a>) -> ArbitraryResult<Self> {
+        let quant_bits = u.int_in_range(2..=16)?;
+        let grid = if u.arbitrary()? {
+            GridShape::Cubic
+        } else {
+            GridShape::PerAxis
+        };
+        let vertex_count = u.int_in_range(3..=64usize)?;
+        let scale = f64::from(u.int_in_range(1..=1000u16)?);
+        let mut positions = Vec::with_capacity(vertex_count);
+        for _ in 0..vertex_count {
+            let [x, y, z]: [i8; 3] = u.arbitrary()?;
+            positions.push(glam::DVec3::new(x.into(), y.into(), z.into()) * scale);
+        }
+        let face_count = u.int_in_range(1..=128usize)?;
+        let mut faces = Vec::with_capacity(face_count);
+        for _ in 0..face_count {
+            let mut face = [0u32; 3];
+            for v in &mut face {
+                *v = u.int_in_range(0..=vertex_count as u32 - 1)?;
+            }
+            faces.push(face);
+        }
+        Ok(GeneratedMesh {
+            quant_bits,
+            grid,
+            mesh: TriMesh::new(positions, faces),
+        })
+    }
+}
+
+/// Encodes `input` with every codec that accepts it and checks that the full decode is lossless
+/// (DESIGN.md A2) and that every level decodes to a valid mesh.
+pub fn round_trip(input: &GeneratedMesh) {
+    let options = EncodeOptions {
+        quant_bits: input.quant_bits,
+        grid: input.grid,
+    };
+    let Ok(canonical) = codecs::canonical_for(&input.mesh, &options) else {
+        return;
+    };
+    for codec in codecs::registry() {
+        let encoded = match codec.encode(&canonical, &options) {
+            Ok(encoded) => encoded,
+            Err(meshcodec::Error::Unsupported(_)) => continue,
+            Err(e) => panic!("{}: encoding failed: {e}", codec.name()),
+        };
+        let (decoded, _) = codecs::decode(&encoded.bytes, Stop::All)
+            .unwrap_or_else(|e| panic!("{}: own stream does not decode: {e}", codec.name()));
+        if let Err(why) = canonical.check_lossless(&decoded.mesh) {
+            panic!("{}: not lossless: {why}", codec.name());
+        }
+        decode_every_way(&encoded.bytes);
+    }
+}

@@ -1,0 +1,87 @@
+//! Replays the fuzz targets' inputs through the same functions the targets call
+//! (fuzz/src/lib.rs): every crash the fuzzers found, as a named test, then every seed and saved
+//! regression input. See FUZZING.md.
+
+#[path = "../fuzz/src/lib.rs"]
+#[allow(dead_code)]
+mod exercise;
+
+use arbitrary::{Arbitrary, Unstructured};
+use std::path::{Path, PathBuf};
+
+/// Runs one input of fuzz target `target` as the target would.
+fn replay(target: &str, bytes: &[u8]) {
+    match target {
+        "decode_mutated" => {
+            if let Ok(input) =
+                exercise::MutatedStream::arbitrary_take_rest(Unstructured::new(bytes))
+            {
+                exercise::decode_mutated(&input);
+            }
+        }
+        "roundtrip" => {
+            if let Ok(input) =
+                exercise::GeneratedMesh::arbitrary_take_rest(Unstructured::new(bytes))
+            {
+                exercise::round_trip(&input);
+            }
+        }
+        _ => {
+            if let Some(codec) = target.strip_prefix("decode_") {
+                exercise::decode_as(&codec.replace('_', "-"), bytes);
+            } else if let Some(format) = target.strip_prefix("read_") {
+                exercise::read_as(format, bytes);
+            } else {
+                panic!("no fuzz target called {target}");
+            }
+        }
+    }
+}
+
+fn fuzz_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz")
+}
+
+fn replay_file(target: &str, name: &str) {
+    let path = fuzz_dir().join("regressions").join(target).join(name);
+    let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    replay(target, &bytes);
+}
+
+/// One test per crash found, named after what was wrong.
+macro_rules! regressions {
+    ($($test:ident: $target:literal / $file:literal;)*) => {
+        $(
+            #[test]
+            fn $test() {
+                replay_file($target, $file);
+            }
+        )*
+    };
+}
+
+regressions! {
+    emc_header_declaring_no_vertices_is_refused: "decode_emc" / "header-declares-no-vertices";
+    pm_base_mesh_with_a_non_manifold_vertex_is_refused: "decode_pm" / "non-manifold-base-mesh";
+    obj_texture_index_past_the_list_is_refused: "read_obj" / "texture-index-overflows-in-tobj";
+}
+
+#[test]
+fn every_seed_and_regression_input_replays_cleanly() {
+    let mut replayed = 0;
+    for kind in ["seeds", "regressions"] {
+        let Ok(targets) = std::fs::read_dir(fuzz_dir().join(kind)) else {
+            continue;
+        };
+        for target in targets {
+            let target = target.unwrap().path();
+            let name = target.file_name().unwrap().to_string_lossy().into_owned();
+            for input in std::fs::read_dir(&target).unwrap() {
+                let bytes = std::fs::read(input.unwrap().path()).unwrap();
+                replay(&name, &bytes);
+                replayed += 1;
+            }
+        }
+    }
+    assert!(replayed >= 20, "only {replayed} inputs found under fuzz/");
+}
