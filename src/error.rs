@@ -96,3 +96,22 @@ pub fn exit_code(outcome: anyhow::Result<()>) -> std::process::ExitCode {
         }
     }
 }
+
+/// Writes `text` to standard output for a binary. A reader that has gone away (`meshcodec info
+/// s.mc | head -1`) is not an error: the rest is dropped, where `println!` would panic.
+pub fn write_stdout(text: &str) -> std::io::Result<()> {
+    use std::io::Write as _;
+    match std::io::stdout().lock().write_all(text.as_bytes()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        other => other,
+    }
+}
+
+/// `println!` for the binaries, through [`write_stdout`]; use inside a function returning a
+/// `Result` whose error takes an `std::io::Error`.
+#[macro_export]
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        $crate::error::write_stdout(&format!("{}\n", format_args!($($arg)*)))?
+    };
+}

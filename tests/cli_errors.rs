@@ -222,3 +222,23 @@ fn emc_commands_work_on_every_shared_mesh() {
         assert!(coarse.vertex_count() <= full.vertex_count());
     }
 }
+
+#[test]
+fn a_reader_that_goes_away_is_no_panic() {
+    // `meshcodec distance --json | head -1`: the reader closes the pipe before the output ends.
+    let dir = scratch();
+    for _ in 0..5 {
+        let mut child = Command::new(MESHCODEC)
+            .args(["distance", "--json", "--samples", "2", "eight", "eight"])
+            .current_dir(dir.path())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{:?}: {stderr}", out.status);
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}

@@ -148,7 +148,7 @@ fn run_codec(
 ) -> Result<RunResult> {
     let harness::RunOutput { result, stream } =
         harness::run(codec, path, options).with_context(|| path.display().to_string())?;
-    println!(
+    meshcodec::outln!(
         "{} on {} ({}): {} vertices, {} triangles at {} bits; {} bytes = {:.3} bits/vertex, \
          {:.3} bits/triangle",
         result.codec,
@@ -162,7 +162,7 @@ fn run_codec(
         result.bits_per_triangle(),
     );
     print!("{}", harness::level_table(&result));
-    println!(
+    meshcodec::outln!(
         "encode {:.3} s, decode {:.4} s ({:.0} vertices/s); lossless: {}",
         result.encode_seconds,
         result.decode_seconds,
@@ -176,12 +176,12 @@ fn run_codec(
     let written = harness::write_result(&result, &stem, out)
         .with_context(|| format!("writing results to {}", out.display()))?;
     for path in written {
-        println!("wrote {}", path.display());
+        meshcodec::outln!("wrote {}", path.display());
     }
     if keep_stream {
         let path = out.join(&result.codec).join(format!("{stem}.mc"));
         meshcodec::mesh::io::write_atomically(&path, &stream)?;
-        println!("wrote {}", path.display());
+        meshcodec::outln!("wrote {}", path.display());
     }
     if !result.lossless {
         anyhow::bail!("{} on {} is not lossless", result.codec, result.mesh);
@@ -221,7 +221,7 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
     };
     let set_name = mesh_name(file);
     if !set.description.is_empty() {
-        println!("{set_name}: {}", set.description);
+        meshcodec::outln!("{set_name}: {}", set.description);
     }
     let mut summary = Vec::new();
     for path in &paths {
@@ -243,7 +243,7 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
                             &file,
                             format!("{why}\n").as_bytes(),
                         )?;
-                        println!("{} refused {name}: {why}", codec.name());
+                        meshcodec::outln!("{} refused {name}: {why}", codec.name());
                     }
                     Err(e) => return Err(e),
                 }
@@ -258,15 +258,21 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
         let title = format!("{name} ({set_name})");
         plot::rate_resolution(&runs, &title).draw(&dir.join(format!("{name}-rate-resolution")))?;
         plot::rate_distortion(&runs, &title).draw(&dir.join(format!("{name}-rate-distortion")))?;
-        println!("wrote comparison charts to {}", dir.display());
+        meshcodec::outln!("wrote comparison charts to {}", dir.display());
         summary.extend(runs);
     }
-    println!(
+    meshcodec::outln!(
         "\n{:<10} {:<22} {:>5} {:>10} {:>9} {:>9} {:>9}",
-        "codec", "mesh", "quant", "bytes", "bpv", "bpt", "lossless"
+        "codec",
+        "mesh",
+        "quant",
+        "bytes",
+        "bpv",
+        "bpt",
+        "lossless"
     );
     for r in &summary {
-        println!(
+        meshcodec::outln!(
             "{:<10} {:<22} {:>5} {:>10} {:>9.3} {:>9.3} {:>9}",
             r.codec,
             r.mesh,
@@ -293,10 +299,10 @@ fn tables(results: &Path, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).with_context(|| out.display().to_string())?;
     let (written, missing) = meshcodec::tables::regenerate(results, out);
     for path in &written {
-        println!("wrote {}", path.display());
+        meshcodec::outln!("wrote {}", path.display());
     }
     for why in &missing {
-        println!("skipped {why}");
+        meshcodec::outln!("skipped {why}");
     }
     if written.is_empty() {
         anyhow::bail!("no table could be made from {}", results.display());
@@ -341,7 +347,7 @@ fn decimation(out: &Path) -> Result<()> {
         let pm = progressive_mesh(&canonical.faces, &simplified);
         let total_seconds = started.elapsed().as_secs_f64();
         let faces = canonical.face_count();
-        println!(
+        meshcodec::outln!(
             "{name} x{}: {faces} faces -> base {} vertices; simplify {simplify_seconds:.2} s, with PM construction {total_seconds:.2} s ({:.0} faces/s)",
             4u32.pow(times),
             pm.base.positions.len(),
@@ -367,6 +373,6 @@ fn decimation(out: &Path) -> Result<()> {
         &path,
         format!("{}\n", serde_json::to_string_pretty(&report)?).as_bytes(),
     )?;
-    println!("wrote {}", path.display());
+    meshcodec::outln!("wrote {}", path.display());
     Ok(())
 }

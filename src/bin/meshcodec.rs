@@ -153,7 +153,7 @@ fn encode(
         .with_context(|| path.display().to_string())?;
     write_atomically(output, &encoded.bytes).with_context(|| output.display().to_string())?;
     let bits = encoded.bytes.len() as f64 * 8.0;
-    println!(
+    meshcodec::outln!(
         "{}: {} vertices, {} triangles at {} bits -> {} bytes in {} levels ({:.3} bits/vertex, {:.3} bits/triangle)",
         output.display(),
         canonical.vertex_count(),
@@ -195,7 +195,7 @@ fn decode(
         );
     }
     write_mesh(&decoded.mesh, output).with_context(|| output.display().to_string())?;
-    println!(
+    meshcodec::outln!(
         "{}: level {levels}, {} vertices, {} triangles from {} bytes",
         output.display(),
         decoded.mesh.vertex_count(),
@@ -246,7 +246,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "levels": levels,
     });
     if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        meshcodec::outln!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
     let mut text = String::new();
@@ -293,7 +293,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
             cell("triangles")
         );
     }
-    print!("{text}");
+    meshcodec::error::write_stdout(&text)?;
     Ok(())
 }
 
@@ -347,26 +347,33 @@ fn distance(
         "hausdorff_paper": m.paper,
     });
     if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        meshcodec::outln!("{}", serde_json::to_string_pretty(&report)?);
         return Ok(());
     }
-    println!(
+    meshcodec::outln!(
         "A = {} , B = {} (diagonal of A {:.6e})",
         path_a.display(),
         path_b.display(),
         diag
     );
-    println!(
+    meshcodec::outln!(
         "{:<8} {:>10} {:>13} {:>13} {:>13}",
-        "", "samples", "max", "mean", "rms"
+        "",
+        "samples",
+        "max",
+        "mean",
+        "rms"
     );
     for (name, s) in [("A -> B", m.forward), ("B -> A", m.backward)] {
-        println!(
+        meshcodec::outln!(
             "{name:<8} {:>10} {:>13.6e} {:>13.6e} {:>13.6e}",
-            s.samples, s.max, s.mean, s.rms
+            s.samples,
+            s.max,
+            s.mean,
+            s.rms
         );
     }
-    println!(
+    meshcodec::outln!(
         "Hausdorff {hausdorff:.6e} ({:.6e} of diagonal), RMS {rms:.6e} ({:.6e} of diagonal)",
         hausdorff / diag,
         rms / diag
