@@ -7,6 +7,10 @@ cd "$(dirname "$0")/.."
 if ! cargo fuzz --version >/dev/null 2>&1; then
   cargo install cargo-fuzz --version 0.13.2 --locked
 fi
+# The committed corpus is one archive (fuzz/corpus.tar.xz); work on it unpacked.
+if [ ! -d fuzz/corpus ] && [ -f fuzz/corpus.tar.xz ]; then
+  tar -C fuzz -xJf fuzz/corpus.tar.xz
+fi
 export RUSTC_BOOTSTRAP=1 # cargo-fuzz passes -Z flags; this lets the stable toolchain take them
 cargo fuzz build -s none
 bin=fuzz/target/x86_64-unknown-linux-gnu/release

@@ -13,6 +13,10 @@ targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
   mapfile -t targets < <(cd fuzz/fuzz_targets && ls *.rs | sed 's/\.rs$//')
 fi
+# The committed corpus is one archive (fuzz/corpus.tar.xz); work on it unpacked.
+if [ ! -d fuzz/corpus ] && [ -f fuzz/corpus.tar.xz ]; then
+  tar -C fuzz -xJf fuzz/corpus.tar.xz
+fi
 export RUSTC_BOOTSTRAP=1 # cargo-fuzz passes -Z flags; this lets the stable toolchain take them
 cargo fuzz build -s none
 # The binaries are run directly, so that editing the sources meanwhile rebuilds nothing.

@@ -178,15 +178,21 @@ def test_mutated_streams_decode_or_fail_in_one_line(codec, streams, tmp_path):
 def test_random_bytes_fail_in_one_line(tmp_path):
     rng = random.Random("random-bytes")
     stream, mesh = tmp_path / "in.mc", tmp_path / "out.obj"
+    decoded, slowest, largest = 0, 0.0, 0
     for case in range(CASES):
         # Half of them start like a stream, so that they reach the header's fields and levels.
         data = rng.randbytes(rng.randint(0, 4096))
         if case % 2:
             data = b"MshC\x01" + bytes([case % 6]) + data
         stream.write_bytes(data)
-        code, _, _ = check_outcome(f"random-case{case}", ["decode", stream, mesh], data, ".mc", tmp_path)
+        code, seconds, peak = check_outcome(
+            f"random-case{case}", ["decode", stream, mesh], data, ".mc", tmp_path
+        )
         if code == 0:
             check_obj(mesh)
+            decoded += 1
+        slowest, largest = max(slowest, seconds), max(largest, peak)
+    print(f"random bytes: {decoded}/{CASES} decoded, slowest {slowest:.3f} s, peak {largest >> 20} MiB")
 
 
 @pytest.mark.parametrize("name,cases", READER_MESHES)
@@ -196,12 +202,13 @@ def test_mutated_mesh_files_read_or_fail_in_one_line(name, cases, tmp_path):
     suffix = Path(name).suffix
     textual = suffix in (".obj", ".off", ".m") or original.startswith(b"ply\nformat ascii")
     path, out = tmp_path / f"in{suffix}", tmp_path / "out.mc"
-    read = 0
+    read, slowest, largest = 0, 0.0, 0
     for case in range(cases):
         data = mutate_text(original, rng) if textual and case % 2 else mutate(original, rng)
         path.write_bytes(data)
-        code, _, _ = check_outcome(
+        code, seconds, peak = check_outcome(
             f"{Path(name).stem}-case{case}", ["encode", "--codec", "raw", path, out], data, suffix, tmp_path
         )
         read += code == 0
-    print(f"{name}: {read}/{cases} read")
+        slowest, largest = max(slowest, seconds), max(largest, peak)
+    print(f"{name}: {read}/{cases} read, slowest {slowest:.3f} s, peak {largest >> 20} MiB")

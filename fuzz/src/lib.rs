@@ -62,20 +62,28 @@ pub fn decode_every_way(bytes: &[u8]) {
 }
 
 /// Steps a PM iterator forward, back, and to vertex and face counts, checking the mesh's
-/// adjacency after each move.
+/// adjacency after each move; an iterator reading the same bytes as an input stream, level by
+/// level, must reach the same meshes.
 fn walk_pm_iterator(bytes: &[u8]) {
     let Ok(mut iter) = PMeshIter::from_stream(bytes) else {
+        assert!(PMeshIter::from_reader(bytes).is_err());
         return;
     };
+    let mut streamed = PMeshIter::from_reader(bytes).expect("the same bytes as a stream");
     for _ in 0..64 {
-        match iter.next() {
-            Ok(true) => {}
-            Ok(false) | Err(_) => break,
+        let (a, b) = (iter.next(), streamed.next());
+        assert_eq!(a.is_ok(), b.is_ok(), "from_stream {a:?}, from_reader {b:?}");
+        if !matches!(a, Ok(true)) {
+            break;
         }
     }
     iter.mesh()
         .check_invariants()
         .expect("PM iterator mesh after next()");
+    assert!(
+        iter.mesh() == streamed.mesh(),
+        "from_stream and from_reader differ"
+    );
     let forward = iter.nvertices();
     while iter.prev() {}
     iter.mesh()
