@@ -64,6 +64,7 @@ regressions! {
     emc_header_declaring_no_vertices_is_refused: "decode_emc" / "header-declares-no-vertices";
     pm_base_mesh_with_a_non_manifold_vertex_is_refused: "decode_pm" / "non-manifold-base-mesh";
     obj_texture_index_past_the_list_is_refused: "read_obj" / "texture-index-overflows-in-tobj";
+    ply_element_with_records_but_no_properties_is_refused: "read_ply" / "element-without-properties";
 }
 
 #[test]

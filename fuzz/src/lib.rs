@@ -200,7 +200,13 @@ pub fn valid_streams() -> &'static [Vec<u8>] {
 pub fn decode_mutated(input: &MutatedStream) {
     let streams = valid_streams();
     let mut bytes = streams[input.stream as usize % streams.len()].clone();
-    for mutation in &input.mutations {
+    mutate(&mut bytes, &input.mutations, streams);
+    decode_every_way(&bytes);
+}
+
+/// Applies `mutations` to `bytes` in order; splices copy from `others`.
+fn mutate(bytes: &mut Vec<u8>, mutations: &[Mutation], others: &[Vec<u8>]) {
+    for mutation in mutations {
         let at = |at: u32, len: usize| at as usize % (len + 1);
         match mutation {
             Mutation::Flip { at: a, bit } => {
@@ -234,7 +240,7 @@ pub fn decode_mutated(input: &MutatedStream) {
                 at: a,
                 len,
             } => {
-                let other = &streams[*from_stream as usize % streams.len()];
+                let other = &others[*from_stream as usize % others.len()];
                 let from = at(*from, other.len());
                 let end = (from + *len as usize).min(other.len());
                 let k = at(*a, bytes.len());
@@ -243,7 +249,6 @@ pub fn decode_mutated(input: &MutatedStream) {
             }
         }
     }
-    decode_every_way(&bytes);
 }
 
 /// A mesh built from fuzz input: positions on a small integer lattice (so that coincident and
@@ -256,6 +261,8 @@ pub struct GeneratedMesh {
     pub grid: GridShape,
     /// The mesh.
     pub mesh: TriMesh,
+    /// Edits of each codec's stream of the mesh, decoded after the lossless check.
+    pub mutations: Vec<Mutation>,
 }
 
 impl<'a> Arbitrary<'a> for GeneratedMesh {
@@ -286,12 +293,14 @@ impl<'a> Arbitrary<'a> for GeneratedMesh {
             quant_bits,
             grid,
             mesh: TriMesh::new(positions, faces),
+            mutations: u.arbitrary()?,
         })
     }
 }
 
 /// Encodes `input` with every codec that accepts it and checks that the full decode is lossless
-/// (DESIGN.md A2) and that every level decodes to a valid mesh.
+/// (DESIGN.md A2) and that every level decodes to a valid mesh; then decodes the stream again
+/// with the input's edits applied.
 pub fn round_trip(input: &GeneratedMesh) {
     let options = EncodeOptions {
         quant_bits: input.quant_bits,
@@ -312,5 +321,10 @@ pub fn round_trip(input: &GeneratedMesh) {
             panic!("{}: not lossless: {why}", codec.name());
         }
         decode_every_way(&encoded.bytes);
+        if !input.mutations.is_empty() {
+            let mut bytes = encoded.bytes;
+            mutate(&mut bytes, &input.mutations, valid_streams());
+            decode_every_way(&bytes);
+        }
     }
 }

@@ -7,7 +7,9 @@ use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 use glam::DVec3;
 use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{Property, PropertyAccess, PropertyAccessResult};
+use ply_rs_bw::ply::{
+    Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
+};
 
 /// One PLY element as we need it: a position, an index list, or neither.
 #[derive(Default)]
@@ -78,6 +80,9 @@ impl PropertyAccess for Record {
 
 pub fn read(bytes: &[u8]) -> Result<TriMesh> {
     let parser = Parser::<Record>::new();
+    if let Ok(header) = parser.read_ply_header(&mut &bytes[..]) {
+        check_counts(&header, bytes)?;
+    }
     let mut source = bytes;
     let ply = parser
         .read_ply(&mut source)
@@ -141,4 +146,46 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
 
 fn one_line(text: &str) -> String {
     text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// ply-rs allocates a record for every one an element's header line declares: an element with
+/// no properties reads no bytes, so "element x 100000000" becomes gigabytes from a tiny file.
+/// Each record is refused before reading unless the bytes after the header can hold it: in
+/// binary files its scalars and list lengths, in ASCII at least a digit and a separator a
+/// property.
+fn check_counts(header: &Header, bytes: &[u8]) -> Result<()> {
+    let Some(at) = bytes.windows(10).position(|w| w == b"end_header") else {
+        return Ok(()); // ply-rs refuses the file itself
+    };
+    let body = bytes.len() - at;
+    let size = |t: &ScalarType| match t {
+        ScalarType::Char | ScalarType::UChar => 1,
+        ScalarType::Short | ScalarType::UShort => 2,
+        ScalarType::Int | ScalarType::UInt | ScalarType::Float => 4,
+        ScalarType::Double => 8,
+    };
+    let mut needed = 0u128;
+    for element in header.elements.values() {
+        if element.count > 0 && element.properties.is_empty() {
+            return Err(Error::mesh(format!(
+                "PLY: element '{}' declares {} records but no properties",
+                element.name, element.count
+            )));
+        }
+        let record: usize = element
+            .properties
+            .values()
+            .map(|p| match (&header.encoding, &p.data_type) {
+                (Encoding::Ascii, _) => 2,
+                (_, PropertyType::Scalar(t)) | (_, PropertyType::List(t, _)) => size(t),
+            })
+            .sum();
+        needed += element.count as u128 * record as u128;
+    }
+    if needed > body as u128 {
+        return Err(Error::Truncated(format!(
+            "PLY header declares records of at least {needed} bytes but {body} bytes follow it"
+        )));
+    }
+    Ok(())
 }
