@@ -320,6 +320,16 @@ pub fn round_trip(input: &GeneratedMesh) {
         if let Err(why) = canonical.check_lossless(&decoded.mesh) {
             panic!("{}: not lossless: {why}", codec.name());
         }
+        // Every level of a stream an encoder wrote must show, within the decoders' limits.
+        {
+            let mut decoder = codecs::open(&encoded.bytes).expect("own stream opens");
+            while decoder.advance().expect("own stream decodes") {
+                if let Err(e) = decoder.mesh() {
+                    let level = decoder.levels_decoded();
+                    panic!("{}: level {level} of its own stream: {e}", codec.name());
+                }
+            }
+        }
         decode_every_way(&encoded.bytes);
         if !input.mutations.is_empty() {
             let mut bytes = encoded.bytes;
