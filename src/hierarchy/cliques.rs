@@ -49,19 +49,9 @@ fn triangles_by_merge(adjacency: &[Vec<u32>], limit: usize) -> Option<Vec<[u32; 
         let above_a = &around_a[around_a.partition_point(|&x| x <= a)..];
         for (i, &b) in above_a.iter().enumerate() {
             let around_b = &adjacency[b as usize];
-            // c > b and adjacent to both: intersect two sorted lists.
-            let (mut p, mut q) = (i + 1, around_b.partition_point(|&x| x <= b));
-            while p < above_a.len() && q < around_b.len() {
-                match above_a[p].cmp(&around_b[q]) {
-                    std::cmp::Ordering::Less => p += 1,
-                    std::cmp::Ordering::Greater => q += 1,
-                    std::cmp::Ordering::Equal => {
-                        out.push([a, b, above_a[p]]);
-                        p += 1;
-                        q += 1;
-                    }
-                }
-            }
+            // c > b and adjacent to both.
+            let above_b = &around_b[around_b.partition_point(|&x| x <= b)..];
+            for_each_common(&above_a[i + 1..], above_b, |c| out.push([a, b, c]));
             if out.len() > limit {
                 return None;
             }
@@ -95,24 +85,11 @@ fn triangles_by_degree_rank(adjacency: &[Vec<u32>], limit: usize) -> Option<Vec<
         let above_u = &higher[u];
         for (i, &rw) in above_u.iter().enumerate() {
             let above_w = &higher[by_degree[rw as usize] as usize];
-            let (mut p, mut q) = (i + 1, 0);
-            while p < above_u.len() && q < above_w.len() {
-                match above_u[p].cmp(&above_w[q]) {
-                    std::cmp::Ordering::Less => p += 1,
-                    std::cmp::Ordering::Greater => q += 1,
-                    std::cmp::Ordering::Equal => {
-                        let mut t = [
-                            u as u32,
-                            by_degree[rw as usize],
-                            by_degree[above_u[p] as usize],
-                        ];
-                        t.sort_unstable();
-                        out.push(t);
-                        p += 1;
-                        q += 1;
-                    }
-                }
-            }
+            for_each_common(&above_u[i + 1..], above_w, |rx| {
+                let mut t = [u as u32, by_degree[rw as usize], by_degree[rx as usize]];
+                t.sort_unstable();
+                out.push(t);
+            });
             if out.len() > limit {
                 return None;
             }
@@ -120,6 +97,22 @@ fn triangles_by_degree_rank(adjacency: &[Vec<u32>], limit: usize) -> Option<Vec<
     }
     out.sort_unstable();
     Some(out)
+}
+
+/// Calls `found` with every value in both ascending lists.
+fn for_each_common(a: &[u32], b: &[u32], mut found: impl FnMut(u32)) {
+    let (mut p, mut q) = (0, 0);
+    while p < a.len() && q < b.len() {
+        match a[p].cmp(&b[q]) {
+            std::cmp::Ordering::Less => p += 1,
+            std::cmp::Ordering::Greater => q += 1,
+            std::cmp::Ordering::Equal => {
+                found(a[p]);
+                p += 1;
+                q += 1;
+            }
+        }
+    }
 }
 
 /// Numbers the edges of a graph: edge (a, b) with a < b gets `first[a]` + the rank of b among

@@ -3,6 +3,7 @@
 //! the edges.
 
 use crate::codecs::LevelMesh;
+use crate::container::Header;
 use crate::hierarchy::cliques::{
     loose_edges, oriented, propagate_orientation, triangles as list_triangles,
 };
@@ -43,6 +44,8 @@ pub struct EmcState {
     pub next_split: Vec<u16>,
     /// Sorted neighbour lists (ids are positions in the vertex list).
     pub adjacency: Vec<Vec<u32>>,
+    /// Edges of the graph (each counted once).
+    edges: u64,
 }
 
 impl EmcState {
@@ -55,6 +58,7 @@ impl EmcState {
             depth: vec![0],
             next_split: vec![if total_vertices >= 2 { 0 } else { NO_SPLIT }],
             adjacency: vec![Vec::new()],
+            edges: 0,
         }
     }
 
@@ -112,10 +116,12 @@ impl EmcState {
                     around.push(r);
                     kept.push(n);
                     moved.push(n);
+                    self.edges += 1;
                 }
             }
         }
         if connecting {
+            self.edges += 1;
             kept.push(r);
             let at = moved.partition_point(|&x| x < v as u32);
             moved.insert(at, v as u32);
@@ -123,6 +129,32 @@ impl EmcState {
         self.adjacency[v] = kept;
         self.adjacency.push(moved);
         r as usize
+    }
+
+    /// An error once the graph has more edges than a mesh of `triangles` (the header's count)
+    /// can have ([`limits::graph_edges`]): a decoder's bound on what a stream may build.
+    pub fn check_edges(&self, triangles: u64) -> Result<(), String> {
+        if self.edges > limits::graph_edges(triangles) {
+            return Err(format!(
+                "more edges than the {triangles} triangles the header declares can have"
+            ));
+        }
+        Ok(())
+    }
+
+    /// What a decoder shows after the levels decoded so far: `full` once the last level's
+    /// corrections are read, else the level's cliques (bounded by the header's triangles).
+    pub fn shown_mesh(
+        &self,
+        full: Option<&LevelMesh>,
+        header: &Header,
+    ) -> crate::Result<LevelMesh> {
+        match full {
+            Some(mesh) => Ok(mesh.clone()),
+            None => self
+                .level_mesh(&header.grid, header.triangles)
+                .map_err(crate::Error::Limit),
+        }
     }
 
     /// Position of every vertex: the centre of its cell at the resolution it has reached.

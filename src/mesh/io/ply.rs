@@ -6,7 +6,7 @@
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 use glam::DVec3;
-use ply_rs_bw::parser::Parser;
+use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{
     Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
 };
@@ -80,16 +80,15 @@ impl PropertyAccess for Record {
 
 pub fn read(bytes: &[u8]) -> Result<TriMesh> {
     let parser = Parser::<Record>::new();
-    if let Ok(header) = parser.read_ply_header(&mut &bytes[..]) {
-        check_counts(&header, bytes)?;
-    }
-    let mut source = bytes;
-    let ply = parser
-        .read_ply(&mut source)
-        // ply-rs reports over several lines; errors here are one line (DESIGN.md A6).
-        .map_err(|e| Error::mesh(format!("PLY: {}", one_line(&e.to_string()))))?;
-    let vertex_def = ply
-        .header
+    // ply-rs reports over several lines; errors here are one line (DESIGN.md A6).
+    let fault = |e: ply_rs_bw::parser::ParseError| {
+        Error::mesh(format!("PLY: {}", one_line(&e.to_string())))
+    };
+    let mut reader = Reader::new(bytes);
+    let header = parser.read_header(&mut reader).map_err(fault)?;
+    check_counts(&header, bytes)?;
+    let payload = parser.read_payload(&mut reader, &header).map_err(fault)?;
+    let vertex_def = header
         .elements
         .get("vertex")
         .ok_or_else(|| Error::mesh("PLY: no vertex element"))?;
@@ -98,8 +97,7 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
             return Err(Error::mesh(format!("PLY: vertex has no '{axis}' property")));
         }
     }
-    let positions: Vec<DVec3> = ply
-        .payload
+    let positions: Vec<DVec3> = payload
         .get("vertex")
         .map(|v| v.iter().map(|r| DVec3::from(r.xyz)).collect())
         .unwrap_or_default();
@@ -114,7 +112,7 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
         }
     };
     let mut faces = Vec::new();
-    for record in ply.payload.get("face").into_iter().flatten() {
+    for record in payload.get("face").into_iter().flatten() {
         let polygon = record
             .indices
             .iter()
@@ -122,7 +120,7 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
             .collect::<Result<Vec<u32>>>()?;
         super::text::fan(&polygon, &mut faces);
     }
-    for record in ply.payload.get("tristrips").into_iter().flatten() {
+    for record in payload.get("tristrips").into_iter().flatten() {
         for strip in record.indices.split(|&i| i < 0) {
             let strip = strip
                 .iter()

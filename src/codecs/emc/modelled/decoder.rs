@@ -147,13 +147,8 @@ impl LevelDecoder for EmcDecoder<'_> {
     }
 
     fn mesh(&self) -> Result<LevelMesh> {
-        match &self.final_mesh {
-            Some(mesh) => Ok(mesh.clone()),
-            None => self
-                .walker
-                .state
-                .level_mesh(&self.header.grid, self.header.triangles)
-                .map_err(Error::Limit),
-        }
+        self.walker
+            .state
+            .shown_mesh(self.final_mesh.as_ref(), &self.header)
     }
 }

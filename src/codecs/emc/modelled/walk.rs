@@ -85,8 +85,6 @@ pub struct Walker {
     pub state: EmcState,
     /// Known to be a single mesh vertex (no further split).
     pub leaf: Vec<bool>,
-    /// Edges of the graph now (the decoder bounds it by the header's triangles).
-    pub edges: u64,
     pub contexts: Box<Contexts>,
     /// For each depth, the shift from the cell prefix to the full grid per axis.
     shifts: Vec<[u8; 3]>,
@@ -104,7 +102,6 @@ impl Walker {
         let mut walker = Walker {
             state: EmcState::new(order, vertices),
             leaf: vec![vertices <= 1],
-            edges: 0,
             contexts: Box::default(),
             shifts,
             centres: Vec::new(),
@@ -327,15 +324,10 @@ impl Walker {
             };
             codes.push(code);
         }
-        self.edges += duplicates as u64 + connecting as u64;
-        if self.edges > crate::limits::graph_edges(max_triangles) {
-            return Err(Stop::Fault(format!(
-                "more edges than the {max_triangles} triangles the header declares can have"
-            )));
-        }
         let r = self
             .state
             .split(v, step, connecting, &codes, [NO_SPLIT, NO_SPLIT]);
+        self.state.check_edges(max_triangles).map_err(Stop::Fault)?;
         self.refresh(v);
         self.refresh(r);
         self.codes = codes;

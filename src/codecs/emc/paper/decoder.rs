@@ -2,21 +2,18 @@
 //! from a cut payload too: every vertex operation is read whole before it is applied, so a cut
 //! leaves the state after the last complete operation.
 
-use super::super::state::{EdgeCode, EmcState, FaceCorrections, NO_SPLIT};
+use super::super::state::{EmcState, FaceCorrections, NO_SPLIT};
 use super::syntax;
 use crate::codecs::{LevelDecoder, LevelMesh};
 use crate::coding::BitSource;
 use crate::container::{Header, LevelPayload, StreamReader};
 use crate::error::{Error, Result};
-use crate::limits;
 
 pub struct EmcDecoder<'a> {
     stream: StreamReader<'a>,
     header: Header,
     state: EmcState,
     levels_done: usize,
-    /// Edges of the graph now, bounded by the header's triangles.
-    edges: u64,
     /// The full mesh once the last level's corrections are read.
     final_mesh: Option<LevelMesh>,
 }
@@ -37,7 +34,6 @@ impl<'a> EmcDecoder<'a> {
             header,
             stream,
             levels_done: 0,
-            edges: 0,
             final_mesh: None,
         }
     }
@@ -79,14 +75,6 @@ impl<'a> EmcDecoder<'a> {
                 for _ in 0..degree {
                     codes.push(syntax::get_edge(&mut source).ok_or(Stop::OutOfBits)?);
                 }
-                let duplicates = codes.iter().filter(|&&c| c == EdgeCode::Duplicate).count();
-                self.edges += duplicates as u64 + connecting as u64;
-                if self.edges > limits::graph_edges(self.header.triangles) {
-                    return Err(fault(format!(
-                        "more edges than the {} triangles the header declares can have",
-                        self.header.triangles
-                    )));
-                }
                 let mut next = [NO_SPLIT; 2];
                 for slot in &mut next {
                     if let Some(d) = syntax::get_distance(&mut source).ok_or(Stop::OutOfBits)? {
@@ -99,6 +87,9 @@ impl<'a> EmcDecoder<'a> {
                     }
                 }
                 self.state.split(v, step, connecting, &codes, next);
+                self.state
+                    .check_edges(self.header.triangles)
+                    .map_err(fault)?;
             }
         }
         if level == order.levels as usize && passes >= 3 {
@@ -197,12 +188,7 @@ impl LevelDecoder for EmcDecoder<'_> {
     }
 
     fn mesh(&self) -> Result<LevelMesh> {
-        match &self.final_mesh {
-            Some(mesh) => Ok(mesh.clone()),
-            None => self
-                .state
-                .level_mesh(&self.header.grid, self.header.triangles)
-                .map_err(Error::Limit),
-        }
+        self.state
+            .shown_mesh(self.final_mesh.as_ref(), &self.header)
     }
 }
