@@ -191,6 +191,34 @@ impl PmMesh {
         out
     }
 
+    /// The first face around `v`, from `f` in the order of [`PmMesh::fan`], that `wanted`
+    /// accepts; walks no further than that face.
+    pub fn find_in_fan(&self, f: u32, v: u32, wanted: impl Fn(u32) -> bool) -> Option<u32> {
+        if wanted(f) {
+            return Some(f);
+        }
+        let mut steps = 0;
+        let mut g = self.ccw(f, v);
+        while g != NIL && g != f && steps <= self.faces.len() {
+            if wanted(g) {
+                return Some(g);
+            }
+            g = self.ccw(g, v);
+            steps += 1;
+        }
+        if g == NIL {
+            let mut g = self.cw(f, v);
+            while g != NIL && steps <= self.faces.len() {
+                if wanted(g) {
+                    return Some(g);
+                }
+                g = self.cw(g, v);
+                steps += 1;
+            }
+        }
+        None
+    }
+
     /// Sets the neighbour of `f` across its edge (previous corner, `v`).
     fn set_nei_before(&mut self, f: u32, v: u32, to: u32) {
         if f != NIL {

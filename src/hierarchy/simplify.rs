@@ -1,18 +1,20 @@
 //! Garland–Heckbert quadric error simplification by edge collapses, and the progressive mesh it
 //! defines (Hoppe: base mesh M⁰ plus the vertex splits that undo the collapses in reverse).
 //!
-//! Collapses are taken cheapest first from a binary heap with lazy invalidation (a per-vertex
-//! version stamp), so simplification is O(f log f). A collapse must keep the mesh a manifold
+//! Collapses are taken cheapest first from an indexed 4-ary heap of edges (each edge's key is
+//! updated in place when a collapse changes it, so the heap never holds stale entries), and
+//! simplification is O(f log f). Each vertex keeps its faces and its edges, so a check reads
+//! only the two endpoints' lists. A collapse must keep the mesh a manifold
 //! (link condition; no interior edge between two boundary vertices; no two faces on the same
 //! three vertices), must not flip a face's normal, and keeps boundaries through constraint
 //! quadrics on boundary edges. When the heap runs dry, every edge is queued again, until a
 //! whole pass collapses nothing: the base mesh is then as small as these rules allow.
 
 use super::pmesh::{anchor, PmMesh, Rotation, Vsplit, NIL};
-use dary_heap::QuaternaryHeap as BinaryHeap;
 use glam::DVec3;
+use orx_priority_queue::{PriorityQueue, PriorityQueueDecKey, QuaternaryHeapOfIndices};
 use rayon::prelude::*;
-use std::cmp::Ordering;
+use smallvec::SmallVec;
 
 /// Where a collapse puts the remaining vertex.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -127,29 +129,10 @@ pub struct Simplified {
     pub faces: Vec<[u32; 3]>,
 }
 
-/// A queued collapse: 16 bytes, so the heap of a million-face mesh stays cache-friendly. The
-/// cost is an f32 (ordering only), the stamps wrap (a wrapped stale entry is only re-checked).
-#[derive(PartialEq)]
-struct Candidate {
-    cost: f32,
-    a: u32,
-    b: u32,
-    stamps: (u16, u16),
-}
-impl Eq for Candidate {}
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Candidate {
-    fn cmp(&self, other: &Self) -> Ordering {
-        // Reversed: the heap pops the cheapest first; ties by vertex ids, for determinism.
-        other
-            .cost
-            .total_cmp(&self.cost)
-            .then_with(|| (other.a, other.b).cmp(&(self.a, self.b)))
-    }
+/// Heap key of an edge: its cost's bits above its id. Costs are never negative, so their bits
+/// order as the costs do; the id breaks ties, for determinism.
+fn heap_key(cost: f64, edge: u32) -> u64 {
+    (u64::from((cost as f32).to_bits()) << 32) | u64::from(edge)
 }
 
 /// Grid step of a split's small delta vad_s: positions between a collapse and its split need
@@ -165,14 +148,26 @@ fn to_f(c: [i32; 3]) -> DVec3 {
     DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
 }
 
+/// Faces or edges around one vertex: most vertices have few, kept inline.
+type Incident = SmallVec<[u32; 8]>;
+
+/// A collapse that passed the checks: (vs, vt, fl, fr, vl, vr) as in [`Collapse`].
+type Checked = (u32, u32, u32, u32, u32, u32);
+
 struct State {
     cells: Vec<[i32; 3]>,
     faces: Vec<[u32; 3]>,
     face_alive: Vec<bool>,
     vertex_alive: Vec<bool>,
-    vfaces: Vec<Vec<u32>>,
+    /// Faces around each vertex.
+    vfaces: Vec<Incident>,
+    /// Edges around each vertex (ids into `edges`).
+    vedges: Vec<Incident>,
+    /// Both ends of each edge; an edge collapsed away or merged into another is in no `vedges`.
+    edges: Vec<[u32; 2]>,
+    /// Where the collapse of each edge puts the remaining vertex, as last computed.
+    target: Vec<[i32; 3]>,
     quadrics: Vec<Quadric>,
-    stamp: Vec<u16>,
     placement: Placement,
     /// Box of the input cells: placements stay inside it, hence on the grid.
     bounds: ([i32; 3], [i32; 3]),
@@ -191,13 +186,18 @@ impl State {
         (b - a).cross(c - a)
     }
 
+    fn other_end(&self, e: u32, v: u32) -> u32 {
+        let [x, y] = self.edges[e as usize];
+        if x == v {
+            y
+        } else {
+            x
+        }
+    }
+
     fn neighbours(&self, v: u32, out: &mut Vec<u32>) {
         out.clear();
-        for &f in &self.vfaces[v as usize] {
-            out.extend(self.faces[f as usize].iter().filter(|&&w| w != v));
-        }
-        out.sort_unstable();
-        out.dedup();
+        out.extend(self.vedges[v as usize].iter().map(|&e| self.other_end(e, v)));
     }
 
     /// Best position for collapsing (a, b) and its cost.
@@ -223,9 +223,12 @@ impl State {
                 if (p - (lo + hi) * 0.5).length() < 2.0 * span {
                     let (blo, bhi) = self.bounds;
                     let step = vad_s_step([cb[0] - ca[0], cb[1] - ca[1], cb[2] - ca[2]]);
+                    let inverse_step = 1.0 / step as f64;
                     for end in [ca, cb] {
                         let snapped = [0, 1, 2].map(|a| {
-                            end[a] - ((end[a] as f64 - p[a]) / step as f64).round() as i32 * step
+                            // Rounds half away from zero, as f64::round, without a libm call.
+                            let steps = (end[a] as f64 - p[a]) * inverse_step;
+                            end[a] - (steps + 0.5f64.copysign(steps)) as i32 * step
                         });
                         if (0..3).all(|a| (blo[a]..=bhi[a]).contains(&snapped[a])) {
                             consider(snapped);
@@ -240,29 +243,39 @@ impl State {
         (best.0, best.1.max(0.0) + 1e-3 * length2)
     }
 
-    /// The collapse of (a, b) to `p` if it keeps the mesh valid: (vs, vt, fl, fr, vl, vr).
-    fn check(
-        &self,
-        a: u32,
-        b: u32,
-        p: [i32; 3],
-        scratch: &mut [Vec<u32>; 3],
-    ) -> Option<(u32, u32, u32, u32, u32, u32)> {
-        let edge_faces: Vec<u32> = self.vfaces[a as usize]
-            .iter()
-            .copied()
-            .filter(|&f| self.faces[f as usize].contains(&b))
-            .collect();
-        if edge_faces.is_empty() || edge_faces.len() > 2 {
+    /// Places edge `e` and returns its heap key.
+    fn place_edge(&mut self, e: u32) -> u64 {
+        let [a, b] = self.edges[e as usize];
+        let (p, cost) = self.place(a, b);
+        self.target[e as usize] = p;
+        heap_key(cost, e)
+    }
+
+    /// The collapse of (a, b) to `p` if it keeps the mesh valid.
+    fn check(&self, a: u32, b: u32, p: [i32; 3], scratch: &mut [Vec<u32>; 3]) -> Option<Checked> {
+        let mut edge_faces = [NIL; 2];
+        let mut edge_face_count = 0;
+        for &f in &self.vfaces[a as usize] {
+            if self.faces[f as usize].contains(&b) {
+                if edge_face_count == 2 {
+                    return None;
+                }
+                edge_faces[edge_face_count] = f;
+                edge_face_count += 1;
+            }
+        }
+        let edge_faces = &edge_faces[..edge_face_count];
+        if edge_faces.is_empty() {
             return None;
         }
         let [na, nb, _] = scratch;
         self.neighbours(a, na);
         self.neighbours(b, nb);
-        let common = na.iter().filter(|x| nb.binary_search(x).is_ok()).count();
+        let common = na.iter().filter(|&&x| x != b && nb.contains(&x)).count();
         if common != edge_faces.len() {
             return None; // link condition
         }
+        // On a manifold, a vertex has as many edges as faces unless it is on a boundary.
         let (bound_a, bound_b) = (
             na.len() != self.vfaces[a as usize].len(),
             nb.len() != self.vfaces[b as usize].len(),
@@ -377,16 +390,105 @@ impl State {
         }
         Some((vs, vt, fl, fr, vl, vr))
     }
+
+    /// Collapses vt into vs at `p`, and records it.
+    fn collapse(&mut self, (vs, vt, fl, fr, vl, vr): Checked, p: [i32; 3]) -> Collapse {
+        let moved: Vec<u32> = self.vfaces[vt as usize]
+            .iter()
+            .copied()
+            .filter(|&f| f != fl && f != fr)
+            .collect();
+        let across = |other: u32, not: u32| {
+            if other == NIL {
+                return NIL;
+            }
+            self.vfaces[vs as usize]
+                .iter()
+                .copied()
+                .find(|&f| f != not && self.faces[f as usize].contains(&other))
+                .unwrap_or(NIL)
+        };
+        let beside = [across(vl, fl), across(vr, fr)];
+        let record = Collapse {
+            vs,
+            vt,
+            before: [self.cells[vs as usize], self.cells[vt as usize]],
+            after: p,
+            fl,
+            fr,
+            vl,
+            vr,
+            moved,
+            beside,
+        };
+        for &f in &record.moved {
+            for x in self.faces[f as usize].iter_mut() {
+                if *x == vt {
+                    *x = vs;
+                }
+            }
+        }
+        for f in [fl, fr] {
+            if f == NIL {
+                continue;
+            }
+            self.face_alive[f as usize] = false;
+            for v in self.faces[f as usize] {
+                self.vfaces[v as usize].retain(|g| *g != f);
+            }
+        }
+        self.vfaces[vs as usize].extend_from_slice(&record.moved);
+        self.vfaces[vt as usize] = Incident::new();
+        // vt's edges: to vs it vanishes; to vl and vr it merges into vs's edge; the rest now
+        // end at vs.
+        for e in std::mem::take(&mut self.vedges[vt as usize]) {
+            let w = self.other_end(e, vt);
+            if w == vs || w == vl || w == vr {
+                self.vedges[w as usize].retain(|g| *g != e);
+            } else {
+                let ends = &mut self.edges[e as usize];
+                *ends = ends.map(|x| if x == vt { vs } else { x });
+                self.vedges[vs as usize].push(e);
+            }
+        }
+        self.vertex_alive[vt as usize] = false;
+        let qt = self.quadrics[vt as usize];
+        self.quadrics[vs as usize].add(&qt);
+        self.cells[vs as usize] = p;
+        record
+    }
 }
 
 /// Simplifies the oriented manifold mesh (`cells`, `faces`) as far as the rules allow.
 pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) -> Simplified {
     let n = cells.len();
-    let mut vfaces = vec![Vec::new(); n];
+    let mut vfaces = vec![Incident::new(); n];
     for (f, t) in faces.iter().enumerate() {
         for &v in t {
             vfaces[v as usize].push(f as u32);
         }
+    }
+    // Edges, sorted by their ends, with how many faces hold each (1: a boundary edge).
+    let mut half_edges: Vec<(u32, u32)> = faces
+        .par_iter()
+        .flat_map_iter(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .collect();
+    half_edges.par_sort_unstable();
+    let mut edges: Vec<[u32; 2]> = Vec::with_capacity(half_edges.len() / 2 + 1);
+    let mut edge_faces: Vec<u32> = Vec::with_capacity(half_edges.len() / 2 + 1);
+    for &(u, w) in &half_edges {
+        if edges.last() == Some(&[u, w]) {
+            *edge_faces.last_mut().expect("an edge") += 1;
+        } else {
+            edges.push([u, w]);
+            edge_faces.push(1);
+        }
+    }
+    drop(half_edges);
+    let mut vedges = vec![Incident::new(); n];
+    for (e, &[u, w]) in edges.iter().enumerate() {
+        vedges[u as usize].push(e as u32);
+        vedges[w as usize].push(e as u32);
     }
     // Face planes (area-weighted) and boundary constraint planes, summed per vertex in parallel.
     let face_quadric = |t: &[u32; 3]| {
@@ -399,14 +501,11 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
         let n = cross / area2;
         Quadric::plane(n, -n.dot(a), area2 * 0.5)
     };
-    let mut edge_count: std::collections::HashMap<(u32, u32), u32> =
-        std::collections::HashMap::new();
-    for t in faces {
-        for k in 0..3 {
-            let (u, v) = (t[k], t[(k + 1) % 3]);
-            *edge_count.entry((u.min(v), u.max(v))).or_default() += 1;
-        }
-    }
+    let is_boundary = |v: u32, w: u32| {
+        vedges[v as usize]
+            .iter()
+            .any(|&e| edges[e as usize].contains(&w) && edge_faces[e as usize] == 1)
+    };
     let quadrics: Vec<Quadric> = (0..n)
         .into_par_iter()
         .map(|v| {
@@ -416,7 +515,7 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
                 q.add(&face_quadric(&t));
                 for k in 0..3 {
                     let (u, w) = (t[k], t[(k + 1) % 3]);
-                    if (u == v as u32 || w == v as u32) && edge_count[&(u.min(w), u.max(w))] == 1 {
+                    if (u == v as u32 || w == v as u32) && is_boundary(u, w) {
                         let (pu, pw) = (to_f(cells[u as usize]), to_f(cells[w as usize]));
                         let [a, b, c] = t.map(|x| to_f(cells[x as usize]));
                         let normal = (b - a).cross(c - a);
@@ -432,14 +531,17 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
             q
         })
         .collect();
+    let edge_count = edges.len();
     let mut state = State {
         cells: cells.to_vec(),
         faces: faces.to_vec(),
         face_alive: vec![true; faces.len()],
         vertex_alive: vec![true; n],
         vfaces,
+        vedges,
+        edges,
+        target: vec![[0; 3]; edge_count],
         quadrics,
-        stamp: vec![0; n],
         placement,
         bounds: cells
             .iter()
@@ -452,95 +554,54 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
     };
     let mut collapses = Vec::new();
     let mut scratch: [Vec<u32>; 3] = Default::default();
-    let mut neighbours = Vec::new();
+    // Every edge is queued; a collapse re-places the edges of vs and drops those of vt. An edge
+    // refused by the checks leaves the queue until a collapse changes it. When the queue runs
+    // dry, every remaining edge is queued again, until a whole pass collapses nothing.
     loop {
-        let edges: Vec<(u32, u32)> = edge_list(&state);
-        let initial: Vec<Candidate> = edges
-            .par_iter()
-            .map(|&(a, b)| {
-                let (_, cost) = state.place(a, b);
-                Candidate {
-                    cost: cost as f32,
-                    a,
-                    b,
-                    stamps: (state.stamp[a as usize], state.stamp[b as usize]),
-                }
+        let live: Vec<u32> = (0..edge_count as u32)
+            .filter(|&e| {
+                let [a, b] = state.edges[e as usize];
+                state.vertex_alive[a as usize]
+                    && state.vedges[a as usize].contains(&e)
+                    && state.vertex_alive[b as usize]
             })
             .collect();
-        let mut heap = BinaryHeap::from(initial);
+        let placed: Vec<(usize, u64, [i32; 3])> = live
+            .par_iter()
+            .map(|&e| {
+                let [a, b] = state.edges[e as usize];
+                let (p, cost) = state.place(a, b);
+                (e as usize, heap_key(cost, e), p)
+            })
+            .collect();
+        for &(e, _, p) in &placed {
+            state.target[e] = p;
+        }
+        let mut queue: QuaternaryHeapOfIndices<usize, u64> =
+            QuaternaryHeapOfIndices::from_iter_with_index_bound(
+                edge_count,
+                placed.into_iter().map(|(e, key, _)| (e, key)),
+            );
         let before = collapses.len();
-        while let Some(c) = heap.pop() {
-            let (a, b) = (c.a, c.b);
-            if !state.vertex_alive[a as usize]
-                || !state.vertex_alive[b as usize]
-                || (state.stamp[a as usize], state.stamp[b as usize]) != c.stamps
-            {
-                continue;
-            }
-            let (p, _) = state.place(a, b);
-            let Some((vs, vt, fl, fr, vl, vr)) = state.check(a, b, p, &mut scratch) else {
+        while let Some((e, _)) = queue.pop() {
+            let [a, b] = state.edges[e];
+            let p = state.target[e];
+            let Some(checked) = state.check(a, b, p, &mut scratch) else {
                 continue;
             };
-            let moved: Vec<u32> = state.vfaces[vt as usize]
-                .iter()
-                .copied()
-                .filter(|&f| f != fl && f != fr)
-                .collect();
-            let across = |other: u32, not: u32| {
-                if other == NIL {
-                    return NIL;
-                }
-                state.vfaces[vs as usize]
-                    .iter()
-                    .copied()
-                    .find(|&f| f != not && state.faces[f as usize].contains(&other))
-                    .unwrap_or(NIL)
-            };
-            let beside = [across(vl, fl), across(vr, fr)];
-            collapses.push(Collapse {
-                vs,
-                vt,
-                before: [state.cells[vs as usize], state.cells[vt as usize]],
-                after: p,
-                fl,
-                fr,
-                vl,
-                vr,
-                moved: moved.clone(),
-                beside,
-            });
-            for &f in &moved {
-                for x in state.faces[f as usize].iter_mut() {
-                    if *x == vt {
-                        *x = vs;
-                    }
+            let (vs, vt, vl, vr) = (checked.0, checked.1, checked.4, checked.5);
+            // vt's edges to vl and vr merge into vs's; its others are re-placed below.
+            for &gone in &state.vedges[vt as usize] {
+                let w = state.other_end(gone, vt);
+                if (w == vl || w == vr) && queue.contains(&(gone as usize)) {
+                    queue.remove(&(gone as usize));
                 }
             }
-            for &f in &[fl, fr] {
-                if f == NIL {
-                    continue;
-                }
-                state.face_alive[f as usize] = false;
-                for &v in &state.faces[f as usize] {
-                    state.vfaces[v as usize].retain(|&g| g != f);
-                }
-            }
-            state.vfaces[vs as usize].extend(moved);
-            state.vfaces[vt as usize].clear();
-            state.vertex_alive[vt as usize] = false;
-            let qt = state.quadrics[vt as usize];
-            state.quadrics[vs as usize].add(&qt);
-            state.cells[vs as usize] = p;
-            state.stamp[vs as usize] = state.stamp[vs as usize].wrapping_add(1);
-            state.neighbours(vs, &mut neighbours);
-            for &w in &neighbours {
-                let (_, cost) = state.place(vs, w);
-                heap.push(Candidate {
-                    cost: cost as f32,
-                    a: vs,
-                    b: w,
-                    stamps: (state.stamp[vs as usize], state.stamp[w as usize]),
-                });
+            collapses.push(state.collapse(checked, p));
+            for i in 0..state.vedges[vs as usize].len() {
+                let e = state.vedges[vs as usize][i];
+                let key = state.place_edge(e);
+                queue.update_key_or_push(&(e as usize), key);
             }
         }
         if collapses.len() == before {
@@ -554,21 +615,6 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
         positions: state.cells,
         faces: state.faces,
     }
-}
-
-fn edge_list(state: &State) -> Vec<(u32, u32)> {
-    let mut edges: Vec<(u32, u32)> = state
-        .faces
-        .iter()
-        .zip(&state.face_alive)
-        .filter(|(_, &alive)| alive)
-        .flat_map(|(t, _)| {
-            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
-        })
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    edges
 }
 
 /// A progressive mesh: the base mesh and the splits that rebuild the full mesh, with the order
@@ -625,6 +671,7 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
         }
     }
     let mut vsplits = Vec::with_capacity(s.collapses.len());
+    let mut moved = Vec::new();
     for c in order.iter().map(|&i| &s.collapses[i]) {
         let (vs, vl) = (new_id[c.vs as usize], new_id[c.vl as usize]);
         let vr = if c.vr == NIL {
@@ -632,8 +679,8 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
         } else {
             new_id[c.vr as usize]
         };
-        let moved: std::collections::HashSet<u32> =
-            c.moved.iter().map(|&f| face_id[f as usize]).collect();
+        moved.clear();
+        moved.extend(c.moved.iter().map(|&f| face_id[f as usize]));
         debug_assert!(
             mesh.faces[vertex_face[vs as usize] as usize]
                 .v
@@ -713,18 +760,16 @@ fn locate_split(
     vl: u32,
     vr: u32,
     face_of_vs: u32,
-    moved: &std::collections::HashSet<u32>,
+    moved: &[u32],
 ) -> (u32, u8, Rotation) {
     // Faces around vs, via any face that holds it.
     let holds = |f: u32, u: u32, w: u32| {
         let t = mesh.faces[f as usize].v;
         (0..3).find(|&k| t[k] == u && t[(k + 1) % 3] == w)
     };
-    let fan = mesh.fan(face_of_vs, vs);
     if moved.is_empty() {
-        let f = *fan
-            .iter()
-            .find(|&&f| holds(f, vl, vs).is_some())
+        let f = mesh
+            .find_in_fan(face_of_vs, vs, |f| holds(f, vl, vs).is_some())
             .expect("face across (vs, vl)");
         let i = mesh.corner(f, vs).expect("corner") as u8;
         let rot = if vr == NIL {
@@ -734,9 +779,10 @@ fn locate_split(
         };
         return (f, i, rot);
     }
-    let f0 = *fan
-        .iter()
-        .find(|&&f| moved.contains(&f) && holds(f, vs, vl).is_some())
+    let f0 = mesh
+        .find_in_fan(face_of_vs, vs, |f| {
+            moved.contains(&f) && holds(f, vs, vl).is_some()
+        })
         .expect("a moved face starts at vl");
     let i = mesh.corner(f0, vs).expect("corner") as u8;
     let rot = if vr == NIL {
