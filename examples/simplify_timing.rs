@@ -23,34 +23,11 @@ fn main() -> anyhow::Result<()> {
         .iter()
         .map(|c| c.map(|x| x as i32))
         .collect();
-    let mut faces = canonical.faces.clone();
-    let mut cells = cells;
-    if std::env::var("MORTON").is_ok() {
-        let morton = |c: [i32; 3]| {
-            let mut m = 0u64;
-            for bit in (0..21).rev() {
-                for a in 0..3 {
-                    m = (m << 1) | ((c[a] as u64 >> (bit + 3)) & 1);
-                }
-            }
-            m
-        };
-        let mut order: Vec<u32> = (0..cells.len() as u32).collect();
-        order.sort_by_key(|&v| morton(cells[v as usize]));
-        let mut rank = vec![0u32; cells.len()];
-        for (i, &v) in order.iter().enumerate() {
-            rank[v as usize] = i as u32;
-        }
-        cells = order.iter().map(|&v| cells[v as usize]).collect();
-        for t in faces.iter_mut() {
-            *t = t.map(|v| rank[v as usize]);
-        }
-        faces.sort_by_key(|t| t[0].min(t[1]).min(t[2]));
-    }
+    let faces = &canonical.faces;
     let started = Instant::now();
-    let simplified = simplify(&cells, &faces, Placement::Optimal);
+    let simplified = simplify(&cells, faces, Placement::Optimal);
     let simplify_seconds = started.elapsed().as_secs_f64();
-    let pm = progressive_mesh(&faces, &simplified);
+    let pm = progressive_mesh(faces, &simplified);
     let total = started.elapsed().as_secs_f64();
     let faces = canonical.face_count();
     println!(

@@ -1,7 +1,7 @@
 //! Garland–Heckbert quadric error simplification by edge collapses, and the progressive mesh it
 //! defines (Hoppe: base mesh M⁰ plus the vertex splits that undo the collapses in reverse).
 //!
-//! Collapses are taken cheapest first from an indexed 4-ary heap of edges (each edge's key is
+//! Collapses are taken cheapest first from an indexed 8-ary heap of edges (each edge's key is
 //! updated in place when a collapse changes it, so the heap never holds stale entries), and
 //! simplification is O(f log f). Each vertex keeps its faces and its edges, so a check reads
 //! only the two endpoints' lists. A collapse must keep the mesh a manifold
@@ -12,7 +12,7 @@
 
 use super::pmesh::{anchor, PmMesh, Rotation, Vsplit, NIL};
 use glam::DVec3;
-use orx_priority_queue::{PriorityQueue, PriorityQueueDecKey, QuaternaryHeapOfIndices};
+use orx_priority_queue::{DaryHeapOfIndices, PriorityQueue, PriorityQueueDecKey};
 use rayon::prelude::*;
 use smallvec::SmallVec;
 
@@ -197,7 +197,11 @@ impl State {
 
     fn neighbours(&self, v: u32, out: &mut Vec<u32>) {
         out.clear();
-        out.extend(self.vedges[v as usize].iter().map(|&e| self.other_end(e, v)));
+        out.extend(
+            self.vedges[v as usize]
+                .iter()
+                .map(|&e| self.other_end(e, v)),
+        );
     }
 
     /// Best position for collapsing (a, b) and its cost.
@@ -471,7 +475,9 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
     // Edges, sorted by their ends, with how many faces hold each (1: a boundary edge).
     let mut half_edges: Vec<(u32, u32)> = faces
         .par_iter()
-        .flat_map_iter(|t| (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]))))
+        .flat_map_iter(|t| {
+            (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+        })
         .collect();
     half_edges.par_sort_unstable();
     let mut edges: Vec<[u32; 2]> = Vec::with_capacity(half_edges.len() / 2 + 1);
@@ -577,8 +583,8 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
         for &(e, _, p) in &placed {
             state.target[e] = p;
         }
-        let mut queue: QuaternaryHeapOfIndices<usize, u64> =
-            QuaternaryHeapOfIndices::from_iter_with_index_bound(
+        let mut queue: DaryHeapOfIndices<usize, u64, 8> =
+            DaryHeapOfIndices::from_iter_with_index_bound(
                 edge_count,
                 placed.into_iter().map(|(e, key, _)| (e, key)),
             );
