@@ -13,6 +13,9 @@ fn main() -> anyhow::Result<()> {
     for _ in 0..times {
         mesh = meshcodec::mesh::generate::subdivide(&mesh);
     }
+    if let Ok(path) = std::env::var("WRITE_MESH") {
+        meshcodec::mesh::io::write_mesh(&mesh, std::path::Path::new(&path))?;
+    }
     let options = EncodeOptions {
         quant_bits: 24,
         grid: GridShape::Cubic,

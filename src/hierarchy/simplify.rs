@@ -9,6 +9,13 @@
 //! three vertices), must not flip a face's normal, and keeps boundaries through constraint
 //! quadrics on boundary edges. When the heap runs dry, every edge is queued again, until a
 //! whole pass collapses nothing: the base mesh is then as small as these rules allow.
+//!
+//! Meshes of 200,000 faces or more are first simplified in parallel: a k-d split of the vertices
+//! makes 8 regions, each collapses its own edges greedily up to a common cost (a high quantile
+//! of the initial costs) with the vertices it shares with another region frozen, and the
+//! regions' collapses are interleaved cheapest first. No two regions touch the same face, so
+//! any interleaving is a valid sequence; the seams, and everything above that cost, then go
+//! through the single greedy loop.
 
 use super::pmesh::{anchor, PmMesh, Rotation, Vsplit, NIL};
 use glam::DVec3;
@@ -168,12 +175,51 @@ struct State {
     /// Where the collapse of each edge puts the remaining vertex, as last computed.
     target: Vec<[i32; 3]>,
     quadrics: Vec<Quadric>,
+    /// Vertices that must not move (shared with another region in the parallel phase).
+    frozen: Vec<bool>,
     placement: Placement,
     /// Box of the input cells: placements stay inside it, hence on the grid.
     bounds: ([i32; 3], [i32; 3]),
 }
 
 impl State {
+    fn new(
+        cells: Vec<[i32; 3]>,
+        faces: Vec<[u32; 3]>,
+        quadrics: Vec<Quadric>,
+        frozen: Vec<bool>,
+        placement: Placement,
+        bounds: ([i32; 3], [i32; 3]),
+    ) -> State {
+        let t = topology(cells.len(), &faces, &vec![true; faces.len()]);
+        State::with_topology(cells, faces, quadrics, frozen, placement, bounds, t)
+    }
+
+    fn with_topology(
+        cells: Vec<[i32; 3]>,
+        faces: Vec<[u32; 3]>,
+        quadrics: Vec<Quadric>,
+        frozen: Vec<bool>,
+        placement: Placement,
+        bounds: ([i32; 3], [i32; 3]),
+        t: Topology,
+    ) -> State {
+        State {
+            face_alive: vec![true; faces.len()],
+            vertex_alive: vec![true; cells.len()],
+            target: vec![[0; 3]; t.edges.len()],
+            vfaces: t.vfaces,
+            vedges: t.vedges,
+            edges: t.edges,
+            cells,
+            faces,
+            quadrics,
+            frozen,
+            placement,
+            bounds,
+        }
+    }
+
     fn normal(&self, f: [u32; 3], replace: u32, with: DVec3) -> DVec3 {
         let p = |v: u32| {
             if v == replace {
@@ -463,19 +509,27 @@ impl State {
     }
 }
 
-/// Simplifies the oriented manifold mesh (`cells`, `faces`) as far as the rules allow.
-pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) -> Simplified {
-    let n = cells.len();
+/// Faces around each vertex, the edges of the live faces (sorted by their ends) with how many
+/// faces hold each (1: a boundary edge), and the edges around each vertex.
+struct Topology {
+    vfaces: Vec<Incident>,
+    edges: Vec<[u32; 2]>,
+    edge_faces: Vec<u32>,
+    vedges: Vec<Incident>,
+}
+
+fn topology(n: usize, faces: &[[u32; 3]], alive: &[bool]) -> Topology {
     let mut vfaces = vec![Incident::new(); n];
-    for (f, t) in faces.iter().enumerate() {
+    for (f, t) in faces.iter().enumerate().filter(|&(f, _)| alive[f]) {
         for &v in t {
             vfaces[v as usize].push(f as u32);
         }
     }
-    // Edges, sorted by their ends, with how many faces hold each (1: a boundary edge).
     let mut half_edges: Vec<(u32, u32)> = faces
         .par_iter()
-        .flat_map_iter(|t| {
+        .zip(alive)
+        .filter(|(_, &alive)| alive)
+        .flat_map_iter(|(t, _)| {
             (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
         })
         .collect();
@@ -490,13 +544,27 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
             edge_faces.push(1);
         }
     }
-    drop(half_edges);
     let mut vedges = vec![Incident::new(); n];
     for (e, &[u, w]) in edges.iter().enumerate() {
         vedges[u as usize].push(e as u32);
         vedges[w as usize].push(e as u32);
     }
-    // Face planes (area-weighted) and boundary constraint planes, summed per vertex in parallel.
+    Topology {
+        vfaces,
+        edges,
+        edge_faces,
+        vedges,
+    }
+}
+
+/// Face planes (area-weighted) and boundary constraint planes, summed per vertex in parallel.
+fn initial_quadrics(cells: &[[i32; 3]], faces: &[[u32; 3]], topology: &Topology) -> Vec<Quadric> {
+    let Topology {
+        vfaces,
+        edges,
+        edge_faces,
+        vedges,
+    } = topology;
     let face_quadric = |t: &[u32; 3]| {
         let [a, b, c] = t.map(|v| to_f(cells[v as usize]));
         let cross = (b - a).cross(c - a);
@@ -512,7 +580,7 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
             .iter()
             .any(|&e| edges[e as usize].contains(&w) && edge_faces[e as usize] == 1)
     };
-    let quadrics: Vec<Quadric> = (0..n)
+    (0..cells.len())
         .into_par_iter()
         .map(|v| {
             let mut q = Quadric::default();
@@ -536,84 +604,316 @@ pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) ->
             }
             q
         })
-        .collect();
-    let edge_count = edges.len();
-    let mut state = State {
-        cells: cells.to_vec(),
-        faces: faces.to_vec(),
-        face_alive: vec![true; faces.len()],
-        vertex_alive: vec![true; n],
-        vfaces,
-        vedges,
-        edges,
-        target: vec![[0; 3]; edge_count],
-        quadrics,
-        placement,
-        bounds: cells
-            .iter()
-            .fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), c| {
-                (
-                    [0, 1, 2].map(|a| lo[a].min(c[a])),
-                    [0, 1, 2].map(|a| hi[a].max(c[a])),
-                )
-            }),
-    };
-    let mut collapses = Vec::new();
-    let mut scratch: [Vec<u32>; 3] = Default::default();
-    // Every edge is queued; a collapse re-places the edges of vs and drops those of vt. An edge
-    // refused by the checks leaves the queue until a collapse changes it. When the queue runs
-    // dry, every remaining edge is queued again, until a whole pass collapses nothing.
-    loop {
+        .collect()
+}
+
+impl State {
+    /// Replaces the face, edge and placement lists by those of the live faces.
+    fn rebuild_topology(&mut self) {
+        let t = topology(self.cells.len(), &self.faces, &self.face_alive);
+        self.vfaces = t.vfaces;
+        self.vedges = t.vedges;
+        self.target = vec![[0; 3]; t.edges.len()];
+        self.edges = t.edges;
+    }
+
+    /// One pass of greedy collapses, cheapest first, over every edge without a frozen end, until
+    /// none passes the checks or the cheapest costs more than `max_cost`. Appends the collapses
+    /// and their costs.
+    fn collapse_greedily(
+        &mut self,
+        max_cost: f32,
+        collapses: &mut Vec<Collapse>,
+        costs: &mut Vec<f32>,
+    ) -> usize {
+        let edge_count = self.edges.len();
+        let movable = |state: &State, e: u32| {
+            let [a, b] = state.edges[e as usize];
+            !state.frozen[a as usize] && !state.frozen[b as usize]
+        };
         let live: Vec<u32> = (0..edge_count as u32)
             .filter(|&e| {
-                let [a, b] = state.edges[e as usize];
-                state.vertex_alive[a as usize]
-                    && state.vedges[a as usize].contains(&e)
-                    && state.vertex_alive[b as usize]
+                let [a, b] = self.edges[e as usize];
+                self.vertex_alive[a as usize]
+                    && self.vedges[a as usize].contains(&e)
+                    && self.vertex_alive[b as usize]
+                    && movable(self, e)
             })
             .collect();
         let placed: Vec<(usize, u64, [i32; 3])> = live
             .par_iter()
             .map(|&e| {
-                let [a, b] = state.edges[e as usize];
-                let (p, cost) = state.place(a, b);
+                let [a, b] = self.edges[e as usize];
+                let (p, cost) = self.place(a, b);
                 (e as usize, heap_key(cost, e), p)
             })
             .collect();
         for &(e, _, p) in &placed {
-            state.target[e] = p;
+            self.target[e] = p;
         }
         let mut queue: DaryHeapOfIndices<usize, u64, 8> =
             DaryHeapOfIndices::from_iter_with_index_bound(
                 edge_count,
                 placed.into_iter().map(|(e, key, _)| (e, key)),
             );
-        let before = collapses.len();
-        while let Some((e, _)) = queue.pop() {
-            let [a, b] = state.edges[e];
-            let p = state.target[e];
-            let Some(checked) = state.check(a, b, p, &mut scratch) else {
+        let mut scratch: [Vec<u32>; 3] = Default::default();
+        let mut made = 0;
+        while let Some((e, key)) = queue.pop() {
+            let cost = f32::from_bits((key >> 32) as u32);
+            if cost > max_cost {
+                break;
+            }
+            let [a, b] = self.edges[e];
+            let p = self.target[e];
+            let Some(checked) = self.check(a, b, p, &mut scratch) else {
                 continue;
             };
             let (vs, vt, vl, vr) = (checked.0, checked.1, checked.4, checked.5);
             // vt's edges to vl and vr merge into vs's; its others are re-placed below.
-            for &gone in &state.vedges[vt as usize] {
-                let w = state.other_end(gone, vt);
+            for &gone in &self.vedges[vt as usize] {
+                let w = self.other_end(gone, vt);
                 if (w == vl || w == vr) && queue.contains(&(gone as usize)) {
                     queue.remove(&(gone as usize));
                 }
             }
-            collapses.push(state.collapse(checked, p));
-            for i in 0..state.vedges[vs as usize].len() {
-                let e = state.vedges[vs as usize][i];
-                let key = state.place_edge(e);
-                queue.update_key_or_push(&(e as usize), key);
+            collapses.push(self.collapse(checked, p));
+            costs.push(cost);
+            made += 1;
+            for i in 0..self.vedges[vs as usize].len() {
+                let e = self.vedges[vs as usize][i];
+                if movable(self, e) {
+                    let key = self.place_edge(e);
+                    queue.update_key_or_push(&(e as usize), key);
+                }
             }
         }
-        if collapses.len() == before {
-            break;
+        made
+    }
+}
+
+/// Meshes below this many faces are simplified by one greedy loop; larger ones first in
+/// regions, in parallel.
+const REGION_MIN_FACES: usize = 200_000;
+/// Regions of the parallel phase (a power of two: halved along the longest axis).
+const REGION_COUNT: usize = 8;
+/// The parallel phase makes the collapses cheaper than this quantile of the initial edge costs;
+/// the rest, with the seams, goes to the global greedy loop. Measured on bunny-closed-35k ×16:
+/// 0.5 leaves 50% of the collapses to the global loop (0.32 M faces/s), 0.97 leaves 7% (0.49 M
+/// faces/s). On bunny-closed-35k itself, forced through the regions, the RMS error of its levels
+/// stays within 6% of one global loop (coarse levels a little better, 8k–33k vertices 4–6%
+/// worse) and the stream grows 0.14%.
+const REGION_COST_QUANTILE: f64 = 0.97;
+
+/// Region of each face: its first corner's place in a k-d split of the vertices into
+/// [`REGION_COUNT`] boxes of equal vertex counts.
+fn face_regions(cells: &[[i32; 3]], faces: &[[u32; 3]]) -> Vec<u8> {
+    fn split(cells: &[[i32; 3]], ids: &mut [u32], region: u8, depth: u32, out: &mut [u8]) {
+        if 1usize << depth == REGION_COUNT {
+            for &v in ids.iter() {
+                out[v as usize] = region;
+            }
+            return;
+        }
+        let (lo, hi) = ids
+            .iter()
+            .fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), &v| {
+                let c = cells[v as usize];
+                (
+                    [0, 1, 2].map(|a| lo[a].min(c[a])),
+                    [0, 1, 2].map(|a| hi[a].max(c[a])),
+                )
+            });
+        let axis = (0..3)
+            .max_by_key(|&a| i64::from(hi[a]) - i64::from(lo[a]))
+            .unwrap_or(0);
+        let middle = ids.len() / 2;
+        ids.select_nth_unstable_by_key(middle, |&v| (cells[v as usize][axis], v));
+        let (low, high) = ids.split_at_mut(middle);
+        split(cells, low, region * 2, depth + 1, out);
+        split(cells, high, region * 2 + 1, depth + 1, out);
+    }
+    let mut vertex_region = vec![0u8; cells.len()];
+    let mut ids: Vec<u32> = (0..cells.len() as u32).collect();
+    split(cells, &mut ids, 0, 0, &mut vertex_region);
+    faces.iter().map(|t| vertex_region[t[0] as usize]).collect()
+}
+
+/// What one region's simplification made, in global ids.
+struct RegionRun {
+    collapses: Vec<Collapse>,
+    costs: Vec<f32>,
+    /// Global id of each local vertex, and its final state.
+    vertices: Vec<u32>,
+    cells: Vec<[i32; 3]>,
+    quadrics: Vec<Quadric>,
+    vertex_alive: Vec<bool>,
+    /// Global id of each local face, and its final corners (global ids) and state.
+    face_ids: Vec<u32>,
+    faces: Vec<[u32; 3]>,
+    face_alive: Vec<bool>,
+}
+
+/// The parallel phase: each region collapses its own edges, greedily, with the vertices it
+/// shares with other regions frozen, so that no two regions touch the same face or vertex and
+/// their collapses can be interleaved in any order. The interleaving follows the costs (always
+/// the cheapest next collapse of any region), so the sequence stays close to one greedy loop.
+fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
+    // Every region stops at the same cost, so that the seams, collapsed after, are the only
+    // collapses out of cost order.
+    let mut initial: Vec<f32> = state
+        .edges
+        .par_iter()
+        .map(|&[a, b]| state.place(a, b).1 as f32)
+        .collect();
+    if initial.is_empty() {
+        return;
+    }
+    let middle = ((initial.len() as f64 * REGION_COST_QUANTILE) as usize).min(initial.len() - 1);
+    let max_cost = *initial.select_nth_unstable_by(middle, f32::total_cmp).1;
+    drop(initial);
+    let regions = face_regions(&state.cells, &state.faces);
+    let n = state.cells.len();
+    let mut region_of = vec![u8::MAX; n];
+    let mut shared = vec![false; n];
+    for (t, &r) in state.faces.iter().zip(&regions) {
+        for &v in t {
+            let slot = &mut region_of[v as usize];
+            if *slot == u8::MAX {
+                *slot = r;
+            } else if *slot != r {
+                shared[v as usize] = true;
+            }
         }
     }
+    let runs: Vec<RegionRun> = (0..REGION_COUNT as u8)
+        .into_par_iter()
+        .map(|r| {
+            let face_ids: Vec<u32> = (0..state.faces.len() as u32)
+                .filter(|&f| regions[f as usize] == r)
+                .collect();
+            let mut vertices: Vec<u32> = face_ids
+                .iter()
+                .flat_map(|&f| state.faces[f as usize])
+                .collect();
+            vertices.sort_unstable();
+            vertices.dedup();
+            let local = |v: u32| vertices.binary_search(&v).expect("a corner") as u32;
+            let faces: Vec<[u32; 3]> = face_ids
+                .iter()
+                .map(|&f| state.faces[f as usize].map(local))
+                .collect();
+            let frozen: Vec<bool> = vertices.iter().map(|&v| shared[v as usize]).collect();
+            let mut region = State::new(
+                vertices.iter().map(|&v| state.cells[v as usize]).collect(),
+                faces,
+                vertices
+                    .iter()
+                    .map(|&v| state.quadrics[v as usize])
+                    .collect(),
+                frozen,
+                state.placement,
+                state.bounds,
+            );
+            let (mut local_collapses, mut costs) = (Vec::new(), Vec::new());
+            region.collapse_greedily(max_cost, &mut local_collapses, &mut costs);
+            let global_vertex = |v: u32| if v == NIL { NIL } else { vertices[v as usize] };
+            let global_face = |f: u32| if f == NIL { NIL } else { face_ids[f as usize] };
+            let collapses = local_collapses
+                .into_iter()
+                .map(|c| Collapse {
+                    vs: global_vertex(c.vs),
+                    vt: global_vertex(c.vt),
+                    vl: global_vertex(c.vl),
+                    vr: global_vertex(c.vr),
+                    fl: global_face(c.fl),
+                    fr: global_face(c.fr),
+                    moved: c.moved.iter().map(|&f| global_face(f)).collect(),
+                    beside: c.beside.map(global_face),
+                    ..c
+                })
+                .collect();
+            RegionRun {
+                collapses,
+                costs,
+                faces: region.faces.iter().map(|t| t.map(global_vertex)).collect(),
+                cells: region.cells,
+                quadrics: region.quadrics,
+                vertex_alive: region.vertex_alive,
+                face_alive: region.face_alive,
+                vertices,
+                face_ids,
+            }
+        })
+        .collect();
+    // Interleave: always the cheapest next collapse of any region.
+    let mut next = vec![0usize; runs.len()];
+    loop {
+        let cheapest = (0..runs.len())
+            .filter(|&r| next[r] < runs[r].costs.len())
+            .min_by(|&x, &y| runs[x].costs[next[x]].total_cmp(&runs[y].costs[next[y]]));
+        let Some(r) = cheapest else {
+            break;
+        };
+        collapses.push(runs[r].collapses[next[r]].clone());
+        next[r] += 1;
+    }
+    for run in runs {
+        for (i, &v) in run.vertices.iter().enumerate() {
+            if !shared[v as usize] {
+                state.cells[v as usize] = run.cells[i];
+                state.quadrics[v as usize] = run.quadrics[i];
+                state.vertex_alive[v as usize] = run.vertex_alive[i];
+            }
+        }
+        for (i, &f) in run.face_ids.iter().enumerate() {
+            state.faces[f as usize] = run.faces[i];
+            state.face_alive[f as usize] = run.face_alive[i];
+        }
+    }
+    state.rebuild_topology();
+}
+
+/// Simplifies the oriented manifold mesh (`cells`, `faces`) as far as the rules allow.
+pub fn simplify(cells: &[[i32; 3]], faces: &[[u32; 3]], placement: Placement) -> Simplified {
+    let regions = faces.len() >= REGION_MIN_FACES && rayon::current_num_threads() > 1;
+    simplify_with_regions(cells, faces, placement, regions)
+}
+
+/// [`simplify`], with or without the parallel phase.
+fn simplify_with_regions(
+    cells: &[[i32; 3]],
+    faces: &[[u32; 3]],
+    placement: Placement,
+    regions: bool,
+) -> Simplified {
+    let n = cells.len();
+    let all = vec![true; faces.len()];
+    let bounds = cells
+        .iter()
+        .fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), c| {
+            (
+                [0, 1, 2].map(|a| lo[a].min(c[a])),
+                [0, 1, 2].map(|a| hi[a].max(c[a])),
+            )
+        });
+    let t = topology(n, faces, &all);
+    let quadrics = initial_quadrics(cells, faces, &t);
+    let mut state = State::with_topology(
+        cells.to_vec(),
+        faces.to_vec(),
+        quadrics,
+        vec![false; n],
+        placement,
+        bounds,
+        t,
+    );
+    let mut collapses = Vec::new();
+    if regions {
+        collapse_regions(&mut state, &mut collapses);
+    }
+    // When a pass runs dry, every remaining edge is queued again, until a pass collapses nothing.
+    let mut costs = Vec::new();
+    while state.collapse_greedily(f32::INFINITY, &mut collapses, &mut costs) > 0 {}
     Simplified {
         collapses,
         vertex_alive: state.vertex_alive,
@@ -945,8 +1245,12 @@ mod tests {
     }
 
     fn check_round_trip(mesh: &crate::mesh::TriMesh, placement: Placement) {
+        check_round_trip_with(mesh, placement, false);
+    }
+
+    fn check_round_trip_with(mesh: &crate::mesh::TriMesh, placement: Placement, regions: bool) {
         let cells = cells_of(mesh);
-        let s = simplify(&cells, &mesh.faces, placement);
+        let s = simplify_with_regions(&cells, &mesh.faces, placement, regions);
         let pm = progressive_mesh(&mesh.faces, &s);
         let mut m = pm.base.clone();
         m.check_invariants().unwrap();
@@ -988,6 +1292,12 @@ mod tests {
             check_round_trip(&generate::icosphere(3), placement);
             check_round_trip(&generate::torus(2.0, 0.6, 24, 12), placement);
             check_round_trip(&generate::terrain(400, 5), placement);
+        }
+        // The parallel phase (regions with frozen seams, interleaved by cost) on small meshes.
+        for placement in [Placement::Optimal, Placement::EndpointOrMidpoint] {
+            check_round_trip_with(&generate::icosphere(3), placement, true);
+            check_round_trip_with(&generate::torus(2.0, 0.6, 32, 16), placement, true);
+            check_round_trip_with(&generate::terrain(800, 7), placement, true);
         }
         let sphere = generate::icosphere(3);
         let s = simplify(&cells_of(&sphere), &sphere.faces, Placement::Optimal);
