@@ -190,18 +190,6 @@ impl State {
         frozen: Vec<bool>,
         placement: Placement,
         bounds: ([i32; 3], [i32; 3]),
-    ) -> State {
-        let t = topology(cells.len(), &faces, &vec![true; faces.len()]);
-        State::with_topology(cells, faces, quadrics, frozen, placement, bounds, t)
-    }
-
-    fn with_topology(
-        cells: Vec<[i32; 3]>,
-        faces: Vec<[u32; 3]>,
-        quadrics: Vec<Quadric>,
-        frozen: Vec<bool>,
-        placement: Placement,
-        bounds: ([i32; 3], [i32; 3]),
         t: Topology,
     ) -> State {
         State {
@@ -803,6 +791,7 @@ fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
                 .map(|&f| state.faces[f as usize].map(local))
                 .collect();
             let frozen: Vec<bool> = vertices.iter().map(|&v| shared[v as usize]).collect();
+            let topology = topology(vertices.len(), &faces, &vec![true; faces.len()]);
             let mut region = State::new(
                 vertices.iter().map(|&v| state.cells[v as usize]).collect(),
                 faces,
@@ -813,6 +802,7 @@ fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
                 frozen,
                 state.placement,
                 state.bounds,
+                topology,
             );
             let (mut local_collapses, mut costs) = (Vec::new(), Vec::new());
             region.collapse_greedily(max_cost, &mut local_collapses, &mut costs);
@@ -898,7 +888,7 @@ fn simplify_with_regions(
         });
     let t = topology(n, faces, &all);
     let quadrics = initial_quadrics(cells, faces, &t);
-    let mut state = State::with_topology(
+    let mut state = State::new(
         cells.to_vec(),
         faces.to_vec(),
         quadrics,
