@@ -959,13 +959,8 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
     let base = PmMesh::from_triangles(base_positions, &base_faces)
         .expect("simplification keeps an oriented manifold");
     let mut mesh = base.clone();
-    // A face of each vertex, to start walks around it.
-    let mut vertex_face = vec![NIL; n];
-    for (f, face) in mesh.faces.iter().enumerate() {
-        for &v in &face.v {
-            vertex_face[v as usize] = f as u32;
-        }
-    }
+    mesh.faces.reserve(original_faces.len() - mesh.faces.len());
+    mesh.positions.reserve(n - mesh.positions.len());
     let mut vsplits = Vec::with_capacity(s.collapses.len());
     let mut moved = Vec::new();
     for c in order.iter().map(|&i| &s.collapses[i]) {
@@ -977,17 +972,12 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
         };
         moved.clear();
         moved.extend(c.moved.iter().map(|&f| face_id[f as usize]));
-        debug_assert!(
-            mesh.faces[vertex_face[vs as usize] as usize]
-                .v
-                .contains(&vs),
-            "vertex_face of {vs} (orig {}) is {} = {:?}",
-            c.vs,
-            vertex_face[vs as usize],
-            mesh.faces[vertex_face[vs as usize] as usize].v
-        );
-        let (flclw, vs_index, vlr_rot) =
-            locate_split(&mesh, vs, vl, vr, vertex_face[vs as usize], &moved);
+        let across_vl = if c.beside[0] == NIL {
+            NIL
+        } else {
+            face_id[c.beside[0] as usize]
+        };
+        let (flclw, vs_index, vlr_rot) = locate_split(&mesh, vs, vl, vr, across_vl, &moved);
         let (ps, pt) = (c.before[0], c.before[1]);
         let vad_l = [pt[0] - ps[0], pt[1] - ps[1], pt[2] - ps[2]];
         let step = vad_s_step(vad_l);
@@ -1032,9 +1022,6 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
         debug_assert_eq!(mesh.positions[vt as usize], pt);
         new_id[c.vt as usize] = vt;
         vertex_origin.push(c.vt);
-        let fl = mesh.faces.len() as u32 - if c.fr == NIL { 1 } else { 2 };
-        vertex_face[vs as usize] = fl;
-        vertex_face[vt as usize] = fl;
         face_id[c.fl as usize] = mesh.faces.len() as u32 - if c.fr == NIL { 1 } else { 2 };
         if c.fr != NIL {
             face_id[c.fr as usize] = mesh.faces.len() as u32 - 1;
@@ -1049,44 +1036,38 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
 }
 
 /// Hoppe's location fields of the split of `vs` between `vl` and `vr` that gives vt the faces
-/// `moved` (face ids of `mesh`).
+/// `moved`; `across_vl` is the face across (vs, vl) from fl (face ids of `mesh`).
 fn locate_split(
     mesh: &PmMesh,
     vs: u32,
     vl: u32,
     vr: u32,
-    face_of_vs: u32,
+    across_vl: u32,
     moved: &[u32],
 ) -> (u32, u8, Rotation) {
-    // Faces around vs, via any face that holds it.
-    let holds = |f: u32, u: u32, w: u32| {
-        let t = mesh.faces[f as usize].v;
-        (0..3).find(|&k| t[k] == u && t[(k + 1) % 3] == w)
-    };
+    let corner = |f: u32| mesh.corner(f, vs).expect("a face of vs") as u8;
     if moved.is_empty() {
-        let f = mesh
-            .find_in_fan(face_of_vs, vs, |f| holds(f, vl, vs).is_some())
-            .expect("face across (vs, vl)");
-        let i = mesh.corner(f, vs).expect("corner") as u8;
         let rot = if vr == NIL {
             Rotation::Empty
         } else {
             Rotation::EmptyAcrossGap
         };
-        return (f, i, rot);
+        return (across_vl, corner(across_vl), rot);
     }
-    let f0 = mesh
-        .find_in_fan(face_of_vs, vs, |f| {
-            moved.contains(&f) && holds(f, vs, vl).is_some()
+    // The moved arc starts at the one face with directed edge vs → vl.
+    let f0 = *moved
+        .iter()
+        .find(|&&f| {
+            let t = mesh.faces[f as usize].v;
+            (0..3).any(|k| t[k] == vs && t[(k + 1) % 3] == vl)
         })
         .expect("a moved face starts at vl");
-    let i = mesh.corner(f0, vs).expect("corner") as u8;
     let rot = if vr == NIL {
         Rotation::ToBoundary
     } else {
         Rotation::Faces(moved.len() as u32 - 1)
     };
-    (f0, i, rot)
+    (f0, corner(f0), rot)
 }
 
 /// The progressive mesh of a simplification with its splits reordered so that successive
