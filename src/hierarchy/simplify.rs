@@ -120,6 +120,13 @@ pub struct Collapse {
     /// Faces across (vs, vl) from fl and across (vs, vr) from fr (NIL where none): the split
     /// re-links them.
     pub beside: [u32; 2],
+    /// The face the split is located from (Hoppe's flclw): the moved face on edge (vt, vl), or
+    /// `beside[0]` when none moves.
+    pub flclw: u32,
+    /// Corner of flclw that holds vs after the collapse.
+    pub flclw_corner: u8,
+    /// Corners of fl and fr that hold vs (fr's is 0 when there is no fr).
+    pub vs_corners: [u8; 2],
 }
 
 /// The result of simplification: collapses in order, and what remains.
@@ -447,6 +454,21 @@ impl State {
                 .unwrap_or(NIL)
         };
         let beside = [across(vl, fl), across(vr, fr)];
+        let corner = |f: u32, v: u32| {
+            self.faces[f as usize]
+                .iter()
+                .position(|&x| x == v)
+                .expect("a corner of the face") as u8
+        };
+        let on_vt_vl = moved.iter().copied().find(|&f| {
+            let t = self.faces[f as usize];
+            (0..3).any(|k| t[k] == vt && t[(k + 1) % 3] == vl)
+        });
+        let (flclw, flclw_corner) = match on_vt_vl {
+            Some(f) => (f, corner(f, vt)),
+            None => (beside[0], corner(beside[0], vs)),
+        };
+        let vs_corners = [corner(fl, vs), if fr == NIL { 0 } else { corner(fr, vs) }];
         let record = Collapse {
             vs,
             vt,
@@ -458,6 +480,9 @@ impl State {
             vr,
             moved,
             beside,
+            flclw,
+            flclw_corner,
+            vs_corners,
         };
         for &f in &record.moved {
             for x in self.faces[f as usize].iter_mut() {
@@ -683,7 +708,7 @@ impl State {
 /// regions, in parallel.
 const REGION_MIN_FACES: usize = 200_000;
 /// Regions of the parallel phase (a power of two: halved along the longest axis).
-const REGION_COUNT: usize = 8;
+const REGION_COUNT: usize = 32;
 /// The parallel phase makes the collapses cheaper than this quantile of the initial edge costs;
 /// the rest, with the seams, goes to the global greedy loop. Measured on bunny-closed-35k ×16:
 /// 0.5 leaves 50% of the collapses to the global loop (0.32 M faces/s), 0.97 leaves 7% (0.49 M
@@ -691,6 +716,8 @@ const REGION_COUNT: usize = 8;
 /// level stays within 6% of one global loop (some better, some worse) and the stream grows
 /// 0.14%; on it ×4 (278k faces), within 2%.
 const REGION_COST_QUANTILE: f64 = 0.97;
+/// About this many evenly spaced edges are placed to estimate that quantile.
+const REGION_COST_SAMPLES: usize = 1 << 16;
 
 /// Region of each face: its first corner's place in a k-d split of the vertices into
 /// [`REGION_COUNT`] boxes of equal vertex counts.
@@ -748,22 +775,26 @@ struct RegionRun {
 fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
     // Every region stops at the same cost, so that the seams, collapsed after, are the only
     // collapses out of cost order.
-    let mut initial: Vec<f32> = state
+    // The quantile is estimated from evenly spaced edges.
+    let stride = (state.edges.len() / REGION_COST_SAMPLES).max(1);
+    let mut sampled: Vec<f32> = state
         .edges
         .par_iter()
+        .step_by(stride)
         .map(|&[a, b]| state.place(a, b).1 as f32)
         .collect();
-    if initial.is_empty() {
+    if sampled.is_empty() {
         return;
     }
-    let middle = ((initial.len() as f64 * REGION_COST_QUANTILE) as usize).min(initial.len() - 1);
-    let max_cost = *initial.select_nth_unstable_by(middle, f32::total_cmp).1;
-    drop(initial);
+    let middle = ((sampled.len() as f64 * REGION_COST_QUANTILE) as usize).min(sampled.len() - 1);
+    let max_cost = *sampled.select_nth_unstable_by(middle, f32::total_cmp).1;
     let regions = face_regions(&state.cells, &state.faces);
     let n = state.cells.len();
     let mut region_of = vec![u8::MAX; n];
     let mut shared = vec![false; n];
-    for (t, &r) in state.faces.iter().zip(&regions) {
+    let mut region_faces: Vec<Vec<u32>> = vec![Vec::new(); REGION_COUNT];
+    for (f, (t, &r)) in state.faces.iter().zip(&regions).enumerate() {
+        region_faces[r as usize].push(f as u32);
         for &v in t {
             let slot = &mut region_of[v as usize];
             if *slot == u8::MAX {
@@ -773,12 +804,9 @@ fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
             }
         }
     }
-    let runs: Vec<RegionRun> = (0..REGION_COUNT as u8)
+    let mut runs: Vec<RegionRun> = region_faces
         .into_par_iter()
-        .map(|r| {
-            let face_ids: Vec<u32> = (0..state.faces.len() as u32)
-                .filter(|&f| regions[f as usize] == r)
-                .collect();
+        .map(|face_ids| {
             let mut vertices: Vec<u32> = face_ids
                 .iter()
                 .flat_map(|&f| state.faces[f as usize])
@@ -819,6 +847,7 @@ fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
                     fr: global_face(c.fr),
                     moved: c.moved.iter().map(|&f| global_face(f)).collect(),
                     beside: c.beside.map(global_face),
+                    flclw: global_face(c.flclw),
                     ..c
                 })
                 .collect();
@@ -835,17 +864,27 @@ fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
             }
         })
         .collect();
-    // Interleave: always the cheapest next collapse of any region.
-    let mut next = vec![0usize; runs.len()];
-    loop {
-        let cheapest = (0..runs.len())
-            .filter(|&r| next[r] < runs[r].costs.len())
-            .min_by(|&x, &y| runs[x].costs[next[x]].total_cmp(&runs[y].costs[next[y]]));
-        let Some(r) = cheapest else {
-            break;
-        };
-        collapses.push(runs[r].collapses[next[r]].clone());
-        next[r] += 1;
+    // Interleave: always the cheapest next collapse of any region (ties: the lower region).
+    // Costs are not negative, so their bits order them.
+    let mut made: Vec<_> = runs
+        .iter_mut()
+        .map(|run| {
+            std::mem::take(&mut run.collapses)
+                .into_iter()
+                .zip(std::mem::take(&mut run.costs))
+                .peekable()
+        })
+        .collect();
+    let mut heads: std::collections::BinaryHeap<_> = made
+        .iter_mut()
+        .enumerate()
+        .filter_map(|(r, m)| Some(std::cmp::Reverse((m.peek()?.1.to_bits(), r))))
+        .collect();
+    while let Some(std::cmp::Reverse((_, r))) = heads.pop() {
+        collapses.extend(made[r].next().map(|(c, _)| c));
+        if let Some((_, cost)) = made[r].peek() {
+            heads.push(std::cmp::Reverse((cost.to_bits(), r)));
+        }
     }
     for run in runs {
         for (i, &v) in run.vertices.iter().enumerate() {
@@ -925,8 +964,7 @@ pub struct ProgressiveMesh {
 }
 
 /// Builds the progressive mesh of a simplification: base mesh from what remains, then the
-/// collapses in reverse as vertex splits with Hoppe's fields, each applied as it is made so that
-/// its face ids are those a decoder will have.
+/// collapses in reverse as vertex splits with Hoppe's fields.
 pub fn progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -> ProgressiveMesh {
     let natural: Vec<usize> = (0..s.collapses.len()).rev().collect();
     build(original_faces, s, &natural)
@@ -934,22 +972,39 @@ pub fn progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -> Progress
 
 /// The progressive mesh with the splits (collapse indices) applied in `order`, which must respect
 /// their dependencies.
+///
+/// Every field of a split follows from its collapse record once the face ids a decoder will
+/// assign are known (base faces, then fl and fr of each split in turn), so the records are made
+/// in parallel without replaying the splits. Face corners keep their places through collapses
+/// and splits; only the first corner differs: a split creates fl as (vs, vl, vt) and fr as
+/// (vs, vt, vr), where the simplifier's face starts wherever the input face did.
 fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> ProgressiveMesh {
     let n = s.vertex_alive.len();
+    let mut vertex_origin: Vec<u32> = (0..n as u32)
+        .filter(|&v| s.vertex_alive[v as usize])
+        .collect();
     let mut new_id = vec![NIL; n];
-    let mut vertex_origin = Vec::with_capacity(n);
-    for (v, id) in new_id.iter_mut().enumerate() {
-        if s.vertex_alive[v] {
-            *id = vertex_origin.len() as u32;
-            vertex_origin.push(v as u32);
-        }
+    for (id, &v) in vertex_origin.iter().enumerate() {
+        new_id[v as usize] = id as u32;
     }
     let mut face_id = vec![NIL; original_faces.len()];
+    // Which of the simplifier's corners of each face is the decoder's first.
+    let mut first_corner = vec![0u8; original_faces.len()];
     let mut base_faces = Vec::new();
     for (f, t) in s.faces.iter().enumerate() {
         if s.face_alive[f] {
             face_id[f] = base_faces.len() as u32;
             base_faces.push(t.map(|v| new_id[v as usize]));
+        }
+    }
+    let mut next_face = base_faces.len() as u32;
+    for c in order.iter().map(|&i| &s.collapses[i]) {
+        for (f, corner) in [(c.fl, c.vs_corners[0]), (c.fr, c.vs_corners[1])] {
+            if f != NIL {
+                face_id[f as usize] = next_face;
+                first_corner[f as usize] = corner;
+                next_face += 1;
+            }
         }
     }
     let base_positions: Vec<[i32; 3]> = vertex_origin
@@ -958,116 +1013,68 @@ fn build(original_faces: &[[u32; 3]], s: &Simplified, order: &[usize]) -> Progre
         .collect();
     let base = PmMesh::from_triangles(base_positions, &base_faces)
         .expect("simplification keeps an oriented manifold");
-    let mut mesh = base.clone();
-    mesh.faces.reserve(original_faces.len() - mesh.faces.len());
-    mesh.positions.reserve(n - mesh.positions.len());
-    let mut vsplits = Vec::with_capacity(s.collapses.len());
-    let mut moved = Vec::new();
-    for c in order.iter().map(|&i| &s.collapses[i]) {
-        let (vs, vl) = (new_id[c.vs as usize], new_id[c.vl as usize]);
-        let vr = if c.vr == NIL {
-            NIL
-        } else {
-            new_id[c.vr as usize]
-        };
-        moved.clear();
-        moved.extend(c.moved.iter().map(|&f| face_id[f as usize]));
-        let across_vl = if c.beside[0] == NIL {
-            NIL
-        } else {
-            face_id[c.beside[0] as usize]
-        };
-        let (flclw, vs_index, vlr_rot) = locate_split(&mesh, vs, vl, vr, across_vl, &moved);
-        let (ps, pt) = (c.before[0], c.before[1]);
-        let vad_l = [pt[0] - ps[0], pt[1] - ps[1], pt[2] - ps[2]];
-        let step = vad_s_step(vad_l);
-        let (ii, vad_s) = (0..3u8)
-            .map(|ii| {
-                let a = anchor(ii, ps, pt);
-                (
-                    ii,
-                    [a[0] - c.after[0], a[1] - c.after[1], a[2] - c.after[2]],
-                )
-            })
-            .filter(|(_, d)| d.iter().all(|x| x % step == 0))
-            .min_by_key(|(ii, d)| {
-                (
-                    d.iter().map(|x| x.unsigned_abs() as u64).sum::<u64>(),
-                    2 - *ii as i32,
-                )
-            })
-            .expect("placements are snapped to an endpoint's step grid");
-        let split = Vsplit {
-            flclw,
-            vs_index,
-            vlr_rot,
-            ii,
-            vad_l,
-            vad_s,
-        };
-        let vt = mesh
-            .vsplit(&split)
-            .expect("a split made from a collapse applies");
-        #[cfg(test)]
-        if let Err(e) = mesh.check_invariants() {
-            panic!(
-                "after split {} {:?} (moved {} {:?} {:?}): {e}",
-                vsplits.len(),
-                split,
-                moved.len(),
-                c,
-                s.collapses.len()
-            );
+    let vsplits: Vec<Vsplit> = order
+        .par_iter()
+        .map(|&i| {
+            let c = &s.collapses[i];
+            let f = c.flclw as usize;
+            let vlr_rot = match (c.moved.len() as u32, c.vr == NIL) {
+                (0, true) => Rotation::Empty,
+                (0, false) => Rotation::EmptyAcrossGap,
+                (_, true) => Rotation::ToBoundary,
+                (k, false) => Rotation::Faces(k - 1),
+            };
+            let (ps, pt) = (c.before[0], c.before[1]);
+            let vad_l = [pt[0] - ps[0], pt[1] - ps[1], pt[2] - ps[2]];
+            let step = vad_s_step(vad_l);
+            let (ii, vad_s) = (0..3u8)
+                .map(|ii| {
+                    let a = anchor(ii, ps, pt);
+                    (
+                        ii,
+                        [a[0] - c.after[0], a[1] - c.after[1], a[2] - c.after[2]],
+                    )
+                })
+                .filter(|(_, d)| d.iter().all(|x| x % step == 0))
+                .min_by_key(|(ii, d)| {
+                    (
+                        d.iter().map(|x| x.unsigned_abs() as u64).sum::<u64>(),
+                        2 - *ii as i32,
+                    )
+                })
+                .expect("placements are snapped to an endpoint's step grid");
+            Vsplit {
+                flclw: face_id[f],
+                vs_index: (c.flclw_corner + 3 - first_corner[f]) % 3,
+                vlr_rot,
+                ii,
+                vad_l,
+                vad_s,
+            }
+        })
+        .collect();
+    vertex_origin.extend(order.iter().map(|&i| s.collapses[i].vt));
+    #[cfg(test)]
+    {
+        // The records rebuild the mesh: every split applies, keeps the invariants and puts vt
+        // where it was.
+        let mut mesh = base.clone();
+        for (k, (split, &i)) in vsplits.iter().zip(order).enumerate() {
+            let c = &s.collapses[i];
+            let vt = mesh
+                .vsplit(split)
+                .unwrap_or_else(|e| panic!("split {k} {split:?} of {c:?}: {e:?}"));
+            if let Err(e) = mesh.check_invariants() {
+                panic!("after split {k} {split:?} of {c:?}: {e}");
+            }
+            assert_eq!(mesh.positions[vt as usize], c.before[1]);
         }
-        debug_assert_eq!(mesh.positions[vt as usize], pt);
-        new_id[c.vt as usize] = vt;
-        vertex_origin.push(c.vt);
-        face_id[c.fl as usize] = mesh.faces.len() as u32 - if c.fr == NIL { 1 } else { 2 };
-        if c.fr != NIL {
-            face_id[c.fr as usize] = mesh.faces.len() as u32 - 1;
-        }
-        vsplits.push(split);
     }
     ProgressiveMesh {
         base,
         vsplits,
         vertex_origin,
     }
-}
-
-/// Hoppe's location fields of the split of `vs` between `vl` and `vr` that gives vt the faces
-/// `moved`; `across_vl` is the face across (vs, vl) from fl (face ids of `mesh`).
-fn locate_split(
-    mesh: &PmMesh,
-    vs: u32,
-    vl: u32,
-    vr: u32,
-    across_vl: u32,
-    moved: &[u32],
-) -> (u32, u8, Rotation) {
-    let corner = |f: u32| mesh.corner(f, vs).expect("a face of vs") as u8;
-    if moved.is_empty() {
-        let rot = if vr == NIL {
-            Rotation::Empty
-        } else {
-            Rotation::EmptyAcrossGap
-        };
-        return (across_vl, corner(across_vl), rot);
-    }
-    // The moved arc starts at the one face with directed edge vs → vl.
-    let f0 = *moved
-        .iter()
-        .find(|&&f| {
-            let t = mesh.faces[f as usize].v;
-            (0..3).any(|k| t[k] == vs && t[(k + 1) % 3] == vl)
-        })
-        .expect("a moved face starts at vl");
-    let rot = if vr == NIL {
-        Rotation::ToBoundary
-    } else {
-        Rotation::Faces(moved.len() as u32 - 1)
-    };
-    (f0, corner(f0), rot)
 }
 
 /// The progressive mesh of a simplification with its splits reordered so that successive
@@ -1137,23 +1144,7 @@ pub fn reordered_progressive_mesh(original_faces: &[[u32; 3]], s: &Simplified) -
             indegree[k as usize] += 1;
         }
     }
-    // flclw of each split, as an original face id, from the natural order's records.
-    let natural = progressive_mesh(original_faces, s);
-    let mut origin_face: Vec<u32> = (0..original_faces.len() as u32)
-        .filter(|&f| s.face_alive[f as usize])
-        .collect();
-    for &ci in &splits {
-        let c = &s.collapses[ci];
-        origin_face.push(c.fl);
-        if c.fr != NIL {
-            origin_face.push(c.fr);
-        }
-    }
-    let flclw_origin: Vec<u32> = natural
-        .vsplits
-        .iter()
-        .map(|v| origin_face[v.flclw as usize])
-        .collect();
+    let flclw_origin: Vec<u32> = splits.iter().map(|&ci| s.collapses[ci].flclw).collect();
     // Face ids in the new order, assigned as faces are created.
     let mut face_id = vec![NIL; original_faces.len()];
     let mut next_face = 0u32;
