@@ -597,9 +597,13 @@ fn initial_quadrics(cells: &[[i32; 3]], faces: &[[u32; 3]], topology: &Topology)
         .into_par_iter()
         .map(|v| {
             let mut q = Quadric::default();
+            let on_boundary = vedges[v].iter().any(|&e| edge_faces[e as usize] == 1);
             for &f in &vfaces[v] {
                 let t = faces[f as usize];
                 q.add(&face_quadric(&t));
+                if !on_boundary {
+                    continue;
+                }
                 for k in 0..3 {
                     let (u, w) = (t[k], t[(k + 1) % 3]);
                     if (u == v as u32 || w == v as u32) && is_boundary(u, w) {
@@ -621,15 +625,6 @@ fn initial_quadrics(cells: &[[i32; 3]], faces: &[[u32; 3]], topology: &Topology)
 }
 
 impl State {
-    /// Replaces the face, edge and placement lists by those of the live faces.
-    fn rebuild_topology(&mut self) {
-        let t = topology(self.cells.len(), &self.faces, &self.face_alive);
-        self.vfaces = t.vfaces;
-        self.vedges = t.vedges;
-        self.target = vec![[0; 3]; t.edges.len()];
-        self.edges = t.edges;
-    }
-
     /// One pass of greedy collapses, cheapest first, over every edge without a frozen end, until
     /// none passes the checks or the cheapest costs more than `max_cost`. Appends the collapses
     /// and their costs.
@@ -768,6 +763,91 @@ struct RegionRun {
     face_alive: Vec<bool>,
 }
 
+impl RegionRun {
+    /// Simplifies the faces `face_ids` of `state` on a compact copy of them (which keeps what it
+    /// touches in cache), greedily, leaving the `frozen` vertices where they are, up to
+    /// `max_cost`: one pass, or with `until_dry` passes until one collapses nothing.
+    fn simplify(
+        state: &State,
+        face_ids: Vec<u32>,
+        frozen: &[bool],
+        max_cost: f32,
+        until_dry: bool,
+    ) -> RegionRun {
+        let mut vertices: Vec<u32> = face_ids
+            .iter()
+            .flat_map(|&f| state.faces[f as usize])
+            .collect();
+        vertices.sort_unstable();
+        vertices.dedup();
+        let local = |v: u32| vertices.binary_search(&v).expect("a corner") as u32;
+        let faces: Vec<[u32; 3]> = face_ids
+            .iter()
+            .map(|&f| state.faces[f as usize].map(local))
+            .collect();
+        let topology = topology(vertices.len(), &faces, &vec![true; faces.len()]);
+        let mut region = State::new(
+            vertices.iter().map(|&v| state.cells[v as usize]).collect(),
+            faces,
+            vertices
+                .iter()
+                .map(|&v| state.quadrics[v as usize])
+                .collect(),
+            vertices.iter().map(|&v| frozen[v as usize]).collect(),
+            state.placement,
+            state.bounds,
+            topology,
+        );
+        let (mut local_collapses, mut costs) = (Vec::new(), Vec::new());
+        while region.collapse_greedily(max_cost, &mut local_collapses, &mut costs) > 0 && until_dry
+        {
+        }
+        let global_vertex = |v: u32| if v == NIL { NIL } else { vertices[v as usize] };
+        let global_face = |f: u32| if f == NIL { NIL } else { face_ids[f as usize] };
+        let collapses = local_collapses
+            .into_iter()
+            .map(|c| Collapse {
+                vs: global_vertex(c.vs),
+                vt: global_vertex(c.vt),
+                vl: global_vertex(c.vl),
+                vr: global_vertex(c.vr),
+                fl: global_face(c.fl),
+                fr: global_face(c.fr),
+                moved: c.moved.iter().map(|&f| global_face(f)).collect(),
+                beside: c.beside.map(global_face),
+                flclw: global_face(c.flclw),
+                ..c
+            })
+            .collect();
+        RegionRun {
+            collapses,
+            costs,
+            faces: region.faces.iter().map(|t| t.map(global_vertex)).collect(),
+            cells: region.cells,
+            quadrics: region.quadrics,
+            vertex_alive: region.vertex_alive,
+            face_alive: region.face_alive,
+            vertices,
+            face_ids,
+        }
+    }
+
+    /// Copies the run's faces and its vertices but the `frozen` ones back into `state`.
+    fn write_back(self, state: &mut State, frozen: &[bool]) {
+        for (i, &v) in self.vertices.iter().enumerate() {
+            if !frozen[v as usize] {
+                state.cells[v as usize] = self.cells[i];
+                state.quadrics[v as usize] = self.quadrics[i];
+                state.vertex_alive[v as usize] = self.vertex_alive[i];
+            }
+        }
+        for (i, &f) in self.face_ids.iter().enumerate() {
+            state.faces[f as usize] = self.faces[i];
+            state.face_alive[f as usize] = self.face_alive[i];
+        }
+    }
+}
+
 /// The parallel phase: each region collapses its own edges, greedily, with the vertices it
 /// shares with other regions frozen, so that no two regions touch the same face or vertex and
 /// their collapses can be interleaved in any order. The interleaving follows the costs (always
@@ -806,63 +886,7 @@ fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
     }
     let mut runs: Vec<RegionRun> = region_faces
         .into_par_iter()
-        .map(|face_ids| {
-            let mut vertices: Vec<u32> = face_ids
-                .iter()
-                .flat_map(|&f| state.faces[f as usize])
-                .collect();
-            vertices.sort_unstable();
-            vertices.dedup();
-            let local = |v: u32| vertices.binary_search(&v).expect("a corner") as u32;
-            let faces: Vec<[u32; 3]> = face_ids
-                .iter()
-                .map(|&f| state.faces[f as usize].map(local))
-                .collect();
-            let frozen: Vec<bool> = vertices.iter().map(|&v| shared[v as usize]).collect();
-            let topology = topology(vertices.len(), &faces, &vec![true; faces.len()]);
-            let mut region = State::new(
-                vertices.iter().map(|&v| state.cells[v as usize]).collect(),
-                faces,
-                vertices
-                    .iter()
-                    .map(|&v| state.quadrics[v as usize])
-                    .collect(),
-                frozen,
-                state.placement,
-                state.bounds,
-                topology,
-            );
-            let (mut local_collapses, mut costs) = (Vec::new(), Vec::new());
-            region.collapse_greedily(max_cost, &mut local_collapses, &mut costs);
-            let global_vertex = |v: u32| if v == NIL { NIL } else { vertices[v as usize] };
-            let global_face = |f: u32| if f == NIL { NIL } else { face_ids[f as usize] };
-            let collapses = local_collapses
-                .into_iter()
-                .map(|c| Collapse {
-                    vs: global_vertex(c.vs),
-                    vt: global_vertex(c.vt),
-                    vl: global_vertex(c.vl),
-                    vr: global_vertex(c.vr),
-                    fl: global_face(c.fl),
-                    fr: global_face(c.fr),
-                    moved: c.moved.iter().map(|&f| global_face(f)).collect(),
-                    beside: c.beside.map(global_face),
-                    flclw: global_face(c.flclw),
-                    ..c
-                })
-                .collect();
-            RegionRun {
-                collapses,
-                costs,
-                faces: region.faces.iter().map(|t| t.map(global_vertex)).collect(),
-                cells: region.cells,
-                quadrics: region.quadrics,
-                vertex_alive: region.vertex_alive,
-                face_alive: region.face_alive,
-                vertices,
-                face_ids,
-            }
-        })
+        .map(|face_ids| RegionRun::simplify(state, face_ids, &shared, max_cost, false))
         .collect();
     // Interleave: always the cheapest next collapse of any region (ties: the lower region).
     // Costs are not negative, so their bits order them.
@@ -887,19 +911,8 @@ fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
         }
     }
     for run in runs {
-        for (i, &v) in run.vertices.iter().enumerate() {
-            if !shared[v as usize] {
-                state.cells[v as usize] = run.cells[i];
-                state.quadrics[v as usize] = run.quadrics[i];
-                state.vertex_alive[v as usize] = run.vertex_alive[i];
-            }
-        }
-        for (i, &f) in run.face_ids.iter().enumerate() {
-            state.faces[f as usize] = run.faces[i];
-            state.face_alive[f as usize] = run.face_alive[i];
-        }
+        run.write_back(state, &shared);
     }
-    state.rebuild_topology();
 }
 
 /// Simplifies the oriented manifold mesh (`cells`, `faces`) as far as the rules allow.
@@ -937,12 +950,21 @@ fn simplify_with_regions(
         t,
     );
     let mut collapses = Vec::new();
+    // When a pass runs dry, every remaining edge is queued again, until a pass collapses nothing.
     if regions {
         collapse_regions(&mut state, &mut collapses);
+        // The seams and the rest, on a compact copy of what remains.
+        let live = (0..faces.len() as u32)
+            .filter(|&f| state.face_alive[f as usize])
+            .collect();
+        let none_frozen = vec![false; n];
+        let mut rest = RegionRun::simplify(&state, live, &none_frozen, f32::INFINITY, true);
+        collapses.append(&mut rest.collapses);
+        rest.write_back(&mut state, &none_frozen);
+    } else {
+        let mut costs = Vec::new();
+        while state.collapse_greedily(f32::INFINITY, &mut collapses, &mut costs) > 0 {}
     }
-    // When a pass runs dry, every remaining edge is queued again, until a pass collapses nothing.
-    let mut costs = Vec::new();
-    while state.collapse_greedily(f32::INFINITY, &mut collapses, &mut costs) > 0 {}
     Simplified {
         collapses,
         vertex_alive: state.vertex_alive,
