@@ -702,102 +702,182 @@ impl State {
 /// Meshes below this many faces are simplified by one greedy loop; larger ones first in
 /// regions, in parallel.
 const REGION_MIN_FACES: usize = 200_000;
-/// Regions of the parallel phase (a power of two: halved along the longest axis).
-const REGION_COUNT: usize = 32;
-/// The parallel phase makes the collapses cheaper than this quantile of the initial edge costs;
-/// the rest, with the seams, goes to the global greedy loop. Measured on bunny-closed-35k ×16:
-/// 0.5 leaves 50% of the collapses to the global loop (0.32 M faces/s), 0.97 leaves 7% (0.49 M
-/// faces/s). On bunny-closed-35k itself, forced through the regions, the RMS error of every
-/// level stays within 6% of one global loop (some better, some worse) and the stream grows
-/// 0.14%; on it ×4 (278k faces), within 2%.
+/// Faces per region in the first round. Small regions keep a greedy loop's data in cache: on
+/// bunny-closed-35k ×16, regions of 140k faces collapse at 3.2 µs per collapse, of 35k at
+/// 2.0 µs; 17k made the whole 7% faster than 35k.
+const REGION_FACES: usize = 1 << 14;
+/// At most this many regions (region ids are bytes).
+const MAX_REGIONS: usize = 128;
+/// Regions of the second round, which cuts across the first round's seams.
+const SECOND_ROUND_REGIONS: usize = 8;
+/// Each round makes the collapses cheaper than this quantile of its initial edge costs; the
+/// rest, with the seams, goes to the next. Measured on bunny-closed-35k ×16 with one round:
+/// 0.5 leaves 50% of the collapses to the global loop, 0.97 leaves 7%. On bunny-closed-35k ×4
+/// (278k faces), the RMS error of every level stays within 4% of one global loop (most of them
+/// better) and the stream grows 0.06%.
 const REGION_COST_QUANTILE: f64 = 0.97;
 /// About this many evenly spaced edges are placed to estimate that quantile.
 const REGION_COST_SAMPLES: usize = 1 << 16;
 
-/// Region of each face: its first corner's place in a k-d split of the vertices into
-/// [`REGION_COUNT`] boxes of equal vertex counts.
-fn face_regions(cells: &[[i32; 3]], faces: &[[u32; 3]]) -> Vec<u8> {
-    fn split(cells: &[[i32; 3]], ids: &mut [u32], region: u8, depth: u32, out: &mut [u8]) {
-        if 1usize << depth == REGION_COUNT {
-            for &v in ids.iter() {
-                out[v as usize] = region;
-            }
-            return;
-        }
-        let (lo, hi) = ids
+/// The faces `face_ids` in `count` regions (a power of two): each face goes where its first
+/// corner is in a k-d split of their vertices into sets of equal size, each set halved across
+/// the one of `directions` along which it is longest.
+fn split_into_regions(
+    cells: &[[i32; 3]],
+    faces: &[[u32; 3]],
+    face_ids: &[u32],
+    directions: &[[i64; 3]],
+    count: usize,
+) -> Vec<Vec<u32>> {
+    let along = |d: &[i64; 3], v: u32| -> i64 {
+        let c = cells[v as usize];
+        (0..3).map(|a| d[a] * i64::from(c[a])).sum()
+    };
+    let split = |ids: &mut [u32]| {
+        let extent = |d: &[i64; 3]| {
+            let (lo, hi) = ids.par_iter().map(|&v| (along(d, v), along(d, v))).reduce(
+                || (i64::MAX, i64::MIN),
+                |(lo, hi), (l, h)| (lo.min(l), hi.max(h)),
+            );
+            hi.saturating_sub(lo)
+        };
+        let d = directions
             .iter()
-            .fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), &v| {
-                let c = cells[v as usize];
-                (
-                    [0, 1, 2].map(|a| lo[a].min(c[a])),
-                    [0, 1, 2].map(|a| hi[a].max(c[a])),
-                )
-            });
-        let axis = (0..3)
-            .max_by_key(|&a| i64::from(hi[a]) - i64::from(lo[a]))
-            .unwrap_or(0);
+            .max_by_key(|d| extent(d))
+            .expect("a direction");
         let middle = ids.len() / 2;
-        ids.select_nth_unstable_by_key(middle, |&v| (cells[v as usize][axis], v));
-        let (low, high) = ids.split_at_mut(middle);
-        split(cells, low, region * 2, depth + 1, out);
-        split(cells, high, region * 2 + 1, depth + 1, out);
+        ids.select_nth_unstable_by_key(middle, |&v| (along(d, v), v));
+        middle
+    };
+    let mut ids: Vec<u32> = face_ids.iter().map(|&f| faces[f as usize][0]).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    // Halve every set until there are `count`.
+    let mut sets: Vec<&mut [u32]> = vec![&mut ids];
+    while sets.len() < count {
+        sets = sets
+            .into_par_iter()
+            .flat_map_iter(|set| {
+                let middle = split(set);
+                let (low, high) = set.split_at_mut(middle);
+                [low, high]
+            })
+            .collect();
     }
     let mut vertex_region = vec![0u8; cells.len()];
-    let mut ids: Vec<u32> = (0..cells.len() as u32).collect();
-    split(cells, &mut ids, 0, 0, &mut vertex_region);
-    faces.iter().map(|t| vertex_region[t[0] as usize]).collect()
+    for (r, set) in sets.iter().enumerate() {
+        for &v in set.iter() {
+            vertex_region[v as usize] = r as u8;
+        }
+    }
+    let mut regions = vec![Vec::new(); count];
+    for &f in face_ids {
+        regions[vertex_region[faces[f as usize][0] as usize] as usize].push(f);
+    }
+    regions
 }
 
-/// What one region's simplification made, in global ids.
+/// The mesh as the region phase keeps it: parts of it are simplified on compact copies and
+/// written back.
+struct Whole {
+    cells: Vec<[i32; 3]>,
+    faces: Vec<[u32; 3]>,
+    quadrics: Vec<Quadric>,
+    vertex_alive: Vec<bool>,
+    face_alive: Vec<bool>,
+    placement: Placement,
+    bounds: ([i32; 3], [i32; 3]),
+}
+
+/// The vertices of some faces (sorted) and the faces in their indices.
+fn compact(faces: &[[u32; 3]], face_ids: &[u32]) -> (Vec<u32>, Vec<[u32; 3]>) {
+    let mut vertices: Vec<u32> = face_ids.iter().flat_map(|&f| faces[f as usize]).collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    let local = |v: u32| vertices.binary_search(&v).expect("a corner") as u32;
+    let local_faces = face_ids
+        .iter()
+        .map(|&f| faces[f as usize].map(local))
+        .collect();
+    (vertices, local_faces)
+}
+
+/// Some faces of the whole mesh, on a compact copy that keeps what a greedy loop touches in
+/// cache.
+struct Part {
+    state: State,
+    /// Whole-mesh id of each vertex and face of the part.
+    vertices: Vec<u32>,
+    face_ids: Vec<u32>,
+}
+
+/// What a part's simplification made, in whole-mesh ids.
 struct RegionRun {
     collapses: Vec<Collapse>,
     costs: Vec<f32>,
-    /// Global id of each local vertex, and its final state.
+    /// Whole-mesh id of each vertex of the part, and its final state.
     vertices: Vec<u32>,
     cells: Vec<[i32; 3]>,
     quadrics: Vec<Quadric>,
     vertex_alive: Vec<bool>,
-    /// Global id of each local face, and its final corners (global ids) and state.
+    /// Whole-mesh id of each face of the part, and its final corners (whole-mesh ids) and state.
     face_ids: Vec<u32>,
     faces: Vec<[u32; 3]>,
     face_alive: Vec<bool>,
 }
 
-impl RegionRun {
-    /// Simplifies the faces `face_ids` of `state` on a compact copy of them (which keeps what it
-    /// touches in cache), greedily, leaving the `frozen` vertices where they are, up to
-    /// `max_cost`: one pass, or with `until_dry` passes until one collapses nothing.
-    fn simplify(
-        state: &State,
-        face_ids: Vec<u32>,
-        frozen: &[bool],
-        max_cost: f32,
-        until_dry: bool,
-    ) -> RegionRun {
-        let mut vertices: Vec<u32> = face_ids
-            .iter()
-            .flat_map(|&f| state.faces[f as usize])
-            .collect();
-        vertices.sort_unstable();
-        vertices.dedup();
-        let local = |v: u32| vertices.binary_search(&v).expect("a corner") as u32;
-        let faces: Vec<[u32; 3]> = face_ids
-            .iter()
-            .map(|&f| state.faces[f as usize].map(local))
-            .collect();
+impl Part {
+    /// The faces `face_ids` of `whole`, with the `frozen` vertices left where they are. With
+    /// `own_quadrics` the part sums its vertices' quadrics itself, which is exact for every
+    /// vertex whose faces all lie in the part; otherwise it takes them from `whole`.
+    fn new(whole: &Whole, face_ids: Vec<u32>, frozen: &[bool], own_quadrics: bool) -> Part {
+        let (vertices, faces) = compact(&whole.faces, &face_ids);
         let topology = topology(vertices.len(), &faces, &vec![true; faces.len()]);
-        let mut region = State::new(
-            vertices.iter().map(|&v| state.cells[v as usize]).collect(),
-            faces,
+        let cells: Vec<[i32; 3]> = vertices.iter().map(|&v| whole.cells[v as usize]).collect();
+        let quadrics = if own_quadrics {
+            initial_quadrics(&cells, &faces, &topology)
+        } else {
             vertices
                 .iter()
-                .map(|&v| state.quadrics[v as usize])
-                .collect(),
+                .map(|&v| whole.quadrics[v as usize])
+                .collect()
+        };
+        let state = State::new(
+            cells,
+            faces,
+            quadrics,
             vertices.iter().map(|&v| frozen[v as usize]).collect(),
-            state.placement,
-            state.bounds,
+            whole.placement,
+            whole.bounds,
             topology,
         );
+        Part {
+            state,
+            vertices,
+            face_ids,
+        }
+    }
+
+    /// Collapse costs of every `stride`-th edge that may collapse.
+    fn sample_costs(&self, stride: usize) -> Vec<f32> {
+        let state = &self.state;
+        state
+            .edges
+            .iter()
+            .filter(|&&[a, b]| !state.frozen[a as usize] && !state.frozen[b as usize])
+            .step_by(stride)
+            .map(|&[a, b]| state.place(a, b).1 as f32)
+            .collect()
+    }
+
+    /// Simplifies the part greedily up to `max_cost`: one pass, or with `until_dry` passes until
+    /// one collapses nothing.
+    fn simplify(self, max_cost: f32, until_dry: bool) -> RegionRun {
+        let Part {
+            state: mut region,
+            vertices,
+            face_ids,
+        } = self;
         let (mut local_collapses, mut costs) = (Vec::new(), Vec::new());
         while region.collapse_greedily(max_cost, &mut local_collapses, &mut costs) > 0 && until_dry
         {
@@ -831,88 +911,200 @@ impl RegionRun {
             face_ids,
         }
     }
+}
 
-    /// Copies the run's faces and its vertices but the `frozen` ones back into `state`.
-    fn write_back(self, state: &mut State, frozen: &[bool]) {
+impl RegionRun {
+    /// Copies the run's faces and its vertices but the `frozen` ones back into `whole`.
+    fn write_back(&self, whole: &mut Whole, frozen: &[bool]) {
         for (i, &v) in self.vertices.iter().enumerate() {
             if !frozen[v as usize] {
-                state.cells[v as usize] = self.cells[i];
-                state.quadrics[v as usize] = self.quadrics[i];
-                state.vertex_alive[v as usize] = self.vertex_alive[i];
+                whole.cells[v as usize] = self.cells[i];
+                whole.quadrics[v as usize] = self.quadrics[i];
+                whole.vertex_alive[v as usize] = self.vertex_alive[i];
             }
         }
         for (i, &f) in self.face_ids.iter().enumerate() {
-            state.faces[f as usize] = self.faces[i];
-            state.face_alive[f as usize] = self.face_alive[i];
+            whole.faces[f as usize] = self.faces[i];
+            whole.face_alive[f as usize] = self.face_alive[i];
         }
     }
 }
 
-/// The parallel phase: each region collapses its own edges, greedily, with the vertices it
-/// shares with other regions frozen, so that no two regions touch the same face or vertex and
-/// their collapses can be interleaved in any order. The interleaving follows the costs (always
-/// the cheapest next collapse of any region), so the sequence stays close to one greedy loop.
-fn collapse_regions(state: &mut State, collapses: &mut Vec<Collapse>) {
-    // Every region stops at the same cost, so that the seams, collapsed after, are the only
-    // collapses out of cost order.
-    // The quantile is estimated from evenly spaced edges.
-    let stride = (state.edges.len() / REGION_COST_SAMPLES).max(1);
-    let mut sampled: Vec<f32> = state
-        .edges
-        .par_iter()
-        .step_by(stride)
-        .map(|&[a, b]| state.place(a, b).1 as f32)
-        .collect();
-    if sampled.is_empty() {
-        return;
+/// Simplification in regions, in parallel, then one greedy loop for what remains.
+///
+/// In a round, each region collapses its own edges, greedily, with the vertices it shares with
+/// other regions frozen, so that no two regions touch the same face or vertex and their
+/// collapses can be interleaved in any order. The interleaving follows the costs (always the
+/// cheapest next collapse of any region), so the sequence stays close to one greedy loop. The
+/// first round cuts the mesh along the axes; the second cuts what remains along diagonal
+/// planes, so that it collapses across the first round's seams. The last greedy loop does the
+/// second round's seams and the costliest collapses.
+///
+/// No topology of the whole mesh is built: in the first round each region sums its own
+/// quadrics (exact for its unshared vertices, all of whose faces it holds) and the shared
+/// vertices get theirs from the band of faces around them.
+fn simplify_in_regions(
+    cells: &[[i32; 3]],
+    faces: &[[u32; 3]],
+    placement: Placement,
+    bounds: ([i32; 3], [i32; 3]),
+) -> Simplified {
+    let n = cells.len();
+    let mut whole = Whole {
+        cells: cells.to_vec(),
+        faces: faces.to_vec(),
+        quadrics: vec![Quadric::default(); n],
+        vertex_alive: vec![true; n],
+        face_alive: vec![true; faces.len()],
+        placement,
+        bounds,
+    };
+    let axes = [[1, 0, 0], [0, 1, 0], [0, 0, 1]];
+    let all: Vec<u32> = (0..faces.len() as u32).collect();
+    // Regions of REGION_FACES to twice that many faces (a power of two of them).
+    let count = (1usize << (faces.len() / REGION_FACES).max(2).ilog2()).min(MAX_REGIONS);
+    let regions = split_into_regions(cells, faces, &all, &axes, count);
+    let (first_runs, max_cost) = collapse_round(&mut whole, regions, None);
+    // The first round's collapses are put in order while the rest are made.
+    let (mut collapses, mut later) = rayon::join(
+        || interleave(first_runs),
+        || simplify_rest(&mut whole, max_cost),
+    );
+    collapses.append(&mut later);
+    Simplified {
+        collapses,
+        vertex_alive: whole.vertex_alive,
+        face_alive: whole.face_alive,
+        positions: whole.cells,
+        faces: whole.faces,
     }
-    let middle = ((sampled.len() as f64 * REGION_COST_QUANTILE) as usize).min(sampled.len() - 1);
-    let max_cost = *sampled.select_nth_unstable_by(middle, f32::total_cmp).1;
-    let regions = face_regions(&state.cells, &state.faces);
-    let n = state.cells.len();
-    let mut region_of = vec![u8::MAX; n];
+}
+
+/// After the first round: the second round, then one greedy loop over what remains.
+fn simplify_rest(whole: &mut Whole, max_cost: f32) -> Vec<Collapse> {
+    let n = whole.cells.len();
+    let diagonals = [[1, 1, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]];
+    let live: Vec<u32> = (0..whole.faces.len() as u32)
+        .filter(|&f| whole.face_alive[f as usize])
+        .collect();
+    let regions = split_into_regions(
+        &whole.cells,
+        &whole.faces,
+        &live,
+        &diagonals,
+        SECOND_ROUND_REGIONS,
+    );
+    let (second_runs, _) = collapse_round(whole, regions, Some(max_cost));
+    let mut collapses = interleave(second_runs);
+    // What remains; when a pass runs dry, every remaining edge is queued again, until a pass
+    // collapses nothing.
+    let live = (0..whole.faces.len() as u32)
+        .filter(|&f| whole.face_alive[f as usize])
+        .collect();
+    let none_frozen = vec![false; n];
+    let mut rest = Part::new(whole, live, &none_frozen, false).simplify(f32::INFINITY, true);
+    collapses.append(&mut rest.collapses);
+    rest.write_back(whole, &none_frozen);
+    collapses
+}
+
+/// One round of the region phase over `regions` (faces of `whole`): up to `max_cost`, or in
+/// the first round (`None`) up to a quantile of the initial costs. Returns each region's
+/// collapses and the cost it stopped at. The first round's regions sum the quadrics of the
+/// input mesh.
+fn collapse_round(
+    whole: &mut Whole,
+    regions: Vec<Vec<u32>>,
+    max_cost: Option<f32>,
+) -> (Vec<RegionRun>, f32) {
+    let first = max_cost.is_none();
+    let n = whole.cells.len();
+    let mut region_of = vec![u32::MAX; n];
     let mut shared = vec![false; n];
-    let mut region_faces: Vec<Vec<u32>> = vec![Vec::new(); REGION_COUNT];
-    for (f, (t, &r)) in state.faces.iter().zip(&regions).enumerate() {
-        region_faces[r as usize].push(f as u32);
-        for &v in t {
-            let slot = &mut region_of[v as usize];
-            if *slot == u8::MAX {
-                *slot = r;
-            } else if *slot != r {
-                shared[v as usize] = true;
+    for (r, face_ids) in regions.iter().enumerate() {
+        for &f in face_ids {
+            for v in whole.faces[f as usize] {
+                let slot = &mut region_of[v as usize];
+                if *slot == u32::MAX {
+                    *slot = r as u32;
+                } else if *slot != r as u32 {
+                    shared[v as usize] = true;
+                }
             }
         }
     }
-    let mut runs: Vec<RegionRun> = region_faces
+    if first {
+        // Quadrics of the shared vertices, from the faces around them.
+        let band: Vec<u32> = regions
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&f| whole.faces[f as usize].iter().any(|&v| shared[v as usize]))
+            .collect();
+        let (band_vertices, band_faces) = compact(&whole.faces, &band);
+        let band_cells: Vec<[i32; 3]> = band_vertices
+            .iter()
+            .map(|&v| whole.cells[v as usize])
+            .collect();
+        let band_topology = topology(band_vertices.len(), &band_faces, &vec![true; band.len()]);
+        let band_quadrics = initial_quadrics(&band_cells, &band_faces, &band_topology);
+        for (&v, q) in band_vertices.iter().zip(band_quadrics) {
+            if shared[v as usize] {
+                whole.quadrics[v as usize] = q;
+            }
+        }
+    }
+    let parts: Vec<Part> = regions
         .into_par_iter()
-        .map(|face_ids| RegionRun::simplify(state, face_ids, &shared, max_cost, false))
+        .map(|face_ids| Part::new(whole, face_ids, &shared, first))
         .collect();
-    // Interleave: always the cheapest next collapse of any region (ties: the lower region).
+    // Every region stops at the same cost, so that the seams, collapsed after, are the only
+    // collapses out of cost order. The quantile is estimated from evenly spaced edges.
+    let max_cost = max_cost.unwrap_or_else(|| {
+        let edge_count: usize = parts.iter().map(|p| p.state.edges.len()).sum();
+        let stride = (edge_count / REGION_COST_SAMPLES).max(1);
+        let mut sampled: Vec<f32> = parts
+            .par_iter()
+            .flat_map_iter(|p| p.sample_costs(stride))
+            .collect();
+        if sampled.is_empty() {
+            return f32::NEG_INFINITY;
+        }
+        let middle =
+            ((sampled.len() as f64 * REGION_COST_QUANTILE) as usize).min(sampled.len() - 1);
+        *sampled.select_nth_unstable_by(middle, f32::total_cmp).1
+    });
+    let mut runs: Vec<RegionRun> = parts
+        .into_par_iter()
+        .map(|part| part.simplify(max_cost, false))
+        .collect();
+    for run in &mut runs {
+        run.write_back(whole, &shared);
+    }
+    (runs, max_cost)
+}
+
+/// The collapses of regions that share no face, in one sequence: always the cheapest next
+/// collapse of any region (ties: the lower region), so that it stays close to one greedy loop.
+fn interleave(runs: Vec<RegionRun>) -> Vec<Collapse> {
     // Costs are not negative, so their bits order them.
     let mut made: Vec<_> = runs
-        .iter_mut()
-        .map(|run| {
-            std::mem::take(&mut run.collapses)
-                .into_iter()
-                .zip(std::mem::take(&mut run.costs))
-                .peekable()
-        })
+        .into_iter()
+        .map(|run| run.collapses.into_iter().zip(run.costs).peekable())
         .collect();
     let mut heads: std::collections::BinaryHeap<_> = made
         .iter_mut()
         .enumerate()
         .filter_map(|(r, m)| Some(std::cmp::Reverse((m.peek()?.1.to_bits(), r))))
         .collect();
+    let mut collapses = Vec::with_capacity(made.iter().map(|m| m.size_hint().0).sum());
     while let Some(std::cmp::Reverse((_, r))) = heads.pop() {
         collapses.extend(made[r].next().map(|(c, _)| c));
         if let Some((_, cost)) = made[r].peek() {
             heads.push(std::cmp::Reverse((cost.to_bits(), r)));
         }
     }
-    for run in runs {
-        run.write_back(state, &shared);
-    }
+    collapses
 }
 
 /// Simplifies the oriented manifold mesh (`cells`, `faces`) as far as the rules allow.
@@ -929,7 +1121,6 @@ fn simplify_with_regions(
     regions: bool,
 ) -> Simplified {
     let n = cells.len();
-    let all = vec![true; faces.len()];
     let bounds = cells
         .iter()
         .fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), c| {
@@ -938,7 +1129,10 @@ fn simplify_with_regions(
                 [0, 1, 2].map(|a| hi[a].max(c[a])),
             )
         });
-    let t = topology(n, faces, &all);
+    if regions {
+        return simplify_in_regions(cells, faces, placement, bounds);
+    }
+    let t = topology(n, faces, &vec![true; faces.len()]);
     let quadrics = initial_quadrics(cells, faces, &t);
     let mut state = State::new(
         cells.to_vec(),
@@ -949,22 +1143,9 @@ fn simplify_with_regions(
         bounds,
         t,
     );
-    let mut collapses = Vec::new();
     // When a pass runs dry, every remaining edge is queued again, until a pass collapses nothing.
-    if regions {
-        collapse_regions(&mut state, &mut collapses);
-        // The seams and the rest, on a compact copy of what remains.
-        let live = (0..faces.len() as u32)
-            .filter(|&f| state.face_alive[f as usize])
-            .collect();
-        let none_frozen = vec![false; n];
-        let mut rest = RegionRun::simplify(&state, live, &none_frozen, f32::INFINITY, true);
-        collapses.append(&mut rest.collapses);
-        rest.write_back(&mut state, &none_frozen);
-    } else {
-        let mut costs = Vec::new();
-        while state.collapse_greedily(f32::INFINITY, &mut collapses, &mut costs) > 0 {}
-    }
+    let (mut collapses, mut costs) = (Vec::new(), Vec::new());
+    while state.collapse_greedily(f32::INFINITY, &mut collapses, &mut costs) > 0 {}
     Simplified {
         collapses,
         vertex_alive: state.vertex_alive,
