@@ -116,7 +116,7 @@ pub struct Collapse {
     /// See `vl`.
     pub vr: u32,
     /// Faces of vt other than fl and fr, which now hold vs.
-    pub moved: Vec<u32>,
+    pub moved: SmallVec<[u32; 6]>,
     /// Faces across (vs, vl) from fl and across (vs, vr) from fr (NIL where none): the split
     /// re-links them.
     pub beside: [u32; 2],
@@ -438,7 +438,7 @@ impl State {
 
     /// Collapses vt into vs at `p`, and records it.
     fn collapse(&mut self, (vs, vt, fl, fr, vl, vr): Checked, p: [i32; 3]) -> Collapse {
-        let moved: Vec<u32> = self.vfaces[vt as usize]
+        let moved: SmallVec<[u32; 6]> = self.vfaces[vt as usize]
             .iter()
             .copied()
             .filter(|&f| f != fl && f != fr)
