@@ -888,8 +888,11 @@ impl Part {
             face_ids,
         } = self;
         let (mut local_collapses, mut costs) = (Vec::new(), Vec::new());
-        while region.collapse_greedily(max_cost, &mut local_collapses, &mut costs) > 0 && until_dry
-        {
+        loop {
+            let made = region.collapse_greedily(max_cost, &mut local_collapses, &mut costs);
+            if made == 0 || !until_dry {
+                break;
+            }
         }
         let global_vertex = |v: u32| if v == NIL { NIL } else { vertices[v as usize] };
         let global_face = |f: u32| if f == NIL { NIL } else { face_ids[f as usize] };
