@@ -169,48 +169,26 @@ impl PmMesh {
 
     /// All faces around `v`, starting at `f` (a face of `v`).
     pub fn fan(&self, f: u32, v: u32) -> Vec<u32> {
-        let mut out = Vec::new();
-        self.find_in_fan(f, v, |g| {
-            out.push(g);
-            false
-        });
-        out
-    }
-
-    /// The first face around `v`, from `f` in the order of [`PmMesh::fan`] (counter-clockwise,
-    /// then clockwise from `f` if a boundary stops the walk), that `wanted` accepts; walks no
-    /// further than that face, and visits no more faces than the mesh has (a corrupt mesh may
-    /// hold a cycle that never returns to `f`).
-    pub fn find_in_fan(&self, f: u32, v: u32, mut wanted: impl FnMut(u32) -> bool) -> Option<u32> {
-        let mut visited = 1;
-        if wanted(f) {
-            return Some(f);
-        }
+        let mut out = vec![f];
         let mut g = self.ccw(f, v);
         while g != NIL && g != f {
-            if wanted(g) {
-                return Some(g);
-            }
-            visited += 1;
-            if visited > self.faces.len() {
-                return None;
-            }
+            out.push(g);
             g = self.ccw(g, v);
+            if out.len() > self.faces.len() {
+                return out;
+            }
         }
         if g == NIL {
             let mut g = self.cw(f, v);
             while g != NIL {
-                if wanted(g) {
-                    return Some(g);
-                }
-                visited += 1;
-                if visited > self.faces.len() {
-                    return None;
-                }
+                out.push(g);
                 g = self.cw(g, v);
+                if out.len() > self.faces.len() {
+                    break;
+                }
             }
         }
-        None
+        out
     }
 
     /// Sets the neighbour of `f` across its edge (previous corner, `v`).

@@ -798,6 +798,14 @@ struct Whole {
     bounds: ([i32; 3], [i32; 3]),
 }
 
+impl Whole {
+    fn live_faces(&self) -> Vec<u32> {
+        (0..self.faces.len() as u32)
+            .filter(|&f| self.face_alive[f as usize])
+            .collect()
+    }
+}
+
 /// The vertices of some faces (sorted) and the faces in their indices.
 fn compact(faces: &[[u32; 3]], face_ids: &[u32]) -> (Vec<u32>, Vec<[u32; 3]>) {
     let mut vertices: Vec<u32> = face_ids.iter().flat_map(|&f| faces[f as usize]).collect();
@@ -996,13 +1004,10 @@ fn simplify_in_regions(
 fn simplify_rest(whole: &mut Whole, max_cost: f32) -> Vec<Collapse> {
     let n = whole.cells.len();
     let diagonals = [[1, 1, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]];
-    let live: Vec<u32> = (0..whole.faces.len() as u32)
-        .filter(|&f| whole.face_alive[f as usize])
-        .collect();
     let regions = split_into_regions(
         &whole.cells,
         &whole.faces,
-        &live,
+        &whole.live_faces(),
         &diagonals,
         SECOND_ROUND_REGIONS,
     );
@@ -1010,15 +1015,16 @@ fn simplify_rest(whole: &mut Whole, max_cost: f32) -> Vec<Collapse> {
     let mut collapses = interleave(second_runs);
     // What remains; when a pass runs dry, every remaining edge is queued again, until a pass
     // collapses nothing.
-    let live = (0..whole.faces.len() as u32)
-        .filter(|&f| whole.face_alive[f as usize])
-        .collect();
     let none_frozen = vec![false; n];
+    let live = whole.live_faces();
     let mut rest = Part::new(whole, live, &none_frozen, false).simplify(f32::INFINITY, true);
     collapses.append(&mut rest.collapses);
     rest.write_back(whole, &none_frozen);
     collapses
 }
+
+/// Each region's collapses, with their costs.
+type Streams = Vec<(Vec<Collapse>, Vec<f32>)>;
 
 /// One round of the region phase over `regions` (faces of `whole`): up to `max_cost`, or in
 /// the first round (`None`) up to a quantile of the initial costs. Returns each region's
@@ -1028,7 +1034,7 @@ fn collapse_round(
     whole: &mut Whole,
     regions: Vec<Vec<u32>>,
     max_cost: Option<f32>,
-) -> (Vec<RegionRun>, f32) {
+) -> (Streams, f32) {
     let first = max_cost.is_none();
     let n = whole.cells.len();
     let mut region_of = vec![u32::MAX; n];
@@ -1046,23 +1052,17 @@ fn collapse_round(
         }
     }
     if first {
-        // Quadrics of the shared vertices, from the faces around them.
+        // Quadrics of the shared vertices, from the band of faces around them.
         let band: Vec<u32> = regions
             .iter()
             .flatten()
             .copied()
             .filter(|&f| whole.faces[f as usize].iter().any(|&v| shared[v as usize]))
             .collect();
-        let (band_vertices, band_faces) = compact(&whole.faces, &band);
-        let band_cells: Vec<[i32; 3]> = band_vertices
-            .iter()
-            .map(|&v| whole.cells[v as usize])
-            .collect();
-        let band_topology = topology(band_vertices.len(), &band_faces, &vec![true; band.len()]);
-        let band_quadrics = initial_quadrics(&band_cells, &band_faces, &band_topology);
-        for (&v, q) in band_vertices.iter().zip(band_quadrics) {
+        let band = Part::new(whole, band, &shared, true);
+        for (&v, q) in band.vertices.iter().zip(&band.state.quadrics) {
             if shared[v as usize] {
-                whole.quadrics[v as usize] = q;
+                whole.quadrics[v as usize] = *q;
             }
         }
     }
@@ -1086,23 +1086,27 @@ fn collapse_round(
             ((sampled.len() as f64 * REGION_COST_QUANTILE) as usize).min(sampled.len() - 1);
         *sampled.select_nth_unstable_by(middle, f32::total_cmp).1
     });
-    let mut runs: Vec<RegionRun> = parts
+    let runs: Vec<RegionRun> = parts
         .into_par_iter()
         .map(|part| part.simplify(max_cost, false))
         .collect();
-    for run in &mut runs {
-        run.write_back(whole, &shared);
-    }
-    (runs, max_cost)
+    let streams = runs
+        .into_iter()
+        .map(|run| {
+            run.write_back(whole, &shared);
+            (run.collapses, run.costs)
+        })
+        .collect();
+    (streams, max_cost)
 }
 
 /// The collapses of regions that share no face, in one sequence: always the cheapest next
 /// collapse of any region (ties: the lower region), so that it stays close to one greedy loop.
-fn interleave(runs: Vec<RegionRun>) -> Vec<Collapse> {
+fn interleave(streams: Streams) -> Vec<Collapse> {
     // Costs are not negative, so their bits order them.
-    let mut made: Vec<_> = runs
+    let mut made: Vec<_> = streams
         .into_iter()
-        .map(|run| run.collapses.into_iter().zip(run.costs).peekable())
+        .map(|(collapses, costs)| collapses.into_iter().zip(costs).peekable())
         .collect();
     let mut heads: std::collections::BinaryHeap<_> = made
         .iter_mut()
