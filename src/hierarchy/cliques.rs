@@ -24,6 +24,30 @@ pub fn adjacency(n: usize, faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
     adj
 }
 
+/// The 3-cliques of a graph, with the ids of their edges (numbered as by [`EdgeIds`]), so that
+/// per-edge work needs no search.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Cliques {
+    /// Ascending triples in lexicographic order.
+    pub tris: Vec<[u32; 3]>,
+    /// Ids of each triple's edges (a, b), (b, c), (a, c).
+    pub edges: Vec<[u32; 3]>,
+    /// Number of edges of the graph.
+    pub edge_count: usize,
+}
+
+impl Cliques {
+    /// Number of cliques.
+    pub fn len(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.tris.is_empty()
+    }
+}
+
 /// All 3-cliques of an undirected graph given as sorted adjacency lists, each as an ascending
 /// triple, in lexicographic order; `None` as soon as there are more than `limit` (a decoder's
 /// bound on what a hostile stream may make it build).
@@ -32,27 +56,67 @@ pub fn adjacency(n: usize, faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
 /// quadratic for a star. When that sum is large the vertices are ranked by degree and each edge
 /// intersects only the lists of higher-ranked neighbours, which are at most √(2e) long
 /// (Chiba & Nishizeki): O(e^1.5) whatever the graph.
-pub fn triangles(adjacency: &[Vec<u32>], limit: usize) -> Option<Vec<[u32; 3]>> {
+pub fn triangles(adjacency: &[Vec<u32>], limit: usize) -> Option<Cliques> {
     let edges = adjacency.iter().map(Vec::len).sum::<usize>() / 2;
     let merge_cost: usize = adjacency.iter().map(|l| l.len() * l.len()).sum();
     if merge_cost <= 64 * edges + (1 << 20) {
         triangles_by_merge(adjacency, limit)
     } else {
-        triangles_by_degree_rank(adjacency, limit)
+        let tris = triangles_by_degree_rank(adjacency, limit)?;
+        let ids = EdgeIds::new(adjacency);
+        let edges = tris
+            .iter()
+            .map(|&[a, b, c]| [ids.id(a, b), ids.id(b, c), ids.id(a, c)].map(|e| e as u32))
+            .collect();
+        Some(Cliques {
+            tris,
+            edges,
+            edge_count: ids.len(),
+        })
     }
 }
 
-fn triangles_by_merge(adjacency: &[Vec<u32>], limit: usize) -> Option<Vec<[u32; 3]>> {
-    let mut out = Vec::new();
+/// Where each vertex's neighbours above it start in its list, and the id of its first edge to
+/// one of them ([`EdgeIds`]); the last entry of the ids is the edge count.
+fn above_and_first(adjacency: &[Vec<u32>]) -> (Vec<u32>, Vec<u32>) {
+    let mut first = Vec::with_capacity(adjacency.len() + 1);
+    let mut above = Vec::with_capacity(adjacency.len());
+    let mut total = 0u32;
+    for (a, list) in adjacency.iter().enumerate() {
+        let start = list.partition_point(|&x| x <= a as u32);
+        first.push(total);
+        above.push(start as u32);
+        total += (list.len() - start) as u32;
+    }
+    first.push(total);
+    (above, first)
+}
+
+fn triangles_by_merge(adjacency: &[Vec<u32>], limit: usize) -> Option<Cliques> {
+    let (above, first) = above_and_first(adjacency);
+    let mut out = Cliques {
+        edge_count: *first.last().unwrap_or(&0) as usize,
+        ..Cliques::default()
+    };
     for (a, around_a) in adjacency.iter().enumerate() {
-        let a = a as u32;
-        let above_a = &around_a[around_a.partition_point(|&x| x <= a)..];
+        let above_a = &around_a[above[a] as usize..];
         for (i, &b) in above_a.iter().enumerate() {
             let around_b = &adjacency[b as usize];
             // c > b and adjacent to both.
-            let above_b = &around_b[around_b.partition_point(|&x| x <= b)..];
-            for_each_common(&above_a[i + 1..], above_b, |c| out.push([a, b, c]));
-            if out.len() > limit {
+            let above_b = &around_b[above[b as usize] as usize..];
+            let (ab, base_b) = (first[a] + i as u32, first[b as usize]);
+            let rest = &above_a[i + 1..];
+            let (mut p, mut q) = (0, 0);
+            while p < rest.len() && q < above_b.len() {
+                let (x, y) = (rest[p], above_b[q]);
+                if x == y {
+                    out.tris.push([a as u32, b, x]);
+                    out.edges.push([ab, base_b + q as u32, ab + 1 + p as u32]);
+                }
+                p += (x <= y) as usize;
+                q += (y <= x) as usize;
+            }
+            if out.tris.len() > limit {
                 return None;
             }
         }
@@ -127,16 +191,7 @@ pub struct EdgeIds<'g> {
 impl<'g> EdgeIds<'g> {
     /// Numbers the edges of `adjacency` (sorted lists).
     pub fn new(adjacency: &'g [Vec<u32>]) -> Self {
-        let mut first = Vec::with_capacity(adjacency.len() + 1);
-        let mut above = Vec::with_capacity(adjacency.len());
-        let mut total = 0u32;
-        for (a, list) in adjacency.iter().enumerate() {
-            let start = list.partition_point(|&x| x <= a as u32);
-            first.push(total);
-            above.push(start as u32);
-            total += (list.len() - start) as u32;
-        }
-        first.push(total);
+        let (above, first) = above_and_first(adjacency);
         EdgeIds {
             adjacency,
             first,
@@ -160,34 +215,35 @@ impl<'g> EdgeIds<'g> {
         let above = &list[self.above[a as usize] as usize..];
         self.first[a as usize] as usize + above.partition_point(|&x| x < b)
     }
-
-    /// The edges in id order.
-    pub fn edges(&self) -> impl Iterator<Item = [u32; 2]> + '_ {
-        self.adjacency
-            .iter()
-            .enumerate()
-            .flat_map(move |(a, list)| {
-                list[self.above[a] as usize..]
-                    .iter()
-                    .map(move |&b| [a as u32, b])
-            })
-    }
 }
 
-/// Edges of the graph that lie on no triangle of `tris` (ascending triples of its edges).
-pub fn loose_edges(adjacency: &[Vec<u32>], tris: &[[u32; 3]]) -> Vec<[u32; 2]> {
-    let ids = EdgeIds::new(adjacency);
-    let mut covered = vec![false; ids.len()];
-    for &[a, b, c] in tris {
-        for (u, v) in [(a, b), (b, c), (a, c)] {
-            covered[ids.id(u, v)] = true;
+/// Edges of the graph that lie on no clique of `cliques` (its 3-cliques) but those `skipped`.
+pub fn loose_edges(
+    adjacency: &[Vec<u32>],
+    cliques: &Cliques,
+    skipped: Option<&[bool]>,
+) -> Vec<[u32; 2]> {
+    let mut covered = vec![false; cliques.edge_count];
+    for (t, edges) in cliques.edges.iter().enumerate() {
+        if skipped.is_some_and(|s| s[t]) {
+            continue;
+        }
+        for &e in edges {
+            covered[e as usize] = true;
         }
     }
-    ids.edges()
-        .zip(covered)
-        .filter(|(_, c)| !c)
-        .map(|(e, _)| e)
-        .collect()
+    // Edges in id order: each vertex's neighbours above it, vertex by vertex.
+    let mut loose = Vec::new();
+    let mut id = 0;
+    for (a, list) in adjacency.iter().enumerate() {
+        for &b in list.iter().filter(|&&b| b > a as u32) {
+            if !covered[id] {
+                loose.push([a as u32, b]);
+            }
+            id += 1;
+        }
+    }
+    loose
 }
 
 /// A triangle as an ascending triple plus whether it is flipped: unflipped means the cycle
@@ -218,23 +274,21 @@ fn traverses(tri: [u32; 3], u: u32, v: u32) -> bool {
 /// result holds the chosen orientation of every triangle (skipped ones: false). `decide` is
 /// also told which triangle it decides: the visiting order depends only on the graph.
 pub fn propagate_orientation(
-    tris: &[[u32; 3]],
+    cliques: &Cliques,
     skipped: &[bool],
-    adjacency: &[Vec<u32>],
     positions: &[DVec3],
     centre: DVec3,
     mut decide: impl FnMut(usize, usize, bool) -> bool,
 ) -> Vec<bool> {
+    let tris = &cliques.tris;
     // For each edge, how many non-skipped triangles use it and the first two of them.
-    let ids = EdgeIds::new(adjacency);
-    let mut users = vec![(0u32, u32::MAX, u32::MAX); ids.len()];
-    let edge_slots = |&[a, b, c]: &[u32; 3]| [(a, b), (b, c), (a, c)];
-    for (t, tri) in tris.iter().enumerate() {
+    let mut users = vec![(0u32, u32::MAX, u32::MAX); cliques.edge_count];
+    for (t, edges) in cliques.edges.iter().enumerate() {
         if skipped[t] {
             continue;
         }
-        for (u, v) in edge_slots(tri) {
-            let e = &mut users[ids.id(u, v)];
+        for &e in edges {
+            let e = &mut users[e as usize];
             match e.0 {
                 0 => e.1 = t as u32,
                 1 => e.2 = t as u32,
@@ -246,12 +300,12 @@ pub fn propagate_orientation(
     // For each triangle and each of its edges (a,b), (b,c), (a,c): the one other triangle across
     // it, if exactly two share the edge.
     let mut across = vec![[u32::MAX; 3]; tris.len()];
-    for (t, tri) in tris.iter().enumerate() {
+    for (t, edges) in cliques.edges.iter().enumerate() {
         if skipped[t] {
             continue;
         }
-        for (slot, (u, v)) in edge_slots(tri).into_iter().enumerate() {
-            let (count, first, second) = users[ids.id(u, v)];
+        for (slot, &e) in edges.iter().enumerate() {
+            let (count, first, second) = users[e as usize];
             if count == 2 {
                 across[t][slot] = if first == t as u32 { second } else { first };
             }
@@ -259,7 +313,7 @@ pub fn propagate_orientation(
     }
     let mut flipped = vec![false; tris.len()];
     let mut seen = skipped.to_vec();
-    let mut queue = std::collections::VecDeque::new();
+    let mut queue = Vec::with_capacity(tris.len());
     let mut visit = 0;
     for start in 0..tris.len() {
         if seen[start] {
@@ -270,8 +324,12 @@ pub fn propagate_orientation(
         let outward = (b - a).cross(c - a).dot((a + b + c) / 3.0 - centre) >= 0.0;
         flipped[start] = decide(visit, start, !outward);
         visit += 1;
-        queue.push_back(start);
-        while let Some(t) = queue.pop_front() {
+        // Breadth-first: the queue is read from `next` on.
+        queue.clear();
+        queue.push(start);
+        let mut next = 0;
+        while let Some(&t) = queue.get(next) {
+            next += 1;
             let tri = tris[t];
             let edges = [(tri[0], tri[1]), (tri[1], tri[2]), (tri[0], tri[2])];
             for (slot, &(u, v)) in edges.iter().enumerate() {
@@ -290,7 +348,7 @@ pub fn propagate_orientation(
                 let predicted = traverses(tris[other as usize], from, to);
                 flipped[other as usize] = decide(visit, other as usize, predicted);
                 visit += 1;
-                queue.push_back(other as usize);
+                queue.push(other as usize);
             }
         }
     }
@@ -306,14 +364,14 @@ mod tests {
     fn a_sphere_is_rebuilt_with_outward_orientation() {
         let sphere = generate::icosphere(2);
         let adj = adjacency(sphere.positions.len(), &sphere.faces);
-        let tris = triangles(&adj, usize::MAX).unwrap();
+        let cliques = triangles(&adj, usize::MAX).unwrap();
+        let tris = &cliques.tris;
         assert_eq!(tris.len(), sphere.faces.len());
         let skipped = vec![false; tris.len()];
         let mut guesses = 0;
         let flipped = propagate_orientation(
-            &tris,
+            &cliques,
             &skipped,
-            &adj,
             &sphere.positions,
             DVec3::ZERO,
             |_, _, p| {
@@ -335,7 +393,17 @@ mod tests {
         ours.sort_unstable();
         theirs.sort_unstable();
         assert_eq!(ours, theirs);
-        assert!(loose_edges(&adj, &tris).is_empty());
+        assert!(loose_edges(&adj, &cliques, None).is_empty());
+        let mut dropped = skipped.clone();
+        dropped[0] = true;
+        assert!(loose_edges(&adj, &cliques, Some(&dropped)).is_empty());
+        // An edge of no triangle.
+        let mut adj = adj;
+        let n = adj.len() as u32;
+        adj.push(vec![0]);
+        adj[0].push(n);
+        let cliques = triangles(&adj, usize::MAX).unwrap();
+        assert_eq!(loose_edges(&adj, &cliques, None), vec![[0, n]]);
     }
 
     #[test]
@@ -362,7 +430,13 @@ mod tests {
             let adj = adjacency(n, &faces);
             let merged = triangles_by_merge(&adj, usize::MAX).unwrap();
             let ranked = triangles_by_degree_rank(&adj, usize::MAX).unwrap();
-            assert_eq!(merged, ranked);
+            assert_eq!(merged.tris, ranked);
+            let ids = EdgeIds::new(&adj);
+            for (&[a, b, c], &edges) in merged.tris.iter().zip(&merged.edges) {
+                let want = [ids.id(a, b), ids.id(b, c), ids.id(a, c)].map(|e| e as u32);
+                assert_eq!(edges, want);
+            }
+            let merged = merged.tris;
             assert!(merged.windows(2).all(|w| w[0] < w[1]));
             let k = merged.len();
             assert_eq!(triangles(&adj, k).unwrap().len(), k);

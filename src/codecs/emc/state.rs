@@ -5,7 +5,7 @@
 use crate::codecs::LevelMesh;
 use crate::container::Header;
 use crate::hierarchy::cliques::{
-    loose_edges, oriented, propagate_orientation, triangles as list_triangles,
+    loose_edges, oriented, propagate_orientation, triangles as list_triangles, Cliques,
 };
 use crate::hierarchy::octree::KeyTrie;
 use crate::hierarchy::octree::StepOrder;
@@ -171,7 +171,7 @@ impl EmcState {
     /// The 3-cliques of the edge graph, ascending triples in lexicographic order; an error if
     /// there are more than a stream of `triangles` (the header's count) may show
     /// ([`limits::level_triangles`]).
-    pub fn cliques(&self, triangles: u64) -> Result<Vec<[u32; 3]>, String> {
+    pub fn cliques(&self, triangles: u64) -> Result<Cliques, String> {
         let limit = limits::level_triangles(triangles);
         list_triangles(&self.adjacency, limit).ok_or_else(|| {
             format!("the edge graph has more than {limit} triangles ({triangles} declared)")
@@ -180,7 +180,7 @@ impl EmcState {
 
     /// The cliques of the final state, once every vertex is decoded (`vertices`, `triangles`:
     /// the header's counts); the face-correction lists index them.
-    pub fn final_cliques(&self, vertices: u64, triangles: u64) -> Result<Vec<[u32; 3]>, String> {
+    pub fn final_cliques(&self, vertices: u64, triangles: u64) -> Result<Cliques, String> {
         if self.len() as u64 != vertices {
             return Err(format!(
                 "{} vertices decoded, the header declares {vertices}",
@@ -195,7 +195,7 @@ impl EmcState {
     pub fn corrected_mesh(
         &self,
         grid: &Grid,
-        cliques: &[[u32; 3]],
+        cliques: &Cliques,
         corrections: &FaceCorrections,
         triangles: u64,
     ) -> Result<LevelMesh, String> {
@@ -207,7 +207,7 @@ impl EmcState {
             return Err("a triangle is listed both false and double-sided".into());
         }
         let positions = self.positions(grid);
-        let faces = final_faces(cliques, &self.adjacency, &positions, corrections);
+        let faces = final_faces(cliques, &positions, corrections);
         if faces.len() as u64 != triangles {
             return Err(format!(
                 "{} triangles decoded, the header declares {triangles}",
@@ -218,14 +218,8 @@ impl EmcState {
         for &i in &corrections.false_triangles {
             is_false[i as usize] = true;
         }
-        let true_cliques: Vec<[u32; 3]> = cliques
-            .iter()
-            .zip(&is_false)
-            .filter(|(_, &f)| !f)
-            .map(|(t, _)| *t)
-            .collect();
         Ok(LevelMesh {
-            loose_edges: loose_edges(&self.adjacency, &true_cliques),
+            loose_edges: loose_edges(&self.adjacency, cliques, Some(&is_false)),
             mesh: TriMesh::new(positions, faces),
         })
     }
@@ -238,21 +232,15 @@ impl EmcState {
         let positions = self.positions(grid);
         let skipped = vec![false; cliques.len()];
         let centre = centroid(&positions);
-        let flipped = propagate_orientation(
-            &cliques,
-            &skipped,
-            &self.adjacency,
-            &positions,
-            centre,
-            |_, _, p| p,
-        );
+        let flipped = propagate_orientation(&cliques, &skipped, &positions, centre, |_, _, p| p);
         let faces = cliques
+            .tris
             .iter()
             .zip(&flipped)
             .map(|(&t, &f)| oriented(t, f))
             .collect();
         Ok(LevelMesh {
-            loose_edges: loose_edges(&self.adjacency, &cliques),
+            loose_edges: loose_edges(&self.adjacency, &cliques, None),
             mesh: TriMesh::new(positions, faces),
         })
     }
@@ -291,8 +279,7 @@ impl FaceCorrections {
 
 /// Applies `corrections` to the cliques of the final state: the faces of the full mesh.
 pub fn final_faces(
-    cliques: &[[u32; 3]],
-    adjacency: &[Vec<u32>],
+    cliques: &Cliques,
     positions: &[DVec3],
     corrections: &FaceCorrections,
 ) -> Vec<[u32; 3]> {
@@ -301,7 +288,6 @@ pub fn final_faces(
     let flipped = propagate_orientation(
         cliques,
         &skipped,
-        adjacency,
         positions,
         centroid(positions),
         |visit, _, predicted| {
@@ -318,7 +304,7 @@ pub fn final_faces(
         double[i as usize] = true;
     }
     let mut faces = Vec::with_capacity(cliques.len() + corrections.double_sided.len());
-    for (i, &t) in cliques.iter().enumerate() {
+    for (i, &t) in cliques.tris.iter().enumerate() {
         if double[i] {
             faces.push(oriented(t, false));
             faces.push(oriented(t, true));
@@ -359,7 +345,7 @@ pub fn face_corrections(
         .cliques(mesh.face_count() as u64)
         .map_err(|why| crate::Error::Unsupported(format!("EMC cannot code this mesh: {why}")))?;
     let mut corrections = FaceCorrections::default();
-    for (i, t) in cliques.iter().enumerate() {
+    for (i, t) in cliques.tris.iter().enumerate() {
         match faces.get(t) {
             None => corrections.false_triangles.push(i as u32),
             Some(3) => corrections.double_sided.push(i as u32),
@@ -376,12 +362,11 @@ pub fn face_corrections(
         .map(|v| mesh.grid.dequantize(state.cells[v]))
         .collect();
     // Let the propagation follow the true orientations and note where they were not predicted.
-    let is_flipped = |t: usize| faces.get(&cliques[t]).copied() == Some(2);
+    let is_flipped = |t: usize| faces.get(&cliques.tris[t]).copied() == Some(2);
     let centre = centroid(&positions);
     propagate_orientation(
         &cliques,
         &skipped,
-        &state.adjacency,
         &positions,
         centre,
         |visit, t, predicted| {
@@ -393,7 +378,7 @@ pub fn face_corrections(
     );
     debug_assert_eq!(
         {
-            let mut got: Vec<_> = final_faces(&cliques, &state.adjacency, &positions, &corrections)
+            let mut got: Vec<_> = final_faces(&cliques, &positions, &corrections)
                 .into_iter()
                 .map(rotate_to_smallest)
                 .collect();

@@ -24,6 +24,18 @@ impl Side for DecoderSide {
     ) -> Result<bool, Stop> {
         Ok(self.coder.bit(context).ok_or(Stop::OutOfBits)? ^ flip)
     }
+
+    fn code3(
+        &mut self,
+        contexts: &mut [BitContext],
+        index: [usize; 3],
+        flips: [bool; 3],
+        _v: usize,
+        _first: usize,
+    ) -> Result<[bool; 3], Stop> {
+        let bits = self.coder.bits3(contexts, index).ok_or(Stop::OutOfBits)?;
+        Ok([0, 1, 2].map(|k| bits[k] ^ flips[k]))
+    }
 }
 
 /// Reads a list written by [`super::encoder::put_list`]; every entry below `bound`.
@@ -83,10 +95,13 @@ impl<'a> EmcDecoder<'a> {
         let mut side = DecoderSide { coder };
         let outcome = (|| {
             let order = self.walker.state.order;
-            for step in 3 * (level - 1)..3 * (level - 1) + passes.min(3) {
-                self.walker
-                    .pass(&mut side, step, self.header.vertices, self.header.triangles)?;
-            }
+            self.walker.level(
+                &mut side,
+                level,
+                passes,
+                self.header.vertices,
+                self.header.triangles,
+            )?;
             if level == order.levels as usize && passes >= 3 {
                 self.read_corrections(&mut side.coder)?;
             }

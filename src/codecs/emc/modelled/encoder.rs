@@ -42,6 +42,26 @@ impl Side for EncoderSide {
         Ok(answer)
     }
 
+    fn code3(
+        &mut self,
+        contexts: &mut [BitContext],
+        index: [usize; 3],
+        flips: [bool; 3],
+        v: usize,
+        first: usize,
+    ) -> Result<[bool; 3], Stop> {
+        let answers = [0, 1, 2].map(|k| self.clusters.bit(v, first + k) == 1);
+        let question = Question::Half;
+        self.coder.bits3(
+            contexts,
+            index,
+            [0, 1, 2].map(|k| answers[k] ^ flips[k]),
+            question.class(),
+            question.field(),
+        );
+        Ok(answers)
+    }
+
     fn begin_split(&mut self, state: &EmcState, v: usize, step: usize) {
         self.clusters.plan(state, v, step, &mut self.plan);
     }
@@ -80,11 +100,9 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
     let mut ledger = BitLedger::default();
     let mut records = Vec::with_capacity(order.levels as usize);
     for level in 1..=order.levels as usize {
-        for step in 3 * (level - 1)..3 * level {
-            walker
-                .pass(&mut side, step, n, mesh.face_count() as u64)
-                .expect("the encoder's answers agree with the header");
-        }
+        walker
+            .level(&mut side, level, 3, n, mesh.face_count() as u64)
+            .expect("the encoder's answers agree with the header");
         let mut coder = std::mem::take(&mut side.coder);
         if level == order.levels as usize {
             let corrections = face_corrections(

@@ -69,6 +69,18 @@ pub trait Side {
         step: usize,
     ) -> Result<bool, Stop>;
 
+    /// Codes (encoder) or reads (decoder) which half `v` takes at each of the three steps from
+    /// `first`, under `contexts[index[k]]` for the k-th, at once; each bit is the answer XOR
+    /// `flips[k]`.
+    fn code3(
+        &mut self,
+        contexts: &mut [crate::coding::arith::BitContext],
+        index: [usize; 3],
+        flips: [bool; 3],
+        v: usize,
+        first: usize,
+    ) -> Result<[bool; 3], Stop>;
+
     /// Called when `v` is about to split at `step`, before its connectivity is coded.
     fn begin_split(&mut self, _state: &EmcState, _v: usize, _step: usize) {}
 
@@ -78,6 +90,13 @@ pub trait Side {
 
 /// Steepest regression plane used for prediction (squared gradient).
 const SLOPE: f64 = 1.5;
+
+/// Count, mean and covariance of a vertex's neighbours (see [`Walker::moments`]).
+struct Moments {
+    k: usize,
+    mean: [f64; 3],
+    cov: [[f64; 3]; 3],
+}
 
 /// The state both sides keep, with the modelled coder's extra knowledge of each vertex.
 pub struct Walker {
@@ -90,8 +109,13 @@ pub struct Walker {
     shifts: Vec<[u8; 3]>,
     /// Twice each vertex's cell centre, in units of the full grid (kept with the cells: the
     /// contexts read the neighbours' centres over and over).
-    centres: Vec<[i64; 3]>,
+    centres: Vec<[i32; 3]>,
     codes: Vec<EdgeCode>,
+    /// Vertices that were clusters at the start of the level (and those split off them since),
+    /// in list order: the passes visit only these.
+    active: Vec<u32>,
+    /// Vertices that were leaves at the start of the level, in list order.
+    resting: Vec<u32>,
 }
 
 impl Walker {
@@ -106,6 +130,8 @@ impl Walker {
             shifts,
             centres: Vec::new(),
             codes: Vec::new(),
+            active: Vec::new(),
+            resting: Vec::new(),
         };
         walker.refresh(0);
         walker
@@ -114,13 +140,14 @@ impl Walker {
     /// Twice the centre of `v`'s cell along `axis`, in units of the full grid.
     #[inline]
     fn centre2(&self, v: usize, axis: usize) -> i64 {
-        self.centres[v][axis]
+        self.centres[v][axis] as i64
     }
 
     /// Recomputes the cached centre of `v` from its cell.
     fn refresh(&mut self, v: usize) {
         let shifts = self.shifts[self.state.depth[v] as usize];
-        let centre = [0, 1, 2].map(|a| (((self.state.cells[v][a] as i64) << 1) | 1) << shifts[a]);
+        // At most 2^25 (24 levels), so i32 holds it; the neighbours' offsets too.
+        let centre = [0, 1, 2].map(|a| (((self.state.cells[v][a] as i32) << 1) | 1) << shifts[a]);
         if v == self.centres.len() {
             self.centres.push(centre);
         } else {
@@ -134,9 +161,42 @@ impl Walker {
         1 << self.shifts[self.state.depth[v] as usize][axis]
     }
 
-    /// Runs one pass (`step`) over the vertices present at its start. `max_vertices` and
+    /// Codes the first `passes` (1..=3) passes of `level` (1-based) and, when all three are
+    /// coded, the level's refinement of the vertices that were leaves at its start. The passes
+    /// visit only the vertices that were clusters at the level's start (and those split off
+    /// them): at the finest levels these are few, and the leaves, whose edges no longer change,
+    /// take their three bits together from one look at their neighbours. `max_vertices` and
     /// `max_triangles` are the header's counts, which no stream may exceed.
-    pub fn pass<S: Side>(
+    pub fn level<S: Side>(
+        &mut self,
+        side: &mut S,
+        level: usize,
+        passes: usize,
+        max_vertices: u64,
+        max_triangles: u64,
+    ) -> Result<(), Stop> {
+        self.active.clear();
+        self.resting.clear();
+        for v in 0..self.state.len() {
+            if self.leaf[v] {
+                self.resting.push(v as u32);
+            } else {
+                self.active.push(v as u32);
+            }
+        }
+        let first = 3 * (level - 1);
+        for step in first..first + passes.min(3) {
+            self.pass(side, step, max_vertices, max_triangles)?;
+        }
+        if std::env::var("EMC_COUNT").is_ok() { eprintln!("level {level}: active {} resting {} len {}", self.active.len(), self.resting.len(), self.state.len()); }
+        if passes >= 3 {
+            self.leaf_pass(side, first)?;
+        }
+        Ok(())
+    }
+
+    /// One pass (`step`) over the active vertices present at its start.
+    fn pass<S: Side>(
         &mut self,
         side: &mut S,
         step: usize,
@@ -146,8 +206,9 @@ impl Walker {
         let order = self.state.order;
         let axis = order.axis(step);
         let remaining = order.levels as usize - order.level(step);
-        let present = self.state.len();
-        for v in 0..present {
+        let present = self.active.len();
+        for i in 0..present {
+            let v = self.active[i] as usize;
             let valence = self.state.adjacency[v].len();
             let (half, flip) = self.half_context(v, axis);
             let splits = !self.leaf[v] && {
@@ -166,80 +227,132 @@ impl Walker {
                     "more splits than the {max_vertices} vertices the header declares"
                 )));
             }
-            self.split(side, v, step, axis, remaining, max_triangles)?;
+            let r = self.split(side, v, step, axis, remaining, max_triangles)?;
+            self.active.push(r as u32);
         }
         Ok(())
     }
 
-    /// Context and flip of the half `v` takes. The prediction is the neighbours' regression
-    /// plane (the coordinate along the axis as a linear function of the other two, evaluated at
-    /// the vertex's own cell centre) where the neighbours span the other two axes, else their
-    /// mean; the context is its distance from the split plane and the expected error (the
-    /// neighbours' residual spread plus what the vertex's own cell leaves open), both in
-    /// half-widths of the cell.
-    fn half_context(&self, v: usize, axis: usize) -> (contexts::HalfContext, bool) {
+    /// The three refinement bits of a level (steps `first`..`first + 3`) of every vertex that
+    /// was a leaf at the level's start, vertex by vertex: the neighbours' moments are taken once
+    /// and serve all three axes (they do not depend on where in its cell the vertex is).
+    fn leaf_pass<S: Side>(&mut self, side: &mut S, first: usize) -> Result<(), Stop> {
+        let order = self.state.order;
+        for i in 0..self.resting.len() {
+            let v = self.resting[i] as usize;
+            let moments = self.moments(v, self.centres[v]);
+            let (mut index, mut flips) = ([0; 3], [false; 3]);
+            for k in 0..3 {
+                let (half, flip) = match &moments {
+                    None => (contexts::half_isolated(true), false),
+                    Some(m) => self.predict(v, order.axis(first + k), m),
+                };
+                (index[k], flips[k]) = (half.index, flip);
+            }
+            let bits = side.code3(&mut self.contexts.half, index, flips, v, first)?;
+            for (k, bit) in bits.into_iter().enumerate() {
+                self.state.refine(v, first + k, bit as u32);
+            }
+            self.refresh(v);
+        }
+        Ok(())
+    }
+
+    /// Count, mean and covariance of `v`'s neighbours' cell centres, relative to `origin`;
+    /// `None` without neighbours.
+    fn moments(&self, v: usize, origin: [i32; 3]) -> Option<Moments> {
         let neighbours = &self.state.adjacency[v];
         if neighbours.is_empty() {
-            return (contexts::half_isolated(self.leaf[v]), false);
+            return None;
         }
-        let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
-        let own = [
-            self.centre2(v, axis),
-            self.centre2(v, b),
-            self.centre2(v, c),
-        ];
-        // Sums of the neighbours' offsets from the vertex's centre: a, b, c and their products.
+        // Sums of the offsets and their products: x, y, z, xx, yy, zz, xy, xz, yz.
         let mut s = [0f64; 9];
         for &n in neighbours {
-            let n = n as usize;
-            let da = (self.centre2(n, axis) - own[0]) as f64;
-            let db = (self.centre2(n, b) - own[1]) as f64;
-            let dc = (self.centre2(n, c) - own[2]) as f64;
-            s[0] += da;
-            s[1] += db;
-            s[2] += dc;
-            s[3] += da * da;
-            s[4] += db * db;
-            s[5] += dc * dc;
-            s[6] += db * dc;
-            s[7] += da * db;
-            s[8] += da * dc;
+            let c = self.centres[n as usize];
+            let d = [0, 1, 2].map(|a| (c[a] - origin[a]) as f64);
+            s[0] += d[0];
+            s[1] += d[1];
+            s[2] += d[2];
+            s[3] += d[0] * d[0];
+            s[4] += d[1] * d[1];
+            s[5] += d[2] * d[2];
+            s[6] += d[0] * d[1];
+            s[7] += d[0] * d[2];
+            s[8] += d[1] * d[2];
         }
-        let k = neighbours.len() as f64;
-        let mean = [s[0] / k, s[1] / k, s[2] / k];
-        let var_a = (s[3] / k - mean[0] * mean[0]).max(0.0);
-        let (cbb, ccc) = (s[4] / k - mean[1] * mean[1], s[5] / k - mean[2] * mean[2]);
-        let cbc = s[6] / k - mean[1] * mean[2];
-        let (cab, cac) = (s[7] / k - mean[0] * mean[1], s[8] / k - mean[0] * mean[2]);
+        let k = neighbours.len();
+        let inv = 1.0 / k as f64;
+        let mean = [s[0] * inv, s[1] * inv, s[2] * inv];
+        let (xy, xz, yz) = (
+            s[6] * inv - mean[0] * mean[1],
+            s[7] * inv - mean[0] * mean[2],
+            s[8] * inv - mean[1] * mean[2],
+        );
+        let cov = [
+            [s[3] * inv - mean[0] * mean[0], xy, xz],
+            [xy, s[4] * inv - mean[1] * mean[1], yz],
+            [xz, yz, s[5] * inv - mean[2] * mean[2]],
+        ];
+        Some(Moments { k, mean, cov })
+    }
+
+    /// Context and flip of the half `v` takes along `axis`, from its neighbours' moments `m`
+    /// (relative to `v`'s centre). The prediction is the neighbours' regression plane (the
+    /// coordinate along the axis as a linear function of the other two, evaluated at the
+    /// vertex's own place across the axis) where the neighbours span the other two axes, else
+    /// their mean; the context is its distance from the split plane and the expected error (the
+    /// neighbours' residual spread plus what the vertex's own cell leaves open), both in
+    /// half-widths of the cell.
+    fn predict(&self, v: usize, axis: usize, m: &Moments) -> (contexts::HalfContext, bool) {
+        let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+        let shifts = self.shifts[self.state.depth[v] as usize];
+        let var_a = m.cov[axis][axis].max(0.0);
+        let (cbb, ccc, cbc) = (m.cov[b][b], m.cov[c][c], m.cov[b][c]);
+        let (cab, cac) = (m.cov[axis][b], m.cov[axis][c]);
+        // The plane's gradient is (nb, nc) / det; it is used where the neighbours span the
+        // other two axes and it is no steeper than SLOPE.
         let det = cbb * ccc - cbc * cbc;
-        let w = self.half_width2(v, axis) as f64;
-        let plane = (neighbours.len() >= 4 && det > 1e-2 * (cbb + ccc) * (cbb + ccc))
-            .then(|| ((cab * ccc - cac * cbc) / det, (cac * cbb - cab * cbc) / det));
-        let (prediction, variance) = if let Some((beta_b, beta_c)) =
-            plane.filter(|&(beta_b, beta_c)| beta_b * beta_b + beta_c * beta_c <= SLOPE)
-        {
+        let (nb, nc) = (cab * ccc - cac * cbc, cac * cbb - cab * cbc);
+        let spread = cbb + ccc;
+        let plane =
+            m.k >= 4 && det > 1e-2 * spread * spread && nb * nb + nc * nc <= SLOPE * det * det;
+        let (prediction, variance) = if plane {
+            let inverse = 1.0 / det;
+            let (beta_b, beta_c) = (nb * inverse, nc * inverse);
             let residual = (var_a - beta_b * cab - beta_c * cac).max(0.0);
             // The vertex's own place across the axis: the neighbours' mean, kept inside its cell.
-            let (wb, wc) = (self.half_width2(v, b) as f64, self.half_width2(v, c) as f64);
-            let (eb, ec) = (mean[1].clamp(-wb, wb), mean[2].clamp(-wc, wc));
+            let (wb, wc) = ((1i64 << shifts[b]) as f64, (1i64 << shifts[c]) as f64);
+            let (mb, mc) = (m.mean[b], m.mean[c]);
+            let (eb, ec) = (mb.clamp(-wb, wb), mc.clamp(-wc, wc));
             let own_cell = beta_b * beta_b * (wb * wb / 3.0).min(cbb)
                 + beta_c * beta_c * (wc * wc / 3.0).min(ccc);
             (
-                mean[0] + beta_b * (eb - mean[1]) + beta_c * (ec - mean[2]),
+                m.mean[axis] + beta_b * (eb - mb) + beta_c * (ec - mc),
                 residual + own_cell,
             )
         } else {
-            (mean[0], var_a)
+            (m.mean[axis], var_a)
         };
+        // In half-widths of the cell: 1 / 2^shift, exactly.
+        let scale = f64::from_bits((1023 - shifts[axis] as u64) << 52);
         (
             contexts::half(
                 self.leaf[v],
-                neighbours.len(),
-                prediction.abs() / w,
-                variance / (w * w),
+                m.k,
+                prediction.abs() * scale,
+                variance * scale * scale,
             ),
             prediction < 0.0,
         )
+    }
+
+    /// Context and flip of the half a vertex in the passes takes ([`Self::predict`] from its
+    /// neighbours as they are now).
+    fn half_context(&self, v: usize, axis: usize) -> (contexts::HalfContext, bool) {
+        match self.moments(v, self.centres[v]) {
+            None => (contexts::half_isolated(self.leaf[v]), false),
+            Some(m) => self.predict(v, axis, &m),
+        }
     }
 
     /// What the already coded neighbours of `v` that are also neighbours of `n` (the `i`-th
@@ -275,7 +388,7 @@ impl Walker {
         axis: usize,
         remaining: usize,
         max_triangles: u64,
-    ) -> Result<(), Stop> {
+    ) -> Result<usize, Stop> {
         side.begin_split(&self.state, v, step);
         let valence = self.state.adjacency[v].len();
         let c = contexts::connecting(valence, remaining);
@@ -350,6 +463,6 @@ impl Walker {
             )?;
         }
         side.end_split(v, r);
-        Ok(())
+        Ok(r)
     }
 }
