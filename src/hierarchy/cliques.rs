@@ -56,9 +56,12 @@ impl Cliques {
 /// quadratic for a star. When that sum is large the vertices are ranked by degree and each edge
 /// intersects only the lists of higher-ranked neighbours, which are at most √(2e) long
 /// (Chiba & Nishizeki): O(e^1.5) whatever the graph.
-pub fn triangles(adjacency: &[Vec<u32>], limit: usize) -> Option<Cliques> {
-    let edges = adjacency.iter().map(Vec::len).sum::<usize>() / 2;
-    let merge_cost: usize = adjacency.iter().map(|l| l.len() * l.len()).sum();
+pub fn triangles<L: AsRef<[u32]>>(adjacency: &[L], limit: usize) -> Option<Cliques> {
+    let edges = adjacency.iter().map(|l| l.as_ref().len()).sum::<usize>() / 2;
+    let merge_cost: usize = adjacency
+        .iter()
+        .map(|l| l.as_ref().len() * l.as_ref().len())
+        .sum();
     if merge_cost <= 64 * edges + (1 << 20) {
         triangles_by_merge(adjacency, limit)
     } else {
@@ -78,11 +81,12 @@ pub fn triangles(adjacency: &[Vec<u32>], limit: usize) -> Option<Cliques> {
 
 /// Where each vertex's neighbours above it start in its list, and the id of its first edge to
 /// one of them ([`EdgeIds`]); the last entry of the ids is the edge count.
-fn above_and_first(adjacency: &[Vec<u32>]) -> (Vec<u32>, Vec<u32>) {
+fn above_and_first<L: AsRef<[u32]>>(adjacency: &[L]) -> (Vec<u32>, Vec<u32>) {
     let mut first = Vec::with_capacity(adjacency.len() + 1);
     let mut above = Vec::with_capacity(adjacency.len());
     let mut total = 0u32;
     for (a, list) in adjacency.iter().enumerate() {
+        let list = list.as_ref();
         let start = list.partition_point(|&x| x <= a as u32);
         first.push(total);
         above.push(start as u32);
@@ -92,16 +96,16 @@ fn above_and_first(adjacency: &[Vec<u32>]) -> (Vec<u32>, Vec<u32>) {
     (above, first)
 }
 
-fn triangles_by_merge(adjacency: &[Vec<u32>], limit: usize) -> Option<Cliques> {
+fn triangles_by_merge<L: AsRef<[u32]>>(adjacency: &[L], limit: usize) -> Option<Cliques> {
     let (above, first) = above_and_first(adjacency);
     let mut out = Cliques {
         edge_count: *first.last().unwrap_or(&0) as usize,
         ..Cliques::default()
     };
     for (a, around_a) in adjacency.iter().enumerate() {
-        let above_a = &around_a[above[a] as usize..];
+        let above_a = &around_a.as_ref()[above[a] as usize..];
         for (i, &b) in above_a.iter().enumerate() {
-            let around_b = &adjacency[b as usize];
+            let around_b = adjacency[b as usize].as_ref();
             // c > b and adjacent to both.
             let above_b = &around_b[above[b as usize] as usize..];
             let (ab, base_b) = (first[a] + i as u32, first[b as usize]);
@@ -124,10 +128,13 @@ fn triangles_by_merge(adjacency: &[Vec<u32>], limit: usize) -> Option<Cliques> {
     Some(out)
 }
 
-fn triangles_by_degree_rank(adjacency: &[Vec<u32>], limit: usize) -> Option<Vec<[u32; 3]>> {
+fn triangles_by_degree_rank<L: AsRef<[u32]>>(
+    adjacency: &[L],
+    limit: usize,
+) -> Option<Vec<[u32; 3]>> {
     let n = adjacency.len();
     let mut by_degree: Vec<u32> = (0..n as u32).collect();
-    by_degree.sort_unstable_by_key(|&v| (adjacency[v as usize].len(), v));
+    by_degree.sort_unstable_by_key(|&v| (adjacency[v as usize].as_ref().len(), v));
     let mut rank = vec![0u32; n];
     for (r, &v) in by_degree.iter().enumerate() {
         rank[v as usize] = r as u32;
@@ -136,6 +143,7 @@ fn triangles_by_degree_rank(adjacency: &[Vec<u32>], limit: usize) -> Option<Vec<
     let higher: Vec<Vec<u32>> = (0..n)
         .map(|v| {
             let mut list: Vec<u32> = adjacency[v]
+                .as_ref()
                 .iter()
                 .map(|&w| rank[w as usize])
                 .filter(|&r| r > rank[v])
@@ -181,16 +189,16 @@ fn for_each_common(a: &[u32], b: &[u32], mut found: impl FnMut(u32)) {
 
 /// Numbers the edges of a graph: edge (a, b) with a < b gets `first[a]` + the rank of b among
 /// a's neighbours above a. Lets per-edge data live in flat arrays instead of sorted pair lists.
-pub struct EdgeIds<'g> {
-    adjacency: &'g [Vec<u32>],
+pub struct EdgeIds<'g, L> {
+    adjacency: &'g [L],
     first: Vec<u32>,
     /// Where each vertex's neighbours above it start in its list.
     above: Vec<u32>,
 }
 
-impl<'g> EdgeIds<'g> {
+impl<'g, L: AsRef<[u32]>> EdgeIds<'g, L> {
     /// Numbers the edges of `adjacency` (sorted lists).
-    pub fn new(adjacency: &'g [Vec<u32>]) -> Self {
+    pub fn new(adjacency: &'g [L]) -> Self {
         let (above, first) = above_and_first(adjacency);
         EdgeIds {
             adjacency,
@@ -211,15 +219,15 @@ impl<'g> EdgeIds<'g> {
 
     /// Id of edge (a, b), a < b, which must exist.
     pub fn id(&self, a: u32, b: u32) -> usize {
-        let list = &self.adjacency[a as usize];
+        let list = self.adjacency[a as usize].as_ref();
         let above = &list[self.above[a as usize] as usize..];
         self.first[a as usize] as usize + above.partition_point(|&x| x < b)
     }
 }
 
 /// Edges of the graph that lie on no clique of `cliques` (its 3-cliques) but those `skipped`.
-pub fn loose_edges(
-    adjacency: &[Vec<u32>],
+pub fn loose_edges<L: AsRef<[u32]>>(
+    adjacency: &[L],
     cliques: &Cliques,
     skipped: Option<&[bool]>,
 ) -> Vec<[u32; 2]> {
@@ -236,7 +244,7 @@ pub fn loose_edges(
     let mut loose = Vec::new();
     let mut id = 0;
     for (a, list) in adjacency.iter().enumerate() {
-        for &b in list.iter().filter(|&&b| b > a as u32) {
+        for &b in list.as_ref().iter().filter(|&&b| b > a as u32) {
             if !covered[id] {
                 loose.push([a as u32, b]);
             }

@@ -28,6 +28,10 @@ pub enum EdgeCode {
     Duplicate,
 }
 
+/// A vertex's sorted neighbour ids. Most vertices of a mesh have at most eight neighbours: they
+/// are kept inline, beside the others', rather than in an allocation of their own.
+pub type Neighbours = smallvec::SmallVec<[u32; 8]>;
+
 /// "No further split".
 pub const NO_SPLIT: u16 = u16::MAX;
 
@@ -43,7 +47,7 @@ pub struct EmcState {
     /// Step of each vertex's next split, or [`NO_SPLIT`].
     pub next_split: Vec<u16>,
     /// Sorted neighbour lists (ids are positions in the vertex list).
-    pub adjacency: Vec<Vec<u32>>,
+    pub adjacency: Vec<Neighbours>,
     /// Edges of the graph (each counted once).
     edges: u64,
 }
@@ -57,7 +61,7 @@ impl EmcState {
             cells: vec![[0; 3]],
             depth: vec![0],
             next_split: vec![if total_vertices >= 2 { 0 } else { NO_SPLIT }],
-            adjacency: vec![Vec::new()],
+            adjacency: vec![Neighbours::new()],
             edges: 0,
         }
     }
@@ -99,8 +103,8 @@ impl EmcState {
         self.next_split.push(next[1]);
 
         let old = std::mem::take(&mut self.adjacency[v]);
-        let mut kept = Vec::with_capacity(old.len() + 1);
-        let mut moved = Vec::with_capacity(old.len() + 1);
+        let mut kept = Neighbours::new();
+        let mut moved = Neighbours::new();
         for (&n, &code) in old.iter().zip(codes) {
             let around = &mut self.adjacency[n as usize];
             match code {

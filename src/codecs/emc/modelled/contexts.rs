@@ -129,12 +129,8 @@ pub fn connecting(valence: usize, remaining: usize) -> usize {
 /// and whether it is a single vertex.
 pub fn edge_place(along: f64, across: f64, leaf: bool) -> usize {
     let a = bin(along, &EDGE_ALONG);
-    let ratio = if along > 0.0 {
-        across / along
-    } else {
-        f64::INFINITY
-    };
-    let c = bin(ratio, &EDGE_ACROSS);
+    // The bin of across / along, without dividing (along 0: the last bin).
+    let c: usize = EDGE_ACROSS.iter().map(|&t| (across >= t * along) as usize).sum();
     ((a * (EDGE_ACROSS.len() + 1)) + c) * 2 + leaf as usize
 }
 

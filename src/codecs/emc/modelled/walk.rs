@@ -91,6 +91,12 @@ pub trait Side {
 /// Steepest regression plane used for prediction (squared gradient).
 const SLOPE: f64 = 1.5;
 
+/// 1 / 2^`shift`, exactly: the factor from the centres' units to half-widths of a cell whose
+/// half-width is 2^`shift` (multiplying is cheaper than dividing).
+fn per_half_width(shift: u8) -> f64 {
+    f64::from_bits((1023 - shift as u64) << 52)
+}
+
 /// Count, mean and covariance of a vertex's neighbours (see [`Walker::moments`]).
 struct Moments {
     k: usize,
@@ -116,6 +122,11 @@ pub struct Walker {
     active: Vec<u32>,
     /// Vertices that were leaves at the start of the level, in list order.
     resting: Vec<u32>,
+    /// Per vertex: the serial of the last split that coded its edge to the splitting vertex
+    /// (bits 3 and up) and the code (bit 0 stay, 1 move, 2 duplicate).
+    marks: Vec<u64>,
+    /// Serial of the current split.
+    split_serial: u64,
 }
 
 impl Walker {
@@ -132,15 +143,11 @@ impl Walker {
             codes: Vec::new(),
             active: Vec::new(),
             resting: Vec::new(),
+            marks: Vec::new(),
+            split_serial: 0,
         };
         walker.refresh(0);
         walker
-    }
-
-    /// Twice the centre of `v`'s cell along `axis`, in units of the full grid.
-    #[inline]
-    fn centre2(&self, v: usize, axis: usize) -> i64 {
-        self.centres[v][axis] as i64
     }
 
     /// Recomputes the cached centre of `v` from its cell.
@@ -155,10 +162,10 @@ impl Walker {
         }
     }
 
-    /// Half the width of `v`'s cell along `axis`, in the units of [`Self::centre2`].
+    /// Half the width of `v`'s cell along `axis` is 2^this, in the units of the centres.
     #[inline]
-    fn half_width2(&self, v: usize, axis: usize) -> i64 {
-        1 << self.shifts[self.state.depth[v] as usize][axis]
+    fn half_width_shift(&self, v: usize, axis: usize) -> u8 {
+        self.shifts[self.state.depth[v] as usize][axis]
     }
 
     /// Codes the first `passes` (1..=3) passes of `level` (1-based) and, when all three are
@@ -188,7 +195,6 @@ impl Walker {
         for step in first..first + passes.min(3) {
             self.pass(side, step, max_vertices, max_triangles)?;
         }
-        if std::env::var("EMC_COUNT").is_ok() { eprintln!("level {level}: active {} resting {} len {}", self.active.len(), self.resting.len(), self.state.len()); }
         if passes >= 3 {
             self.leaf_pass(side, first)?;
         }
@@ -333,8 +339,7 @@ impl Walker {
         } else {
             (m.mean[axis], var_a)
         };
-        // In half-widths of the cell: 1 / 2^shift, exactly.
-        let scale = f64::from_bits((1023 - shifts[axis] as u64) << 52);
+        let scale = per_half_width(shifts[axis]);
         (
             contexts::half(
                 self.leaf[v],
@@ -355,29 +360,21 @@ impl Walker {
         }
     }
 
-    /// What the already coded neighbours of `v` that are also neighbours of `n` (the `i`-th
-    /// neighbour) did: bit 0 some stayed, bit 1 some moved, bit 2 some were duplicated. Around a
-    /// manifold vertex the duplicated edges are where the stayed arc meets the moved one.
-    fn coded_ring(&self, v: usize, i: usize, n: usize, codes: &[EdgeCode]) -> usize {
-        let coded = &self.state.adjacency[v][..i];
-        let around = &self.state.adjacency[n];
-        let (mut x, mut y, mut seen) = (0, 0, 0);
-        while x < coded.len() && y < around.len() {
-            match coded[x].cmp(&around[y]) {
-                std::cmp::Ordering::Less => x += 1,
-                std::cmp::Ordering::Greater => y += 1,
-                std::cmp::Ordering::Equal => {
-                    seen |= match codes[x] {
-                        EdgeCode::Stay => 1,
-                        EdgeCode::Move => 2,
-                        EdgeCode::Duplicate => 4,
-                    };
-                    x += 1;
-                    y += 1;
-                }
-            }
+    /// What the already coded neighbours of the splitting vertex that are also neighbours of
+    /// `n` did: bit 0 some stayed, bit 1 some moved, bit 2 some were duplicated (read from the
+    /// marks of the current split). Around a manifold vertex the duplicated edges are where the
+    /// stayed arc meets the moved one.
+    fn coded_ring(&self, n: usize) -> usize {
+        let mut seen = 0;
+        for &m in &self.state.adjacency[n] {
+            let mark = self.marks[m as usize];
+            seen |= if mark >> 3 == self.split_serial {
+                mark & 7
+            } else {
+                0
+            };
         }
-        seen
+        seen as usize
     }
 
     fn split<S: Side>(
@@ -399,21 +396,27 @@ impl Walker {
             v,
             step,
         )?;
-        let mid = self.centre2(v, axis);
-        let w = self.half_width2(v, axis) as f64;
-        let centre = [0, 1, 2].map(|a| self.centre2(v, a));
+        let centre = self.centres[v];
+        let scale = per_half_width(self.half_width_shift(v, axis));
         let mut codes = std::mem::take(&mut self.codes);
         codes.clear();
+        // Marks left by earlier splits are told apart by their serial.
+        self.split_serial += 1;
+        if self.marks.len() < self.state.len() {
+            self.marks.resize(self.state.len() + 1, 0);
+        }
         let mut duplicates = 0;
         for i in 0..valence {
             let n = self.state.adjacency[v][i] as usize;
-            let along = (self.centre2(n, axis) - mid) as f64 / w;
-            let mut across = 0f64;
-            for a in (0..3).filter(|&a| a != axis) {
-                across = across.max((self.centre2(n, a) - centre[a]).abs() as f64 / w);
-            }
+            let offset = self.centres[n].map(|x| x as i64);
+            let along = (offset[axis] - centre[axis] as i64) as f64 * scale;
+            let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+            let across = (offset[b] - centre[b] as i64)
+                .abs()
+                .max((offset[c] - centre[c] as i64).abs()) as f64
+                * scale;
             let place = contexts::edge_place(along.abs(), across, self.leaf[n]);
-            let ring = self.coded_ring(v, i, n, &codes);
+            let ring = self.coded_ring(n);
             let c = contexts::duplicate(place, ring, duplicates);
             let code = if side.code(
                 &mut self.contexts.duplicate[c],
@@ -436,6 +439,12 @@ impl Walker {
                 EdgeCode::Stay
             };
             codes.push(code);
+            self.marks[n] = self.split_serial << 3
+                | match code {
+                    EdgeCode::Stay => 1,
+                    EdgeCode::Move => 2,
+                    EdgeCode::Duplicate => 4,
+                };
         }
         let r = self
             .state
