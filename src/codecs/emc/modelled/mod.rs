@@ -2,16 +2,30 @@
 //!
 //! The octree, its splits and the STAY / MOVE / DUPLICATE edge updates are the paper's (see
 //! [`super`]); what changes is how each decision is coded. Every decision is one binary question
-//! (see [`walk::Question`]) coded by constriction's range coder under an adaptive context chosen
-//! from what the decoder already knows; each level is flushed on its own, so every prefix of
+//! (see [`walk::Question`]) with an adaptive context chosen from what the decoder already knows,
+//! coded by constriction's range coder (a leaf's three "which half" questions of a level go
+//! through it as one symbol); each level is flushed on its own, so every prefix of
 //! whole levels decodes.
 //!
-//! # Syntax, per step
-//! For each vertex present at the start of the step, in list order:
-//! 1. unless it is known to be a single mesh vertex (a *leaf*): does it split now?
+//! # Syntax, per level
+//! A vertex known to be a single mesh vertex (a *leaf*) never splits again and its edges change
+//! only when a neighbour splits; the others are *clusters*. A level is three passes over the
+//! vertices that were clusters at its start, then one pass over those that were leaves.
+//!
+//! Each of the three passes (one per axis), for each cluster present at the start of the pass
+//! (and each vertex split off one earlier in the level), in list order:
+//! 1. unless it is a leaf by now: does it split now?
 //! 2. if not: which half it takes;
 //! 3. if it splits: is there a connecting edge; for each neighbour (ascending ids) is the edge
 //!    duplicated, and if not, does it move to the upper half; then, for each half, is it a leaf.
+//!
+//! Then, for each vertex that was a leaf at the level's start, in list order: which half it takes
+//! on each of the three axes, coded as one symbol of three bits
+//! ([`crate::coding::arith::ArithEncoder::bits3`]) under three "which half" contexts taken from
+//! one look at its neighbours. At the finest levels nearly every vertex is a leaf: the passes
+//! visit the few clusters left, and each leaf costs one neighbourhood and one range-coder step a
+//! level instead of three. A stream cut after one or two passes of a level (`Stop::Passes`)
+//! shows the clusters refined by those passes and the leaves as the level before left them.
 //!
 //! The last level ends with the paper coder's three face-correction lists (false triangles,
 //! faces in both orientations, orientation exceptions), lengths and gaps in adaptive Exp-Golomb.
@@ -59,11 +73,20 @@
 //! | split by the prediction's distance from the plane instead of the cluster's age | 15.86 |
 //! | finer distance bins for the half question | 15.82 |
 //! | fast + slow estimates mixed (rates 1/16 and 1/128; 1/16 + 1/64: 15.77 but worse geometry, 1/32 + 1/256: 15.92) | 15.78 |
-//! | half by vertex kind (cluster, leaf by valence) | **15.60 (3.27 / 12.31)** |
+//! | half by vertex kind (cluster, leaf by valence) | 15.60 (3.27 / 12.31) |
+//! | leaves take a level's three bits in a pass of their own, after the clusters' passes (the clusters see their leaf neighbours one level coarser, the leaves see every cluster refined) | 15.73 (3.34 / 12.37) |
+//! | a leaf's three contexts from one look at its neighbours, before any of its three bits (its own place across each axis as at the level's start), the bits coded as one symbol | **15.74 (3.34 / 12.38)** |
+//!
+//! The last two rows cost 0.14 bits a vertex and bought decoding speed: a leaf's neighbours are
+//! read once a level instead of three times, and a level's bits take one range-coder step
+//! (bunny.ply at 12 bits: 71 → 50 ms with the other changes of the same commit; see
+//! BENCHMARKS.md). Reusing a leaf's neighbour moments from an earlier level instead of reading
+//! the neighbours every level was measured too and dropped: every other level 16.22, once only
+//! 17.20 (the neighbours' last level of precision matters).
 //!
 //! Tried and not kept: the neighbours' reach (their distance in cell widths) for split and leaf
 //! (+0.02), the cluster's age beside the distance for split (+0.00), a single adaptation rate
-//! of 1/64 (+0.06). armadillo-43k.obj ends at 15.98 (4.51 / 11.45).
+//! of 1/64 (+0.06). armadillo-43k.obj ends at 15.98 (4.58 / 11.38).
 //!
 //! The finest levels stay expensive: at 12 bits the last three levels cost 2.2–2.7 bits a
 //! vertex each (nearly a bit per step), because the prediction's error (a few grid units on
