@@ -159,7 +159,11 @@ impl DecoderModel<TRIPLE_PRECISION> for Triple {
                 size = zero;
             }
         }
-        (symbol, left, NonZeroU32::new(size).expect("parts are nonzero"))
+        (
+            symbol,
+            left,
+            NonZeroU32::new(size).expect("parts are nonzero"),
+        )
     }
 }
 

@@ -98,9 +98,13 @@ fn above_and_first<L: AsRef<[u32]>>(adjacency: &[L]) -> (Vec<u32>, Vec<u32>) {
 
 fn triangles_by_merge<L: AsRef<[u32]>>(adjacency: &[L], limit: usize) -> Option<Cliques> {
     let (above, first) = above_and_first(adjacency);
+    let edge_count = *first.last().unwrap_or(&0) as usize;
+    // A closed mesh has two triangles for every three edges.
+    let expected = (edge_count * 2 / 3).min(limit);
     let mut out = Cliques {
-        edge_count: *first.last().unwrap_or(&0) as usize,
-        ..Cliques::default()
+        tris: Vec::with_capacity(expected),
+        edges: Vec::with_capacity(expected),
+        edge_count,
     };
     for (a, around_a) in adjacency.iter().enumerate() {
         let above_a = &around_a.as_ref()[above[a] as usize..];

@@ -130,7 +130,10 @@ pub fn connecting(valence: usize, remaining: usize) -> usize {
 pub fn edge_place(along: f64, across: f64, leaf: bool) -> usize {
     let a = bin(along, &EDGE_ALONG);
     // The bin of across / along, without dividing (along 0: the last bin).
-    let c: usize = EDGE_ACROSS.iter().map(|&t| (across >= t * along) as usize).sum();
+    let c: usize = EDGE_ACROSS
+        .iter()
+        .map(|&t| (across >= t * along) as usize)
+        .sum();
     ((a * (EDGE_ACROSS.len() + 1)) + c) * 2 + leaf as usize
 }
 
