@@ -446,4 +446,41 @@ mod tests {
         }
         assert_eq!(dec.raw(20), Some(0xabcde));
     }
+
+    #[test]
+    fn three_bits_as_one_symbol_round_trip_and_cost_what_three_bits_would() {
+        // Skewed and even bits, two of the three sharing a context now and then.
+        let mut x = 0x2545_f491_u32;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            x
+        };
+        let draws: Vec<([usize; 3], [bool; 3])> = (0..20_000)
+            .map(|_| {
+                let r = next();
+                let index = [(r % 4) as usize, ((r >> 2) % 4) as usize, 4];
+                let bits = [r >> 8 & 15 == 0, r >> 12 & 1 == 1, r >> 13 & 63 != 0];
+                (index, bits)
+            })
+            .collect();
+        let mut contexts = [BitContext::default(); 5];
+        let mut enc = ArithEncoder::default();
+        for &(index, bits) in &draws {
+            enc.bits3(&mut contexts, index, bits, SyntaxClass::Geometry, "t");
+        }
+        let estimated = enc.estimated[SyntaxClass::Geometry as usize];
+        let (bytes, _) = enc.finish();
+        let actual = bytes.len() as f64 * 8.0;
+        assert!(
+            actual < estimated * 1.01 + 64.0,
+            "{actual} bits coded, {estimated} estimated"
+        );
+        let mut dec = ArithDecoder::new(&bytes).unwrap();
+        let mut contexts = [BitContext::default(); 5];
+        for &(index, bits) in &draws {
+            assert_eq!(dec.bits3(&mut contexts, index), Some(bits));
+        }
+    }
 }

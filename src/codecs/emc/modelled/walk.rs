@@ -240,13 +240,14 @@ impl Walker {
     }
 
     /// The three refinement bits of a level (steps `first`..`first + 3`) of every vertex that
-    /// was a leaf at the level's start, vertex by vertex: the neighbours' moments are taken once
-    /// and serve all three axes (they do not depend on where in its cell the vertex is).
+    /// was a leaf at the level's start, vertex by vertex: the neighbours' moments are taken once,
+    /// and all three contexts come from them and the vertex's cell at the level's start, before
+    /// any of the three bits, so that the bits go through the coder as one symbol.
     fn leaf_pass<S: Side>(&mut self, side: &mut S, first: usize) -> Result<(), Stop> {
         let order = self.state.order;
         for i in 0..self.resting.len() {
             let v = self.resting[i] as usize;
-            let moments = self.moments(v, self.centres[v]);
+            let moments = self.moments(v);
             let (mut index, mut flips) = ([0; 3], [false; 3]);
             for k in 0..3 {
                 let (half, flip) = match &moments {
@@ -264,9 +265,10 @@ impl Walker {
         Ok(())
     }
 
-    /// Count, mean and covariance of `v`'s neighbours' cell centres, relative to `origin`;
+    /// Count, mean and covariance of `v`'s neighbours' cell centres, relative to `v`'s centre;
     /// `None` without neighbours.
-    fn moments(&self, v: usize, origin: [i32; 3]) -> Option<Moments> {
+    fn moments(&self, v: usize) -> Option<Moments> {
+        let origin = self.centres[v];
         let neighbours = &self.state.adjacency[v];
         if neighbours.is_empty() {
             return None;
@@ -354,7 +356,7 @@ impl Walker {
     /// Context and flip of the half a vertex in the passes takes ([`Self::predict`] from its
     /// neighbours as they are now).
     fn half_context(&self, v: usize, axis: usize) -> (contexts::HalfContext, bool) {
-        match self.moments(v, self.centres[v]) {
+        match self.moments(v) {
             None => (contexts::half_isolated(self.leaf[v]), false),
             Some(m) => self.predict(v, axis, &m),
         }
