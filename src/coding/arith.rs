@@ -126,32 +126,16 @@ impl EntropyModel<TRIPLE_PRECISION> for Triple {
     type Probability = u32;
 }
 
-impl EncoderModel<TRIPLE_PRECISION> for Triple {
-    fn left_cumulative_and_probability(
-        &self,
-        symbol: impl Borrow<u8>,
-    ) -> Option<(u32, NonZeroU32)> {
-        let symbol = *symbol.borrow();
-        let (mut left, mut size) = (0u32, 1u32 << TRIPLE_PRECISION);
-        for (k, &p1) in self.p1.iter().enumerate() {
-            let zero = Triple::zero_part(size, p1);
-            if symbol >> k & 1 == 1 {
-                left += zero;
-                size -= zero;
-            } else {
-                size = zero;
-            }
-        }
-        Some((left, NonZeroU32::new(size)?))
-    }
-}
-
-impl DecoderModel<TRIPLE_PRECISION> for Triple {
-    fn quantile_function(&self, quantile: u32) -> (u8, u32, NonZeroU32) {
+impl Triple {
+    /// Walks down the splits: `one(k, left, zero)` says whether the k-th bit is 1, given the
+    /// current part's start and the size of its "0" sub-part. Returns the three bits, the
+    /// chosen part's start and its size.
+    #[inline]
+    fn descend(&self, mut one: impl FnMut(usize, u32, u32) -> bool) -> (u8, u32, u32) {
         let (mut left, mut size, mut symbol) = (0u32, 1u32 << TRIPLE_PRECISION, 0u8);
         for (k, &p1) in self.p1.iter().enumerate() {
             let zero = Triple::zero_part(size, p1);
-            if quantile - left >= zero {
+            if one(k, left, zero) {
                 symbol |= 1 << k;
                 left += zero;
                 size -= zero;
@@ -159,6 +143,24 @@ impl DecoderModel<TRIPLE_PRECISION> for Triple {
                 size = zero;
             }
         }
+        (symbol, left, size)
+    }
+}
+
+impl EncoderModel<TRIPLE_PRECISION> for Triple {
+    fn left_cumulative_and_probability(
+        &self,
+        symbol: impl Borrow<u8>,
+    ) -> Option<(u32, NonZeroU32)> {
+        let symbol = *symbol.borrow();
+        let (_, left, size) = self.descend(|k, _, _| symbol >> k & 1 == 1);
+        Some((left, NonZeroU32::new(size)?))
+    }
+}
+
+impl DecoderModel<TRIPLE_PRECISION> for Triple {
+    fn quantile_function(&self, quantile: u32) -> (u8, u32, NonZeroU32) {
+        let (symbol, left, size) = self.descend(|_, left, zero| quantile - left >= zero);
         (
             symbol,
             left,

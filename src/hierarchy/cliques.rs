@@ -113,17 +113,10 @@ fn triangles_by_merge<L: AsRef<[u32]>>(adjacency: &[L], limit: usize) -> Option<
             // c > b and adjacent to both.
             let above_b = &around_b[above[b as usize] as usize..];
             let (ab, base_b) = (first[a] + i as u32, first[b as usize]);
-            let rest = &above_a[i + 1..];
-            let (mut p, mut q) = (0, 0);
-            while p < rest.len() && q < above_b.len() {
-                let (x, y) = (rest[p], above_b[q]);
-                if x == y {
-                    out.tris.push([a as u32, b, x]);
-                    out.edges.push([ab, base_b + q as u32, ab + 1 + p as u32]);
-                }
-                p += (x <= y) as usize;
-                q += (y <= x) as usize;
-            }
+            for_each_common(&above_a[i + 1..], above_b, |c, p, q| {
+                out.tris.push([a as u32, b, c]);
+                out.edges.push([ab, base_b + q as u32, ab + 1 + p as u32]);
+            });
             if out.tris.len() > limit {
                 return None;
             }
@@ -161,7 +154,7 @@ fn triangles_by_degree_rank<L: AsRef<[u32]>>(
         let above_u = &higher[u];
         for (i, &rw) in above_u.iter().enumerate() {
             let above_w = &higher[by_degree[rw as usize] as usize];
-            for_each_common(&above_u[i + 1..], above_w, |rx| {
+            for_each_common(&above_u[i + 1..], above_w, |rx, _, _| {
                 let mut t = [u as u32, by_degree[rw as usize], by_degree[rx as usize]];
                 t.sort_unstable();
                 out.push(t);
@@ -175,19 +168,17 @@ fn triangles_by_degree_rank<L: AsRef<[u32]>>(
     Some(out)
 }
 
-/// Calls `found` with every value in both ascending lists.
-fn for_each_common(a: &[u32], b: &[u32], mut found: impl FnMut(u32)) {
+/// Calls `found` with every value in both ascending lists and its positions in `a` and `b`.
+fn for_each_common(a: &[u32], b: &[u32], mut found: impl FnMut(u32, usize, usize)) {
     let (mut p, mut q) = (0, 0);
     while p < a.len() && q < b.len() {
-        match a[p].cmp(&b[q]) {
-            std::cmp::Ordering::Less => p += 1,
-            std::cmp::Ordering::Greater => q += 1,
-            std::cmp::Ordering::Equal => {
-                found(a[p]);
-                p += 1;
-                q += 1;
-            }
+        let (x, y) = (a[p], b[q]);
+        if x == y {
+            found(x, p, q);
         }
+        // Both steps without branches: which list is behind is as good as random.
+        p += (x <= y) as usize;
+        q += (y <= x) as usize;
     }
 }
 
