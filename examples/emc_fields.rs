@@ -25,7 +25,7 @@ fn main() -> anyhow::Result<()> {
         let encoded = codec.encode(&canonical, &options)?;
         let mut seconds = f64::INFINITY;
         let mut decoded = None;
-        for _ in 0..10 {
+        for _ in 0..std::env::var("REPS").ok().and_then(|s| s.parse().ok()).unwrap_or(10) {
             let start = std::time::Instant::now();
             decoded = Some(codecs::decode(&encoded.bytes, Stop::All)?.0);
             seconds = seconds.min(start.elapsed().as_secs_f64());

@@ -106,6 +106,7 @@ pub fn half_isolated(leaf: bool) -> HalfContext {
 
 /// Which half: by the neighbours' mean offset and variance (both relative to the half-width,
 /// the variance to its square).
+#[inline]
 pub fn half(leaf: bool, valence: usize, offset: f64, variance: f64) -> HalfContext {
     let kind = if leaf {
         1 + (valence >= 5) as usize + (valence >= 7) as usize

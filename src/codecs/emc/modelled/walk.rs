@@ -97,6 +97,58 @@ fn per_half_width(shift: u8) -> f64 {
     f64::from_bits((1023 - shift as u64) << 52)
 }
 
+/// 2^`shift`, exactly.
+#[inline]
+fn power_of_two(shift: u8) -> f64 {
+    f64::from_bits((1023 + shift as u64) << 52)
+}
+
+/// `if choose { a } else { b }` without a branch: which one is as good as random to a branch
+/// predictor.
+#[inline]
+fn select(choose: bool, a: f64, b: f64) -> f64 {
+    let mask = (choose as u64).wrapping_neg();
+    f64::from_bits((a.to_bits() & mask) | (b.to_bits() & !mask))
+}
+
+/// Where a vertex is expected along `axis`, relative to its centre, and the expected squared
+/// error, both in the units of the centres, from its neighbours' moments `m` (relative to its
+/// centre) and the shifts of its cell's half-widths. The prediction is the neighbours'
+/// regression plane (the coordinate along the axis as a linear function of the other two,
+/// evaluated at the vertex's own place across the axis) where the neighbours span the other two
+/// axes, else their mean; the error is the neighbours' residual spread plus what the vertex's
+/// own cell leaves open.
+#[inline(always)]
+fn estimate(m: &Moments, axis: usize, shifts: [u8; 3]) -> (f64, f64) {
+    let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+    let var_a = m.cov[axis][axis].max(0.0);
+    let (cbb, ccc, cbc) = (m.cov[b][b], m.cov[c][c], m.cov[b][c]);
+    let (cab, cac) = (m.cov[axis][b], m.cov[axis][c]);
+    // The plane's gradient is (nb, nc) / det; it is used where the neighbours span the
+    // other two axes and it is no steeper than SLOPE.
+    let det = cbb * ccc - cbc * cbc;
+    let (nb, nc) = (cab * ccc - cac * cbc, cac * cbb - cab * cbc);
+    let spread = cbb + ccc;
+    let plane =
+        (m.k >= 4) & (det > 1e-2 * spread * spread) & (nb * nb + nc * nc <= SLOPE * det * det);
+    // Both estimates are computed and one is kept (the plane's may be meaningless where it is
+    // not used).
+    let inverse = 1.0 / det;
+    let (beta_b, beta_c) = (nb * inverse, nc * inverse);
+    let residual = (var_a - beta_b * cab - beta_c * cac).max(0.0);
+    // The vertex's own place across the axis: the neighbours' mean, kept inside its cell.
+    let (wb, wc) = (power_of_two(shifts[b]), power_of_two(shifts[c]));
+    let (mb, mc) = (m.mean[b], m.mean[c]);
+    let (eb, ec) = (mb.max(-wb).min(wb), mc.max(-wc).min(wc));
+    let own_cell =
+        beta_b * beta_b * (wb * wb / 3.0).min(cbb) + beta_c * beta_c * (wc * wc / 3.0).min(ccc);
+    let on_plane = m.mean[axis] + beta_b * (eb - mb) + beta_c * (ec - mc);
+    (
+        select(plane, on_plane, m.mean[axis]),
+        select(plane, residual + own_cell, var_a),
+    )
+}
+
 /// Count, mean and covariance of a vertex's neighbours (see [`Walker::moments`]).
 struct Moments {
     k: usize,
@@ -305,42 +357,11 @@ impl Walker {
     }
 
     /// Context and flip of the half `v` takes along `axis`, from its neighbours' moments `m`
-    /// (relative to `v`'s centre). The prediction is the neighbours' regression plane (the
-    /// coordinate along the axis as a linear function of the other two, evaluated at the
-    /// vertex's own place across the axis) where the neighbours span the other two axes, else
-    /// their mean; the context is its distance from the split plane and the expected error (the
-    /// neighbours' residual spread plus what the vertex's own cell leaves open), both in
-    /// half-widths of the cell.
+    /// (relative to `v`'s centre); see [`estimate`].
+    #[inline]
     fn predict(&self, v: usize, axis: usize, m: &Moments) -> (contexts::HalfContext, bool) {
-        let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
         let shifts = self.shifts[self.state.depth[v] as usize];
-        let var_a = m.cov[axis][axis].max(0.0);
-        let (cbb, ccc, cbc) = (m.cov[b][b], m.cov[c][c], m.cov[b][c]);
-        let (cab, cac) = (m.cov[axis][b], m.cov[axis][c]);
-        // The plane's gradient is (nb, nc) / det; it is used where the neighbours span the
-        // other two axes and it is no steeper than SLOPE.
-        let det = cbb * ccc - cbc * cbc;
-        let (nb, nc) = (cab * ccc - cac * cbc, cac * cbb - cab * cbc);
-        let spread = cbb + ccc;
-        let plane =
-            m.k >= 4 && det > 1e-2 * spread * spread && nb * nb + nc * nc <= SLOPE * det * det;
-        let (prediction, variance) = if plane {
-            let inverse = 1.0 / det;
-            let (beta_b, beta_c) = (nb * inverse, nc * inverse);
-            let residual = (var_a - beta_b * cab - beta_c * cac).max(0.0);
-            // The vertex's own place across the axis: the neighbours' mean, kept inside its cell.
-            let (wb, wc) = ((1i64 << shifts[b]) as f64, (1i64 << shifts[c]) as f64);
-            let (mb, mc) = (m.mean[b], m.mean[c]);
-            let (eb, ec) = (mb.clamp(-wb, wb), mc.clamp(-wc, wc));
-            let own_cell = beta_b * beta_b * (wb * wb / 3.0).min(cbb)
-                + beta_c * beta_c * (wc * wc / 3.0).min(ccc);
-            (
-                m.mean[axis] + beta_b * (eb - mb) + beta_c * (ec - mc),
-                residual + own_cell,
-            )
-        } else {
-            (m.mean[axis], var_a)
-        };
+        let (prediction, variance) = estimate(m, axis, shifts);
         let scale = per_half_width(shifts[axis]);
         (
             contexts::half(
