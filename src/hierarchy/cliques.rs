@@ -300,9 +300,10 @@ pub fn propagate_orientation(
             e.0 += 1;
         }
     }
-    // For each triangle and each of its edges (a,b), (b,c), (a,c): the one other triangle across
-    // it, if exactly two share the edge.
-    let mut across = vec![[u32::MAX; 3]; tris.len()];
+    // For each triangle: its vertices and, for each of its edges (a,b), (b,c), (a,c), the one
+    // other triangle across it, if exactly two share the edge. Side by side, so that reaching a
+    // triangle (in an order the cache cannot foresee) reads one place.
+    let mut nodes: Vec<([u32; 3], [u32; 3])> = tris.iter().map(|&t| (t, [u32::MAX; 3])).collect();
     for (t, edges) in cliques.edges.iter().enumerate() {
         if skipped[t] {
             continue;
@@ -310,7 +311,7 @@ pub fn propagate_orientation(
         for (slot, &e) in edges.iter().enumerate() {
             let (count, first, second) = users[e as usize];
             if count == 2 {
-                across[t][slot] = if first == t as u32 { second } else { first };
+                nodes[t].1[slot] = if first == t as u32 { second } else { first };
             }
         }
     }
@@ -329,29 +330,29 @@ pub fn propagate_orientation(
         visit += 1;
         // Breadth-first: the queue is read from `next` on.
         queue.clear();
-        queue.push(start);
+        queue.push(start as u32);
         let mut next = 0;
         while let Some(&t) = queue.get(next) {
             next += 1;
-            let tri = tris[t];
+            let (tri, across) = nodes[t as usize];
             let edges = [(tri[0], tri[1]), (tri[1], tri[2]), (tri[0], tri[2])];
             for (slot, &(u, v)) in edges.iter().enumerate() {
-                let other = across[t][slot];
+                let other = across[slot];
                 if other == u32::MAX || seen[other as usize] {
                     continue;
                 }
                 seen[other as usize] = true;
                 // Direction in which t, as oriented, traverses this edge.
-                let (from, to) = if traverses(oriented(tri, flipped[t]), u, v) {
+                let (from, to) = if traverses(oriented(tri, flipped[t as usize]), u, v) {
                     (u, v)
                 } else {
                     (v, u)
                 };
                 // The neighbour agrees when it traverses the edge the other way.
-                let predicted = traverses(tris[other as usize], from, to);
+                let predicted = traverses(nodes[other as usize].0, from, to);
                 flipped[other as usize] = decide(visit, other as usize, predicted);
                 visit += 1;
-                queue.push(other as usize);
+                queue.push(other);
             }
         }
     }
