@@ -44,11 +44,10 @@ impl Default for BitContext {
 }
 
 fn adapt(p: u32, bit: bool, rate: u32) -> u32 {
-    if bit {
-        p + ((ONE - p) >> rate)
-    } else {
-        p - (p >> rate)
-    }
+    // p + ((ONE - p) >> rate) for a 1, p - (p >> rate) for a 0, without a branch: the bits a
+    // decoder reads are as good as random to a branch predictor.
+    let one = (bit as u32).wrapping_neg();
+    p + (((ONE - p) >> rate) & one) - ((p >> rate) & !one)
 }
 
 impl BitContext {
@@ -89,12 +88,16 @@ impl EncoderModel<PRECISION> for BitContext {
 
 impl DecoderModel<PRECISION> for BitContext {
     fn quantile_function(&self, quantile: u32) -> (bool, u32, NonZeroU32) {
+        // Without branches, as in `adapt`.
         let p0 = ONE - self.p1;
-        if quantile < p0 {
-            (false, 0, NonZeroU32::new(p0).expect("p0 > 0"))
-        } else {
-            (true, p0, NonZeroU32::new(self.p1).expect("p1 > 0"))
-        }
+        let bit = quantile >= p0;
+        let one = (bit as u32).wrapping_neg();
+        let probability = (self.p1 & one) | (p0 & !one);
+        (
+            bit,
+            p0 & one,
+            NonZeroU32::new(probability).expect("p1 and p0 are clamped away from 0"),
+        )
     }
 }
 
@@ -135,13 +138,12 @@ impl Triple {
         let (mut left, mut size, mut symbol) = (0u32, 1u32 << TRIPLE_PRECISION, 0u8);
         for (k, &p1) in self.p1.iter().enumerate() {
             let zero = Triple::zero_part(size, p1);
-            if one(k, left, zero) {
-                symbol |= 1 << k;
-                left += zero;
-                size -= zero;
-            } else {
-                size = zero;
-            }
+            // Without branches: a decoder's bits are as good as random to a branch predictor.
+            let bit = one(k, left, zero);
+            let mask = (bit as u32).wrapping_neg();
+            symbol |= (bit as u8) << k;
+            left += zero & mask;
+            size = (size - zero) & mask | zero & !mask;
         }
         (symbol, left, size)
     }

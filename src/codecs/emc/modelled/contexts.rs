@@ -108,11 +108,22 @@ pub fn half_isolated(leaf: bool) -> HalfContext {
 /// the variance to its square).
 #[inline]
 pub fn half(leaf: bool, valence: usize, offset: f64, variance: f64) -> HalfContext {
-    let kind = if leaf {
+    half_in(half_kind(leaf, valence), offset, variance)
+}
+
+/// The vertex kind of a "which half" question: cluster, or leaf of valence ≤ 4, 5–6, ≥ 7.
+#[inline]
+pub fn half_kind(leaf: bool, valence: usize) -> usize {
+    if leaf {
         1 + (valence >= 5) as usize + (valence >= 7) as usize
     } else {
         0
-    };
+    }
+}
+
+/// [`half`] for a vertex of kind `kind` ([`half_kind`]).
+#[inline]
+pub fn half_in(kind: usize, offset: f64, variance: f64) -> HalfContext {
     let o = bin(offset, &HALF_OFFSET);
     let s = bin(variance, &HALF_SPREAD);
     HalfContext {

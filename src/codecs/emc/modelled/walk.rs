@@ -149,6 +149,66 @@ fn estimate(m: &Moments, axis: usize, shifts: [u8; 3]) -> (f64, f64) {
     )
 }
 
+/// [`estimate`] and the "which half" context of a leaf on all three axes at once (lane `a`:
+/// axis `a`; a fourth lane repeats the first so that the lanes fill vector registers): the same
+/// operations in the same order, so the same values, in a form the compiler vectorizes.
+/// Returns each axis's context index and whether the prediction is below the split plane.
+#[inline(always)]
+fn leaf_contexts(m: &Moments, shifts: [u8; 3]) -> ([usize; 3], [bool; 3]) {
+    type Lanes = [f64; 4];
+    fn each(f: impl Fn(usize) -> f64) -> Lanes {
+        [f(0), f(1), f(2), f(3)]
+    }
+    let cov = &m.cov;
+    // Lane a reads axis a, b = a + 1 and c = a + 2 (mod 3).
+    let at = |lane: usize, shift: usize| (lane + shift) % 3;
+    let var_a = each(|l| cov[at(l, 0)][at(l, 0)].max(0.0));
+    let cbb = each(|l| cov[at(l, 1)][at(l, 1)]);
+    let ccc = each(|l| cov[at(l, 2)][at(l, 2)]);
+    let cbc = each(|l| cov[at(l, 1)][at(l, 2)]);
+    let cab = each(|l| cov[at(l, 0)][at(l, 1)]);
+    let cac = each(|l| cov[at(l, 0)][at(l, 2)]);
+    let mean_a = each(|l| m.mean[at(l, 0)]);
+    let mb = each(|l| m.mean[at(l, 1)]);
+    let mc = each(|l| m.mean[at(l, 2)]);
+    let wb = each(|l| power_of_two(shifts[at(l, 1)]));
+    let wc = each(|l| power_of_two(shifts[at(l, 2)]));
+    let scale = each(|l| per_half_width(shifts[at(l, 0)]));
+    let det = each(|l| cbb[l] * ccc[l] - cbc[l] * cbc[l]);
+    let nb = each(|l| cab[l] * ccc[l] - cac[l] * cbc[l]);
+    let nc = each(|l| cac[l] * cbb[l] - cab[l] * cbc[l]);
+    let spread = each(|l| cbb[l] + ccc[l]);
+    let inverse = each(|l| 1.0 / det[l]);
+    let beta_b = each(|l| nb[l] * inverse[l]);
+    let beta_c = each(|l| nc[l] * inverse[l]);
+    let residual = each(|l| (var_a[l] - beta_b[l] * cab[l] - beta_c[l] * cac[l]).max(0.0));
+    let eb = each(|l| mb[l].max(-wb[l]).min(wb[l]));
+    let ec = each(|l| mc[l].max(-wc[l]).min(wc[l]));
+    let own_cell = each(|l| {
+        beta_b[l] * beta_b[l] * (wb[l] * wb[l] / 3.0).min(cbb[l])
+            + beta_c[l] * beta_c[l] * (wc[l] * wc[l] / 3.0).min(ccc[l])
+    });
+    let on_plane = each(|l| mean_a[l] + beta_b[l] * (eb[l] - mb[l]) + beta_c[l] * (ec[l] - mc[l]));
+    let mut index = [0; 3];
+    let mut below = [false; 3];
+    let kind = contexts::half_kind(true, m.k);
+    for l in 0..3 {
+        let plane = (m.k >= 4)
+            & (det[l] > 1e-2 * spread[l] * spread[l])
+            & (nb[l] * nb[l] + nc[l] * nc[l] <= SLOPE * det[l] * det[l]);
+        let prediction = select(plane, on_plane[l], mean_a[l]);
+        let variance = select(plane, residual[l] + own_cell[l], var_a[l]);
+        index[l] = contexts::half_in(
+            kind,
+            prediction.abs() * scale[l],
+            variance * scale[l] * scale[l],
+        )
+        .index;
+        below[l] = prediction < 0.0;
+    }
+    (index, below)
+}
+
 /// Count, mean and covariance of a vertex's neighbours (see [`Walker::moments`]).
 struct Moments {
     k: usize,
@@ -296,17 +356,19 @@ impl Walker {
     /// and all three contexts come from them and the vertex's cell at the level's start, before
     /// any of the three bits, so that the bits go through the coder as one symbol.
     fn leaf_pass<S: Side>(&mut self, side: &mut S, first: usize) -> Result<(), Stop> {
-        let order = self.state.order;
+        let axes = [0, 1, 2].map(|k| self.state.order.axis(first + k));
         for i in 0..self.resting.len() {
             let v = self.resting[i] as usize;
-            let moments = self.moments(v);
             let (mut index, mut flips) = ([0; 3], [false; 3]);
-            for k in 0..3 {
-                let (half, flip) = match &moments {
-                    None => (contexts::half_isolated(true), false),
-                    Some(m) => self.predict(v, order.axis(first + k), m),
-                };
-                (index[k], flips[k]) = (half.index, flip);
+            match self.moments(v) {
+                None => index = [contexts::half_isolated(true).index; 3],
+                Some(m) => {
+                    let shifts = self.shifts[self.state.depth[v] as usize];
+                    let (by_axis, below) = leaf_contexts(&m, shifts);
+                    for k in 0..3 {
+                        (index[k], flips[k]) = (by_axis[axes[k]], below[axes[k]]);
+                    }
+                }
             }
             let bits = side.code3(&mut self.contexts.half, index, flips, v, first)?;
             for (k, bit) in bits.into_iter().enumerate() {
