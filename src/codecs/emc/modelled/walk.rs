@@ -379,6 +379,14 @@ impl Walker {
         Ok(())
     }
 
+    /// Reads `v`'s neighbours' lists and centres (a sum for [`std::hint::black_box`] to keep).
+    fn touch(&self, v: usize) -> usize {
+        self.state.adjacency[v]
+            .iter()
+            .map(|&n| self.state.adjacency[n as usize].len() + self.centres[n as usize][0] as usize)
+            .sum()
+    }
+
     /// Count, mean and covariance of `v`'s neighbours' cell centres, relative to `v`'s centre;
     /// `None` without neighbours.
     fn moments(&self, v: usize) -> Option<Moments> {
@@ -473,6 +481,10 @@ impl Walker {
     ) -> Result<usize, Stop> {
         side.begin_split(&self.state, v, step);
         let valence = self.state.adjacency[v].len();
+        // The neighbours' lists and centres are about to be read (and most lists edited): load
+        // them now, side by side, rather than one after another between the questions (which
+        // leaves the processor waiting on each in turn).
+        std::hint::black_box(self.touch(v));
         let c = contexts::connecting(valence, remaining);
         let connecting = side.code(
             &mut self.contexts.connecting[c],
