@@ -143,7 +143,7 @@ impl Triple {
             let mask = (bit as u32).wrapping_neg();
             symbol |= (bit as u8) << k;
             left += zero & mask;
-            size = (size - zero) & mask | zero & !mask;
+            size = ((size - zero) & mask) | (zero & !mask);
         }
         (symbol, left, size)
     }

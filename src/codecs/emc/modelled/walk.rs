@@ -572,3 +572,48 @@ impl Walker {
         Ok(r)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The lane-wise contexts of a leaf are exactly those of [`estimate`] axis by axis, for
+    /// neighbourhoods flat and not, with few neighbours and many, at fine and coarse cells.
+    #[test]
+    fn leaf_contexts_match_the_estimate_of_each_axis() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        for _ in 0..20_000 {
+            let k = rng.gen_range(1..12);
+            let shifts = [0; 3].map(|_| rng.gen_range(0..13u8));
+            let flat = rng.gen_range(0..3usize);
+            let reach = 1i64 << rng.gen_range(0..14);
+            let offsets: Vec<[f64; 3]> = (0..k)
+                .map(|_| {
+                    let mut d = [0; 3].map(|_| rng.gen_range(-reach..=reach) as f64);
+                    if rng.gen_bool(0.5) {
+                        d[flat] = (d[(flat + 1) % 3] * 0.3).round();
+                    }
+                    d
+                })
+                .collect();
+            let inv = 1.0 / k as f64;
+            let mean: [f64; 3] =
+                std::array::from_fn(|a| offsets.iter().map(|d| d[a]).sum::<f64>() * inv);
+            let cov: [[f64; 3]; 3] = std::array::from_fn(|a| {
+                std::array::from_fn(|b| {
+                    offsets.iter().map(|d| d[a] * d[b]).sum::<f64>() * inv - mean[a] * mean[b]
+                })
+            });
+            let m = Moments { k, mean, cov };
+            let (index, below) = leaf_contexts(&m, shifts);
+            for axis in 0..3 {
+                let (prediction, variance) = estimate(&m, axis, shifts);
+                let scale = per_half_width(shifts[axis]);
+                let half =
+                    contexts::half(true, k, prediction.abs() * scale, variance * scale * scale);
+                assert_eq!((index[axis], below[axis]), (half.index, prediction < 0.0));
+            }
+        }
+    }
+}
