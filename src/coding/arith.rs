@@ -106,9 +106,11 @@ impl DecoderModel<PRECISION> for BitContext {
 const TRIPLE_PRECISION: usize = 24;
 
 /// Three binary decisions coded as one symbol: the interval is split by the first bit's
-/// probability, each half by the second's, each quarter by the third's. Coding them at once
-/// costs one range-coder step instead of three; the contexts are read before any of the three
-/// is adapted (where two decisions share a context, both see it as it was).
+/// probability, each half by the second's, each quarter by the third's. One range-coder step
+/// instead of three, though not faster: the step's division is saved but the three splits are a
+/// chain of dependent multiplications (`cargo bench --bench arith`: 19 ns a symbol, 6.6 ns a
+/// single bit). The contexts are read before any of the three is adapted (where two decisions
+/// share a context, both see it as it was).
 #[derive(Clone, Copy, Debug)]
 struct Triple {
     p1: [u32; 3],
@@ -121,15 +123,7 @@ impl Triple {
         let zero = ((size as u64 * (ONE - p1) as u64) >> PRECISION) as u32;
         zero.clamp(1, size - 1)
     }
-}
 
-impl EntropyModel<TRIPLE_PRECISION> for Triple {
-    /// The three bits, the first in bit 0.
-    type Symbol = u8;
-    type Probability = u32;
-}
-
-impl Triple {
     /// Walks down the splits: `one(k, left, zero)` says whether the k-th bit is 1, given the
     /// current part's start and the size of its "0" sub-part. Returns the three bits, the
     /// chosen part's start and its size.
@@ -147,6 +141,12 @@ impl Triple {
         }
         (symbol, left, size)
     }
+}
+
+impl EntropyModel<TRIPLE_PRECISION> for Triple {
+    /// The three bits, the first in bit 0.
+    type Symbol = u8;
+    type Probability = u32;
 }
 
 impl EncoderModel<TRIPLE_PRECISION> for Triple {

@@ -78,9 +78,10 @@
 //! | a leaf's three contexts from one look at its neighbours, before any of its three bits (its own place across each axis as at the level's start), the bits coded as one symbol | **15.74 (3.34 / 12.38)** |
 //!
 //! The last two rows cost 0.14 bits a vertex and bought decoding speed: a leaf's neighbours are
-//! read once a level instead of three times, and a level's bits take one range-coder step
-//! (bunny.ply at 12 bits: 71 → 50 ms with the other changes of the same commit; see
-//! BENCHMARKS.md). Reusing a leaf's neighbour moments from an earlier level instead of reading
+//! read once a level instead of three times (bunny.ply at 12 bits: 71 → 50 ms with the other
+//! changes of the same commit; see BENCHMARKS.md). Its three bits take one range-coder step,
+//! which turned out no faster than three: `cargo bench --bench arith` measures 19 ns for a
+//! three-bit symbol, 6.6 ns for one bit. Reusing a leaf's neighbour moments from an earlier level instead of reading
 //! the neighbours every level was measured too and dropped: every other level 16.22, once only
 //! 17.20 (the neighbours' last level of precision matters).
 //!
