@@ -259,12 +259,6 @@ pub fn oriented(tri: [u32; 3], flipped: bool) -> [u32; 3] {
     }
 }
 
-/// Does the cycle a → b → c of `tri` (ascending) traverse the directed edge u → v?
-fn traverses(tri: [u32; 3], u: u32, v: u32) -> bool {
-    let [a, b, c] = tri;
-    (u, v) == (a, b) || (u, v) == (b, c) || (u, v) == (c, a)
-}
-
 /// Orients the triangles `tris` (ascending triples of edges of the graph `adjacency`) that are
 /// not `skipped`.
 ///
@@ -284,37 +278,44 @@ pub fn propagate_orientation(
     mut decide: impl FnMut(usize, usize, bool) -> bool,
 ) -> Vec<bool> {
     let tris = &cliques.tris;
-    // For each edge, how many non-skipped triangles use it and the first two of them.
-    let mut users = vec![(0u32, u32::MAX, u32::MAX); cliques.edge_count];
+    // For each edge: how many non-skipped triangles use it (saturating at 3: only "two"
+    // matters), the XOR of their ids (seen from one of two, the other's id) and the XOR of
+    // the directions in which they traverse it unflipped (low to high id on their edges
+    // (a,b) and (b,c), high to low on (a,c)): 0 when two use it the same way round.
+    let mut users = vec![0u8; cliques.edge_count];
+    let mut ids = vec![0u32; cliques.edge_count];
+    let mut directions = vec![0u8; cliques.edge_count];
     for (t, edges) in cliques.edges.iter().enumerate() {
-        if skipped[t] {
-            continue;
-        }
-        for &e in edges {
-            let e = &mut users[e as usize];
-            match e.0 {
-                0 => e.1 = t as u32,
-                1 => e.2 = t as u32,
-                _ => {}
-            }
-            e.0 += 1;
-        }
-    }
-    // For each triangle: its vertices and, for each of its edges (a,b), (b,c), (a,c), the one
-    // other triangle across it, if exactly two share the edge. Side by side, so that reaching a
-    // triangle (in an order the cache cannot foresee) reads one place.
-    let mut nodes: Vec<([u32; 3], [u32; 3])> = tris.iter().map(|&t| (t, [u32::MAX; 3])).collect();
-    for (t, edges) in cliques.edges.iter().enumerate() {
-        if skipped[t] {
-            continue;
-        }
+        let keep = !skipped[t];
         for (slot, &e) in edges.iter().enumerate() {
-            let (count, first, second) = users[e as usize];
-            if count == 2 {
-                nodes[t].1[slot] = if first == t as u32 { second } else { first };
-            }
+            let e = e as usize;
+            users[e] = (users[e] + keep as u8).min(3);
+            ids[e] ^= t as u32 & (keep as u32).wrapping_neg();
+            directions[e] ^= (keep & (slot != 2)) as u8;
         }
     }
+    // For each triangle, across each of its edges (a,b), (b,c), (a,c): the one other
+    // triangle, if exactly two share the edge, and whether the two traverse it the same way
+    // round unflipped (bit `slot` of the second field). Side by side, so that reaching a
+    // triangle (in an order the cache cannot foresee) reads one place.
+    let nodes: Vec<([u32; 3], u8)> = cliques
+        .edges
+        .iter()
+        .enumerate()
+        .map(|(t, edges)| {
+            let mut same = 0;
+            let across = std::array::from_fn(|slot| {
+                let e = edges[slot] as usize;
+                same |= ((directions[e] == 0) as u8) << slot;
+                if users[e] == 2 && !skipped[t] {
+                    ids[e] ^ t as u32
+                } else {
+                    u32::MAX
+                }
+            });
+            (across, same)
+        })
+        .collect();
     let mut flipped = vec![false; tris.len()];
     let mut seen = skipped.to_vec();
     let mut queue = Vec::with_capacity(tris.len());
@@ -328,31 +329,26 @@ pub fn propagate_orientation(
         let outward = (b - a).cross(c - a).dot((a + b + c) / 3.0 - centre) >= 0.0;
         flipped[start] = decide(visit, start, !outward);
         visit += 1;
-        // Breadth-first: the queue is read from `next` on.
+        // Breadth-first: the queue, read from `next` on, holds each reached triangle with its
+        // orientation.
         queue.clear();
-        queue.push(start as u32);
+        queue.push((start as u32, flipped[start]));
         let mut next = 0;
-        while let Some(&t) = queue.get(next) {
+        while let Some(&(t, flip)) = queue.get(next) {
             next += 1;
-            let (tri, across) = nodes[t as usize];
-            let edges = [(tri[0], tri[1]), (tri[1], tri[2]), (tri[0], tri[2])];
-            for (slot, &(u, v)) in edges.iter().enumerate() {
-                let other = across[slot];
+            let (across, same) = nodes[t as usize];
+            for (slot, &other) in across.iter().enumerate() {
                 if other == u32::MAX || seen[other as usize] {
                     continue;
                 }
                 seen[other as usize] = true;
-                // Direction in which t, as oriented, traverses this edge.
-                let (from, to) = if traverses(oriented(tri, flipped[t as usize]), u, v) {
-                    (u, v)
-                } else {
-                    (v, u)
-                };
-                // The neighbour agrees when it traverses the edge the other way.
-                let predicted = traverses(nodes[other as usize].0, from, to);
-                flipped[other as usize] = decide(visit, other as usize, predicted);
+                // The neighbour agrees when it traverses the shared edge the other way round:
+                // flipped unlike t where the two traverse it alike unflipped, else like t.
+                let predicted = flip ^ (same >> slot & 1 == 1);
+                let chosen = decide(visit, other as usize, predicted);
+                flipped[other as usize] = chosen;
                 visit += 1;
-                queue.push(other);
+                queue.push((other, chosen));
             }
         }
     }
