@@ -80,10 +80,10 @@
 //! The last two rows cost 0.14 bits a vertex and bought decoding speed: a leaf's neighbours are
 //! read once a level instead of three times (bunny.ply at 12 bits: 71 → 50 ms with the other
 //! changes of the same commit; see BENCHMARKS.md). Its three bits take one range-coder step,
-//! which turned out no faster than three: `cargo bench --bench arith` measures 19 ns for a
-//! three-bit symbol, 6.6 ns for one bit. Reusing a leaf's neighbour moments from an earlier level instead of reading
-//! the neighbours every level was measured too and dropped: every other level 16.22, once only
-//! 17.20 (the neighbours' last level of precision matters).
+//! which is only a little faster than three: `cargo bench --bench arith` measures 14.7 ns for a
+//! three-bit symbol, 5.8 ns for one bit. Reusing a leaf's neighbour moments from an earlier
+//! level instead of reading the neighbours every level was measured too and dropped: every
+//! other level 16.22, once only 17.20 (the neighbours' last level of precision matters).
 //!
 //! Tried and not kept: the neighbours' reach (their distance in cell widths) for split and leaf
 //! (+0.02), the cluster's age beside the distance for split (+0.00), a single adaptation rate
