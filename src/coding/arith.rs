@@ -109,8 +109,8 @@ const TRIPLE_PRECISION: usize = 24;
 /// probability, each half by the second's, each quarter by the third's. One range-coder step
 /// instead of three, though only a little faster: two divisions are saved but the three splits
 /// are a chain of dependent multiplications (`cargo bench --bench arith`: 14.7 ns a symbol,
-/// 5.8 ns a single bit). The contexts are read before any of the three is adapted (where two decisions
-/// share a context, both see it as it was).
+/// 5.8 ns a single bit). The contexts are read before any of the three is adapted (where two
+/// decisions share a context, both see it as it was).
 #[derive(Clone, Copy, Debug)]
 struct Triple {
     p1: [u32; 3],
