@@ -29,11 +29,11 @@ fn throughput_of(c: &mut Criterion, codec: &str) {
                 grid: GridShape::Cubic,
             };
             let canonical = codecs::canonical_for(&mesh, &options).unwrap();
-            let bytes = emc.encode(&canonical, &options).unwrap().bytes;
+            let bytes = emc.encode(&canonical).unwrap().bytes;
             group.throughput(Throughput::Elements(canonical.vertex_count() as u64));
             let id = format!("{name}/{bits} levels");
             group.bench_function(BenchmarkId::new("encode", &id), |b| {
-                b.iter(|| emc.encode(&canonical, &options).unwrap())
+                b.iter(|| emc.encode(&canonical).unwrap())
             });
             group.bench_function(BenchmarkId::new("decode", &id), |b| {
                 b.iter(|| codecs::decode(&bytes, Stop::All).unwrap())

@@ -22,7 +22,7 @@ fn main() -> anyhow::Result<()> {
         let mesh = read_mesh(&resolve(&name)?)?;
         let canonical = codecs::canonical_for(&mesh, &options)?;
         let v = canonical.vertex_count() as f64;
-        let encoded = codec.encode(&canonical, &options)?;
+        let encoded = codec.encode(&canonical)?;
         // Best of ten full decodes, and each level's best (the last level's includes the
         // final faces).
         let mut seconds = f64::INFINITY;

@@ -36,13 +36,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 grid,
             };
             let canonical = codecs::canonical_for(&mesh, &options)?;
-            let encoded = emc.encode(&canonical, &options)?;
-            for (key, value) in &encoded.stats {
+            let encoded = emc.encode(&canonical)?;
+            for (key, value) in encoded.stats.iter() {
                 let Some(d) = key.strip_prefix("distance_") else {
                     continue;
                 };
                 let symbol = if d == "none" { 0 } else { d.parse::<usize>()? };
-                counts[symbol] += *value as u64;
+                counts[symbol] += value as u64;
             }
         }
         eprintln!("{name}: pooled");

@@ -25,7 +25,7 @@ fn main() {
             grid: GridShape::Cubic,
         };
         let canonical = codecs::canonical_for(&mesh, &options).unwrap();
-        let bytes = codec.encode(&canonical, &options).unwrap().bytes;
+        let bytes = codec.encode(&canonical).unwrap().bytes;
         let (mut ok, mut err, mut slowest) = (0, 0, 0f64);
         for i in 0..n {
             let mut b = bytes.clone();

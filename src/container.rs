@@ -1,15 +1,21 @@
-//! The stream container of DESIGN.md A3: a header, then levels, each prefixed by its length.
+//! The stream container (docs/FORMAT.md §2): a header, an index of independently decodable
+//! units, then the units' payloads.
 //!
 //! ```text
 //! magic "MshC"  format version (u8)  codec id (u8)
 //! params: varint length + codec-specific bytes
 //! grid: bits (u8), origin 3 × f64 LE, cell 3 × f64 LE
-//! vertices (varint)  triangles (varint)  levels (varint)      -- of the full mesh
-//! level*: varint byte length + payload
+//! vertices (varint)  triangles (varint)                        -- of the full mesh
+//! index: units N (varint), payload bytes P (varint),
+//!        N × { offset (varint), length (varint), parent (varint: 0 = none, k = unit i − k) }
+//! payload: P bytes, every byte in exactly one unit
 //! ```
-//! Levels carry their own lengths so that a prefix of the stream decodes to its last complete
-//! level without knowing how the codec's syntax ends, and so that a range coder's output can be
-//! flushed per level. Counts are checked against [`crate::limits`] before any use.
+//! A unit is what a decoder can take on its own once the units it depends on are decoded: a level
+//! for the layered codecs (each level's parent is the level before), a meta-node for a hierarchy
+//! fetched by parts. A reader holding the header and index can fetch any unit by its byte range;
+//! a prefix of the stream decodes to the units wholly inside it. The index is checked whole —
+//! counts against [`crate::limits`] and the bytes that hold them, ranges inside the payload,
+//! no overlaps, no stray bytes — before anything is allocated for what it claims.
 
 use crate::coding::varint;
 use crate::error::{Error, Result};
@@ -19,13 +25,16 @@ use std::io::Read as _;
 
 /// First bytes of every stream.
 pub const MAGIC: [u8; 4] = *b"MshC";
-/// Version of the container syntax; bumped whenever a stream of the old syntax would not decode.
-pub const FORMAT_VERSION: u8 = 1;
+/// Version of the stream syntax: bumped on every change to the bytes any codec writes
+/// (docs/FORMAT.md, "History").
+pub const FORMAT_VERSION: u8 = 2;
+/// The fewest bytes an index entry takes (three one-byte varints).
+const MIN_ENTRY_BYTES: u64 = 3;
 
-/// What a stream says about itself before its levels.
+/// What a stream says about itself before its index.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Header {
-    /// Which codec wrote the levels.
+    /// Which codec wrote the units.
     pub codec_id: u8,
     /// Codec-specific parameters.
     pub params: Vec<u8>,
@@ -35,8 +44,172 @@ pub struct Header {
     pub vertices: u64,
     /// Triangles of the full mesh.
     pub triangles: u64,
-    /// Levels in the stream.
-    pub levels: u64,
+}
+
+/// Where one unit's payload lies, and what it needs decoded first.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct UnitEntry {
+    /// Offset of the unit's first byte from the payload's start.
+    pub offset: u64,
+    /// Bytes of the unit.
+    pub length: u64,
+    /// The unit that must be decoded before this one (always an earlier unit).
+    pub parent: Option<usize>,
+}
+
+impl UnitEntry {
+    /// One past the unit's last byte, from the payload's start.
+    pub fn end(&self) -> u64 {
+        self.offset + self.length
+    }
+}
+
+/// The index of a stream's units.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Index {
+    /// Units in decoding order.
+    pub units: Vec<UnitEntry>,
+    /// Bytes of the payload (the sum of the units' lengths).
+    pub payload_bytes: u64,
+}
+
+impl Index {
+    /// The index of units laid out back to back in order, each depending on the one before —
+    /// the levels of a layered codec.
+    pub fn layered(lengths: &[u64]) -> Index {
+        let mut offset = 0;
+        let units = lengths
+            .iter()
+            .enumerate()
+            .map(|(i, &length)| {
+                let unit = UnitEntry {
+                    offset,
+                    length,
+                    parent: i.checked_sub(1),
+                };
+                offset += length;
+                unit
+            })
+            .collect();
+        Index {
+            units,
+            payload_bytes: offset,
+        }
+    }
+
+    /// True when the units are levels: back to back in order, each depending on the one before.
+    pub fn is_layered(&self) -> bool {
+        *self == Index::layered(&self.units.iter().map(|u| u.length).collect::<Vec<_>>())
+    }
+
+    /// Number of units.
+    pub fn len(&self) -> usize {
+        self.units.len()
+    }
+
+    /// True when the index lists no unit (no stream has such an index).
+    pub fn is_empty(&self) -> bool {
+        self.units.is_empty()
+    }
+
+    fn write(&self, out: &mut Vec<u8>) {
+        varint::put(out, self.units.len() as u64);
+        varint::put(out, self.payload_bytes);
+        for (i, unit) in self.units.iter().enumerate() {
+            varint::put(out, unit.offset);
+            varint::put(out, unit.length);
+            varint::put(out, unit.parent.map_or(0, |p| (i - p) as u64));
+        }
+    }
+
+    /// Reads and checks an index from `bytes` at `pos`.
+    fn read(bytes: &[u8], pos: &mut usize) -> Result<Index> {
+        let units = read_count(bytes, pos, "units", limits::MAX_UNITS)?;
+        let payload_bytes = read_count(bytes, pos, "payload bytes", u64::MAX >> 1)?;
+        if units == 0 {
+            return Err(Error::malformed(0, *pos, "the index lists no unit"));
+        }
+        // Nothing is allocated for the entries before the bytes that must hold them are there.
+        if ((bytes.len() - *pos) as u64) < units * MIN_ENTRY_BYTES {
+            return Err(Error::Truncated("the stream ends inside its index".into()));
+        }
+        let mut entries = Vec::with_capacity(units as usize);
+        for i in 0..units as usize {
+            let at = *pos;
+            // Bounded so that their sum cannot overflow; checked against the payload below.
+            let offset = read_count(bytes, pos, "unit offset", u64::MAX >> 2)?;
+            let length = read_count(bytes, pos, "unit length", u64::MAX >> 2)?;
+            let back = read_count(bytes, pos, "parent distance", i as u64)?;
+            if offset + length > payload_bytes {
+                return Err(Error::malformed(
+                    0,
+                    at,
+                    format!(
+                        "index: unit {i} (bytes {offset}..{}) runs past the {payload_bytes} payload bytes",
+                        offset + length
+                    ),
+                ));
+            }
+            entries.push(UnitEntry {
+                offset,
+                length,
+                parent: (back > 0).then(|| i - back as usize),
+            });
+        }
+        let mut by_offset: Vec<usize> = (0..entries.len()).collect();
+        by_offset.sort_by_key(|&i| (entries[i].offset, entries[i].length));
+        for pair in by_offset.windows(2) {
+            let (a, b) = (entries[pair[0]], entries[pair[1]]);
+            if b.offset < a.end() {
+                return Err(Error::malformed(
+                    0,
+                    *pos,
+                    format!(
+                        "index: units {} (bytes {}..{}) and {} (bytes {}..{}) overlap",
+                        pair[0],
+                        a.offset,
+                        a.end(),
+                        pair[1],
+                        b.offset,
+                        b.end()
+                    ),
+                ));
+            }
+        }
+        let covered: u64 = entries.iter().map(|u| u.length).sum();
+        if covered != payload_bytes {
+            return Err(Error::malformed(
+                0,
+                *pos,
+                format!(
+                    "index: units cover {covered} of the {payload_bytes} payload bytes it declares"
+                ),
+            ));
+        }
+        Ok(Index {
+            units: entries,
+            payload_bytes,
+        })
+    }
+}
+
+/// A varint count at `pos`, no larger than `limit`.
+fn read_count(bytes: &[u8], pos: &mut usize, what: &str, limit: u64) -> Result<u64> {
+    let at = *pos;
+    let value = varint::get(bytes, pos).map_err(|f| match f {
+        varint::VarintFault::Truncated => {
+            Error::Truncated("the stream ends inside its header".into())
+        }
+        varint::VarintFault::Overflow => {
+            Error::malformed(0, at, format!("{what} overflows 64 bits"))
+        }
+    })?;
+    if value > limit {
+        return Err(Error::Limit(format!(
+            "stream declares {value} {what} (at most {limit})"
+        )));
+    }
+    Ok(value)
 }
 
 impl Header {
@@ -53,10 +226,9 @@ impl Header {
         }
         varint::put(out, self.vertices);
         varint::put(out, self.triangles);
-        varint::put(out, self.levels);
     }
 
-    /// Reads a header from the start of `bytes`; returns it and the offset of the first level.
+    /// Reads a header from the start of `bytes`; returns it and the offset of the index.
     pub fn read(bytes: &[u8]) -> Result<(Header, usize)> {
         let cut = || Error::Truncated("the stream ends inside its header".into());
         let bad = |byte: usize, what: &str| Error::malformed(0, byte, what);
@@ -69,27 +241,17 @@ impl Header {
         let version = *bytes.get(4).ok_or_else(cut)?;
         if version != FORMAT_VERSION {
             return Err(Error::Unsupported(format!(
-                "stream format version {version} (this build reads version {FORMAT_VERSION})"
+                "stream format version {version} (this build reads version {FORMAT_VERSION} only)"
             )));
         }
         let codec_id = *bytes.get(5).ok_or_else(cut)?;
         let mut pos = 6;
-        let count = |pos: &mut usize, what: &str, limit: u64| -> Result<u64> {
-            let at = *pos;
-            let value = varint::get(bytes, pos).map_err(|f| match f {
-                varint::VarintFault::Truncated => cut(),
-                varint::VarintFault::Overflow => bad(at, &format!("{what} overflows 64 bits")),
-            })?;
-            if value > limit {
-                return Err(Error::Limit(format!(
-                    "stream declares {value} {what} (at most {limit})"
-                )));
-            }
-            Ok(value)
-        };
-        let param_len = count(&mut pos, "parameter bytes", limits::MAX_PARAM_BYTES)? as usize;
-        let params = bytes.get(pos..pos + param_len).ok_or_else(cut)?.to_vec();
-        pos += param_len;
+        let param_len = read_count(bytes, &mut pos, "parameter bytes", limits::MAX_PARAM_BYTES)?;
+        let params = bytes
+            .get(pos..pos + param_len as usize)
+            .ok_or_else(cut)?
+            .to_vec();
+        pos += param_len as usize;
         let bits = *bytes.get(pos).ok_or_else(cut)?;
         if bits == 0 || bits > crate::mesh::quantize::MAX_QUANT_BITS {
             return Err(bad(pos, &format!("quantization of {bits} bits")));
@@ -117,16 +279,13 @@ impl Header {
                 "grid origin or cell size is not a finite positive number",
             ));
         }
-        let vertices = count(&mut pos, "vertices", limits::MAX_VERTICES)?;
-        let triangles = count(&mut pos, "triangles", limits::MAX_TRIANGLES)?;
-        let levels = count(&mut pos, "levels", limits::MAX_LEVELS)?;
-        if vertices == 0 || triangles == 0 || levels == 0 {
+        let vertices = read_count(bytes, &mut pos, "vertices", limits::MAX_VERTICES)?;
+        let triangles = read_count(bytes, &mut pos, "triangles", limits::MAX_TRIANGLES)?;
+        if vertices == 0 || triangles == 0 {
             // No encoder writes an empty mesh (empty input is refused before encoding).
             return Err(bad(
                 pos,
-                &format!(
-                    "header declares {vertices} vertices, {triangles} triangles, {levels} levels"
-                ),
+                &format!("header declares {vertices} vertices and {triangles} triangles"),
             ));
         }
         let header = Header {
@@ -135,46 +294,105 @@ impl Header {
             grid,
             vertices,
             triangles,
-            levels,
         };
         Ok((header, pos))
     }
 }
 
-/// Builds a stream level by level.
+/// Reads the header and index at the start of `bytes`; returns them and the payload's offset.
+pub fn read_header_and_index(bytes: &[u8]) -> Result<(Header, Index, usize)> {
+    let (header, mut pos) = Header::read(bytes)?;
+    let index = Index::read(bytes, &mut pos)?;
+    Ok((header, index, pos))
+}
+
+/// What a layered encoder reports about one level as it writes it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LevelCost {
+    /// Connectivity bits booked in this level alone.
+    pub connectivity_bits: u64,
+    /// Geometry bits booked in this level alone.
+    pub geometry_bits: u64,
+    /// Vertices of the mesh after this level.
+    pub vertices: usize,
+    /// Triangles of the mesh after this level.
+    pub triangles: usize,
+}
+
+/// One level as the encoder wrote it, with the cost of the stream up to its end.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LevelRecord {
+    /// Offset in the stream where this level ends (so bits so far = 8 × end_byte).
+    pub end_byte: usize,
+    /// Connectivity bits booked in this level and all before it.
+    pub connectivity_bits: u64,
+    /// Geometry bits booked in this level and all before it.
+    pub geometry_bits: u64,
+    /// Vertices of the mesh after this level.
+    pub vertices: usize,
+    /// Triangles of the mesh after this level.
+    pub triangles: usize,
+}
+
+/// Builds a layered stream level by level: the header and index are written when it finishes.
 pub struct StreamWriter {
-    bytes: Vec<u8>,
-    level_ends: Vec<usize>,
+    header: Header,
+    payload: Vec<u8>,
+    lengths: Vec<u64>,
+    costs: Vec<LevelCost>,
 }
 
 impl StreamWriter {
-    /// Starts a stream with `header` (whose `levels` must equal the levels pushed).
+    /// Starts a stream with `header`.
     pub fn new(header: &Header) -> Self {
-        let mut bytes = Vec::new();
-        header.write(&mut bytes);
         StreamWriter {
-            bytes,
-            level_ends: Vec::new(),
+            header: header.clone(),
+            payload: Vec::new(),
+            lengths: Vec::new(),
+            costs: Vec::new(),
         }
     }
 
-    /// Appends one level's payload.
-    pub fn push_level(&mut self, payload: &[u8]) {
-        varint::put(&mut self.bytes, payload.len() as u64);
-        self.bytes.extend_from_slice(payload);
-        self.level_ends.push(self.bytes.len());
+    /// Appends one level's payload and what it cost.
+    pub fn push_level(&mut self, payload: &[u8], cost: LevelCost) {
+        self.payload.extend_from_slice(payload);
+        self.lengths.push(payload.len() as u64);
+        self.costs.push(cost);
     }
 
-    /// The stream and, for each level, the byte offset where it ends.
-    pub fn finish(self) -> (Vec<u8>, Vec<usize>) {
-        (self.bytes, self.level_ends)
+    /// The stream and, for each level, where it ends and what the stream cost up to there.
+    pub fn finish(self) -> (Vec<u8>, Vec<LevelRecord>) {
+        let mut bytes = Vec::new();
+        self.header.write(&mut bytes);
+        Index::layered(&self.lengths).write(&mut bytes);
+        let mut end = bytes.len();
+        bytes.extend_from_slice(&self.payload);
+        let (mut connectivity, mut geometry) = (0, 0);
+        let records = self
+            .lengths
+            .iter()
+            .zip(&self.costs)
+            .map(|(&length, cost)| {
+                end += length as usize;
+                connectivity += cost.connectivity_bits;
+                geometry += cost.geometry_bits;
+                LevelRecord {
+                    end_byte: end,
+                    connectivity_bits: connectivity,
+                    geometry_bits: geometry,
+                    vertices: cost.vertices,
+                    triangles: cost.triangles,
+                }
+            })
+            .collect();
+        (bytes, records)
     }
 }
 
-/// One level's payload as found in a stream.
+/// One unit's payload as found in a stream.
 #[derive(Clone, Copy, Debug)]
 pub struct LevelPayload<'a> {
-    /// Level number, from 0.
+    /// Unit number, from 0.
     pub index: usize,
     /// Offset of the payload's first byte in the stream (for error messages).
     pub start: usize,
@@ -182,29 +400,57 @@ pub struct LevelPayload<'a> {
     pub bytes: &'a [u8],
 }
 
-/// Reads a stream's levels in order.
+/// Reads a stream's units: in order as levels, or any one by its index entry.
 #[derive(Clone, Debug)]
 pub struct StreamReader<'a> {
     header: Header,
+    index: Index,
     bytes: &'a [u8],
-    pos: usize,
+    payload_start: usize,
     next_level: usize,
-    truncated: bool,
-    partial_start: Option<usize>,
 }
 
 impl<'a> StreamReader<'a> {
-    /// Parses the header of `bytes`.
+    /// Parses the header and index of `bytes` (a whole stream or a prefix).
     pub fn open(bytes: &'a [u8]) -> Result<Self> {
-        let (header, pos) = Header::read(bytes)?;
+        let (header, index, payload_start) = read_header_and_index(bytes)?;
+        let present = (bytes.len() - payload_start) as u64;
+        if present > index.payload_bytes {
+            return Err(Error::malformed(
+                index.len(),
+                payload_start + index.payload_bytes as usize,
+                format!(
+                    "{} bytes after the last unit",
+                    present - index.payload_bytes
+                ),
+            ));
+        }
         Ok(StreamReader {
             header,
+            index,
             bytes,
-            pos,
+            payload_start,
             next_level: 0,
-            truncated: false,
-            partial_start: None,
         })
+    }
+
+    /// Opens a stream whose units must be levels (back to back, each after the one before).
+    pub fn open_layered(bytes: &'a [u8]) -> Result<Self> {
+        let reader = StreamReader::open(bytes)?;
+        reader.require_layered()?;
+        Ok(reader)
+    }
+
+    /// Refuses a stream whose units are not levels.
+    pub fn require_layered(&self) -> Result<()> {
+        if !self.index.is_layered() {
+            return Err(Error::malformed(
+                0,
+                self.payload_start,
+                "index: this codec's units are levels, laid out in order, each after the one before",
+            ));
+        }
+        Ok(())
     }
 
     /// The stream's header.
@@ -212,129 +458,59 @@ impl<'a> StreamReader<'a> {
         &self.header
     }
 
+    /// The stream's index.
+    pub fn index(&self) -> &Index {
+        &self.index
+    }
+
+    /// Offset of the payload's first byte in the stream.
+    pub fn payload_start(&self) -> usize {
+        self.payload_start
+    }
+
     /// The whole stream (or prefix) being read.
     pub fn bytes(&self) -> &'a [u8] {
         self.bytes
     }
 
-    /// The next complete level, or `None` when the stream has no more (all declared levels read,
-    /// or the bytes end inside the next one: then [`StreamReader::truncated`] is true).
-    pub fn next_level(&mut self) -> Result<Option<LevelPayload<'a>>> {
-        if self.next_level as u64 >= self.header.levels {
-            if self.pos < self.bytes.len() {
-                return Err(Error::malformed(
-                    self.next_level,
-                    self.pos,
-                    format!("{} bytes after the last level", self.bytes.len() - self.pos),
-                ));
-            }
-            return Ok(None);
-        }
-        let mut pos = self.pos;
-        let len = match varint::get(self.bytes, &mut pos) {
-            Ok(len) => len,
-            Err(varint::VarintFault::Truncated) => {
-                self.truncated = true;
-                return Ok(None);
-            }
-            Err(varint::VarintFault::Overflow) => {
-                return Err(Error::malformed(
-                    self.next_level,
-                    self.pos,
-                    "level length overflows",
-                ))
-            }
-        };
-        let available = (self.bytes.len() - pos) as u64;
-        if len > available {
-            self.truncated = true;
-            self.partial_start = Some(pos);
-            return Ok(None);
-        }
-        let payload = LevelPayload {
-            index: self.next_level,
-            start: pos,
-            bytes: &self.bytes[pos..pos + len as usize],
-        };
-        self.pos = pos + len as usize;
-        self.next_level += 1;
-        Ok(Some(payload))
-    }
-
-    /// True when the bytes ended inside a level.
-    pub fn truncated(&self) -> bool {
-        self.truncated
-    }
-
-    /// The bytes present of the level the stream was cut in (after its complete length
-    /// prefix), for codecs that can decode part of a level.
-    pub fn partial_level(&self) -> Option<LevelPayload<'a>> {
-        self.partial_start.map(|start| LevelPayload {
-            index: self.next_level,
+    /// Unit `i`, when all its bytes are present.
+    pub fn unit(&self, i: usize) -> Option<LevelPayload<'a>> {
+        let entry = self.index.units.get(i)?;
+        let start = self.payload_start + entry.offset as usize;
+        let end = self.payload_start + entry.end() as usize;
+        self.bytes.get(start..end).map(|bytes| LevelPayload {
+            index: i,
             start,
-            bytes: &self.bytes[start..],
+            bytes,
         })
     }
-}
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn header() -> Header {
-        Header {
-            codec_id: 7,
-            params: vec![1, 2, 3],
-            grid: Grid {
-                origin: [0.5, -1.0, 2.0],
-                cell: [0.25, 0.25, 0.125],
-                bits: 12,
-            },
-            vertices: 1000,
-            triangles: 2000,
-            levels: 2,
+    /// The next complete level, or `None` when the stream has no more (all levels read, or the
+    /// bytes end inside the next one: then [`StreamReader::truncated`] is true).
+    pub fn next_level(&mut self) -> Result<Option<LevelPayload<'a>>> {
+        let unit = self.unit(self.next_level);
+        if unit.is_some() {
+            self.next_level += 1;
         }
+        Ok(unit)
     }
 
-    #[test]
-    fn header_and_levels_round_trip_and_every_prefix_reads_cleanly() {
-        let mut writer = StreamWriter::new(&header());
-        writer.push_level(&[9; 5]);
-        writer.push_level(&[8; 300]);
-        let (bytes, ends) = writer.finish();
-        let mut reader = StreamReader::open(&bytes).unwrap();
-        assert_eq!(reader.header(), &header());
-        assert_eq!(reader.next_level().unwrap().unwrap().bytes, &[9; 5]);
-        assert_eq!(reader.next_level().unwrap().unwrap().bytes.len(), 300);
-        assert!(reader.next_level().unwrap().is_none());
-        assert_eq!(ends.last(), Some(&bytes.len()));
-        for cut in 0..bytes.len() {
-            match StreamReader::open(&bytes[..cut]) {
-                Err(Error::Truncated(_)) => {}
-                Err(e) => panic!("cut {cut}: {e}"),
-                Ok(mut r) => {
-                    let mut complete = 0;
-                    while r.next_level().unwrap().is_some() {
-                        complete += 1;
-                    }
-                    let expected = ends.iter().filter(|&&e| e <= cut).count();
-                    assert_eq!(complete, expected, "cut {cut}");
-                }
-            }
-        }
+    /// True when the bytes end before the payload does.
+    pub fn truncated(&self) -> bool {
+        ((self.bytes.len() - self.payload_start) as u64) < self.index.payload_bytes
     }
 
-    #[test]
-    fn foreign_and_oversized_headers_are_refused() {
-        assert!(matches!(
-            Header::read(b"PK\x03\x04 zip file"),
-            Err(Error::Malformed { .. })
-        ));
-        let mut big = header();
-        big.vertices = 1 << 31;
-        let mut bytes = Vec::new();
-        big.write(&mut bytes);
-        assert!(matches!(Header::read(&bytes), Err(Error::Limit(_))));
+    /// The bytes present of the next level when the stream was cut inside it, for codecs that
+    /// can decode part of a level.
+    pub fn partial_level(&self) -> Option<LevelPayload<'a>> {
+        let entry = self.index.units.get(self.next_level)?;
+        let start = self.payload_start + entry.offset as usize;
+        let bytes = self.bytes.get(start..)?;
+        (bytes.len() < entry.length as usize).then_some(LevelPayload {
+            index: self.next_level,
+            start,
+            bytes,
+        })
     }
 }
 
@@ -371,29 +547,39 @@ impl LevelSource for StreamReader<'_> {
     }
 }
 
-/// Reads a stream's levels from an input stream (a file, a socket), one level at a time, so a
-/// decoder can start before the rest has arrived.
+/// Reads a layered stream's levels from an input stream (a file, a socket), one level at a time,
+/// so a decoder can start before the rest has arrived.
 pub struct ReadLevels<R: std::io::Read> {
     reader: R,
     header: Header,
+    index: Index,
     offset: usize,
     next_level: usize,
 }
 
 impl<R: std::io::Read> ReadLevels<R> {
-    /// Reads the header (and nothing beyond it) from `reader`.
+    /// Reads the header and index (and nothing beyond them) from `reader`.
     pub fn open(mut reader: R) -> Result<Self> {
         // The header's length is only known once it parses: read a byte at a time.
         let mut bytes = Vec::new();
         loop {
-            match Header::read(&bytes) {
-                Ok((header, _)) => {
-                    return Ok(ReadLevels {
-                        offset: bytes.len(),
+            match read_header_and_index(&bytes) {
+                Ok((header, index, offset)) => {
+                    let levels = ReadLevels {
+                        offset,
                         reader,
                         header,
+                        index,
                         next_level: 0,
-                    })
+                    };
+                    if !levels.index.is_layered() {
+                        return Err(Error::malformed(
+                            0,
+                            offset,
+                            "index: the units are not levels in order",
+                        ));
+                    }
+                    return Ok(levels);
                 }
                 Err(Error::Truncated(what)) => {
                     let mut byte = [0u8];
@@ -414,34 +600,15 @@ impl<R: std::io::Read> LevelSource for ReadLevels<R> {
     }
 
     fn next_owned_level(&mut self) -> Result<Option<OwnedLevel>> {
-        if self.next_level as u64 >= self.header.levels {
+        let Some(entry) = self.index.units.get(self.next_level) else {
             return Ok(None);
-        }
-        let mut length_bytes = Vec::new();
-        let len = loop {
-            let mut byte = [0u8];
-            if self.reader.read(&mut byte)? == 0 {
-                return Ok(None);
-            }
-            length_bytes.push(byte[0]);
-            let mut pos = 0;
-            match varint::get(&length_bytes, &mut pos) {
-                Ok(len) => break len,
-                Err(varint::VarintFault::Truncated) => continue,
-                Err(varint::VarintFault::Overflow) => {
-                    return Err(Error::malformed(
-                        self.next_level,
-                        self.offset,
-                        "level length overflows",
-                    ))
-                }
-            }
         };
-        self.offset += length_bytes.len();
-        // Read what arrives rather than allocating what the length claims.
+        // Read what arrives rather than allocating what the index claims.
         let mut bytes = Vec::new();
-        (&mut self.reader).take(len).read_to_end(&mut bytes)?;
-        if (bytes.len() as u64) < len {
+        (&mut self.reader)
+            .take(entry.length)
+            .read_to_end(&mut bytes)?;
+        if (bytes.len() as u64) < entry.length {
             return Ok(None);
         }
         let level = OwnedLevel {
@@ -449,8 +616,165 @@ impl<R: std::io::Read> LevelSource for ReadLevels<R> {
             start: self.offset,
             bytes,
         };
-        self.offset += len as usize;
+        self.offset += entry.length as usize;
         self.next_level += 1;
         Ok(Some(level))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header() -> Header {
+        Header {
+            codec_id: 7,
+            params: vec![1, 2, 3],
+            grid: Grid {
+                origin: [0.5, -1.0, 2.0],
+                cell: [0.25, 0.25, 0.125],
+                bits: 12,
+            },
+            vertices: 1000,
+            triangles: 2000,
+        }
+    }
+
+    fn two_levels() -> (Vec<u8>, Vec<LevelRecord>) {
+        let mut writer = StreamWriter::new(&header());
+        writer.push_level(&[9; 5], LevelCost::default());
+        writer.push_level(&[8; 300], LevelCost::default());
+        writer.finish()
+    }
+
+    /// A stream with `header()` and the given index over `payload`.
+    fn with_index(index: &Index, payload: &[u8]) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        header().write(&mut bytes);
+        index.write(&mut bytes);
+        bytes.extend_from_slice(payload);
+        bytes
+    }
+
+    #[test]
+    fn header_and_levels_round_trip_and_every_prefix_reads_cleanly() {
+        let (bytes, records) = two_levels();
+        let mut reader = StreamReader::open_layered(&bytes).unwrap();
+        assert_eq!(reader.header(), &header());
+        assert_eq!(reader.next_level().unwrap().unwrap().bytes, &[9; 5]);
+        assert_eq!(reader.next_level().unwrap().unwrap().bytes.len(), 300);
+        assert!(reader.next_level().unwrap().is_none());
+        assert_eq!(records.last().map(|r| r.end_byte), Some(bytes.len()));
+        for cut in 0..bytes.len() {
+            match StreamReader::open(&bytes[..cut]) {
+                Err(Error::Truncated(_)) => {}
+                Err(e) => panic!("cut {cut}: {e}"),
+                Ok(mut r) => {
+                    let mut complete = 0;
+                    while r.next_level().unwrap().is_some() {
+                        complete += 1;
+                    }
+                    let expected = records.iter().filter(|r| r.end_byte <= cut).count();
+                    assert_eq!(complete, expected, "cut {cut}");
+                    assert!(r.truncated());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn any_unit_is_found_from_the_header_and_index_alone() {
+        let (bytes, records) = two_levels();
+        let (_, index, payload_start) = read_header_and_index(&bytes).unwrap();
+        let unit = index.units[1];
+        let start = payload_start + unit.offset as usize;
+        assert_eq!(start, records[0].end_byte);
+        assert_eq!(&bytes[start..start + unit.length as usize], &[8; 300]);
+        assert_eq!(unit.parent, Some(0));
+    }
+
+    #[test]
+    fn foreign_and_oversized_headers_are_refused() {
+        assert!(matches!(
+            Header::read(b"PK\x03\x04 zip file"),
+            Err(Error::Malformed { .. })
+        ));
+        let mut big = header();
+        big.vertices = 1 << 31;
+        let mut bytes = Vec::new();
+        big.write(&mut bytes);
+        assert!(matches!(Header::read(&bytes), Err(Error::Limit(_))));
+    }
+
+    #[test]
+    fn unknown_versions_are_refused() {
+        let (mut bytes, _) = two_levels();
+        bytes[4] = 1;
+        let e = StreamReader::open(&bytes).unwrap_err();
+        assert!(e.to_string().contains("format version 1"), "{e}");
+    }
+
+    #[test]
+    fn lying_indexes_are_refused() {
+        let entry = |offset, length, parent| UnitEntry {
+            offset,
+            length,
+            parent,
+        };
+        let past = Index {
+            units: vec![entry(0, 4, None), entry(4, 10, Some(0))],
+            payload_bytes: 8,
+        };
+        let e = StreamReader::open(&with_index(&past, &[0; 8])).unwrap_err();
+        assert!(e.to_string().contains("runs past"), "{e}");
+        let overlapping = Index {
+            units: vec![entry(0, 6, None), entry(4, 2, Some(0))],
+            payload_bytes: 8,
+        };
+        let e = StreamReader::open(&with_index(&overlapping, &[0; 8])).unwrap_err();
+        assert!(e.to_string().contains("overlap"), "{e}");
+        let gap = Index {
+            units: vec![entry(0, 2, None), entry(4, 2, Some(0))],
+            payload_bytes: 8,
+        };
+        let e = StreamReader::open(&with_index(&gap, &[0; 8])).unwrap_err();
+        assert!(e.to_string().contains("cover 4 of the 8"), "{e}");
+        // A count of units the bytes cannot hold is refused before any entry is read.
+        let mut huge = Vec::new();
+        header().write(&mut huge);
+        varint::put(&mut huge, limits::MAX_UNITS);
+        varint::put(&mut huge, 8);
+        assert!(matches!(
+            StreamReader::open(&huge),
+            Err(Error::Truncated(_))
+        ));
+        // Units out of order are a valid index, but not the levels of a layered codec.
+        let swapped = Index {
+            units: vec![entry(4, 4, None), entry(0, 4, Some(0))],
+            payload_bytes: 8,
+        };
+        let bytes = with_index(&swapped, &[0; 8]);
+        assert!(StreamReader::open(&bytes).is_ok());
+        assert!(StreamReader::open_layered(&bytes).is_err());
+    }
+
+    #[test]
+    fn bytes_after_the_payload_are_refused() {
+        let (mut bytes, _) = two_levels();
+        bytes.push(0);
+        let e = StreamReader::open(&bytes).unwrap_err();
+        assert!(e.to_string().contains("after the last unit"), "{e}");
+    }
+
+    #[test]
+    fn levels_read_from_an_input_stream_match() {
+        let (bytes, _) = two_levels();
+        let mut source = ReadLevels::open(&bytes[..]).unwrap();
+        assert_eq!(
+            source.next_owned_level().unwrap().unwrap().bytes,
+            vec![9; 5]
+        );
+        assert_eq!(source.next_owned_level().unwrap().unwrap().bytes.len(), 300);
+        assert!(source.next_owned_level().unwrap().is_none());
     }
 }

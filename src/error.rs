@@ -2,7 +2,7 @@
 //!
 //! Every fault a user can provoke — a bad mesh file, a corrupt or truncated stream, a mesh a codec
 //! cannot take, a count past a limit — becomes one of these variants; nothing panics on input.
-//! Binaries print it on one line, prefixed with the file it concerns (DESIGN.md A6).
+//! Binaries print it on one line, prefixed with the file it concerns (docs/CONTRACT.md §7).
 
 use std::fmt;
 
@@ -83,35 +83,3 @@ impl Error {
 
 /// Result with the crate's error.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
-
-/// Ends a binary: exit status 0, or 1 with the error on one line of stderr (DESIGN.md A6),
-/// whatever line breaks the error's text holds.
-pub fn exit_code(outcome: anyhow::Result<()>) -> std::process::ExitCode {
-    match outcome {
-        Ok(()) => std::process::ExitCode::SUCCESS,
-        Err(e) => {
-            let message = format!("{e:#}").replace(['\n', '\t'], " ");
-            eprintln!("error: {message}");
-            std::process::ExitCode::FAILURE
-        }
-    }
-}
-
-/// Writes `text` to standard output for a binary. A reader that has gone away (`meshcodec info
-/// s.mc | head -1`) is not an error: the rest is dropped, where `println!` would panic.
-pub fn write_stdout(text: &str) -> std::io::Result<()> {
-    use std::io::Write as _;
-    match std::io::stdout().lock().write_all(text.as_bytes()) {
-        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
-        other => other,
-    }
-}
-
-/// `println!` for the binaries, through [`write_stdout`]; use inside a function returning a
-/// `Result` whose error takes an `std::io::Error`.
-#[macro_export]
-macro_rules! outln {
-    ($($arg:tt)*) => {
-        $crate::error::write_stdout(&format!("{}\n", format_args!($($arg)*)))?
-    };
-}

@@ -9,7 +9,10 @@
 //! | `raw` | the uncompressed indexed face set, 3·Q bits a vertex | the baseline row of every table |
 //!
 //! Layers (see ARCHITECTURE.md): [`mesh`] knows no bits, [`coding`] knows no meshes, [`codecs`]
-//! joins them through the stream [`container`]; [`metrics`] and [`harness`] measure.
+//! joins them through the stream [`container`]. With the default `lab` feature, `metrics`,
+//! `harness`, `plot`, `tables` and the binaries measure; without it
+//! (`default-features = false`) the crate is the codec core alone. The contract the codecs keep
+//! is docs/CONTRACT.md; the bytes they write are docs/FORMAT.md.
 //!
 //! ```
 //! use meshcodec::codecs::{self, Stop};
@@ -17,9 +20,8 @@
 //!
 //! let mesh = generate::torus(1.0, 0.4, 24, 12);
 //! let codec = codecs::by_name("raw")?;
-//! let options = codec.default_options();
-//! let canonical = codecs::canonical_for(&mesh, &options)?;
-//! let encoded = codec.encode(&canonical, &options)?;
+//! let canonical = codecs::canonical_for(&mesh, &codec.default_options())?;
+//! let encoded = codec.encode(&canonical)?;
 //! let (decoded, _levels) = codecs::decode(&encoded.bytes, Stop::All)?;
 //! assert_eq!(canonical.check_lossless(&decoded.mesh), Ok(()));
 //! # Ok::<(), meshcodec::Error>(())
@@ -29,13 +31,23 @@ pub mod codecs;
 pub mod coding;
 pub mod container;
 pub mod error;
-pub mod harness;
 pub mod hierarchy;
 pub mod limits;
 pub mod mesh;
+
+#[cfg(feature = "lab")]
+pub mod cli;
+#[cfg(feature = "lab")]
+pub mod harness;
+#[cfg(feature = "lab")]
 pub mod metrics;
+#[cfg(feature = "lab")]
 pub mod plot;
+#[cfg(feature = "lab")]
 pub mod render;
+#[cfg(feature = "lab")]
+pub mod results;
+#[cfg(feature = "lab")]
 pub mod tables;
 
 pub use error::{Error, Result};

@@ -5,8 +5,8 @@
 pub const MAX_VERTICES: u64 = 1 << 28;
 /// Most triangles a stream may declare.
 pub const MAX_TRIANGLES: u64 = 1 << 29;
-/// Most levels a stream may declare.
-pub const MAX_LEVELS: u64 = 1 << 16;
+/// Most units (levels, meta-nodes) a stream's index may list.
+pub const MAX_UNITS: u64 = 1 << 20;
 /// Most bytes of codec parameters in a header.
 pub const MAX_PARAM_BYTES: u64 = 1 << 12;
 

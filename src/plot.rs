@@ -6,7 +6,7 @@
 //! which keeps one drawing path for both kinds of chart.
 
 use crate::error::{Error, Result};
-use crate::harness::{LevelRow, RunResult};
+use crate::results::{LevelRow, RunResult};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};

@@ -2,12 +2,13 @@
 //! papers' own figures. Nothing here encodes: tables read `RunResult`s, and the rendered figure
 //! decodes the streams that the experiments kept.
 
+use crate::codecs::stats::{PmField, Stat};
 use crate::codecs::{self, Stop};
 use crate::error::{Error, Result};
-use crate::harness::{read_result, RunResult};
 use crate::mesh::io::{read_mesh, write_atomically};
 use crate::plot;
 use crate::render::{render, View};
+use crate::results::{read_result, RunResult};
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -80,8 +81,12 @@ const EMC_TABLE1_MESHES: [(&str, &str); 3] = [
 pub const EMC_TABLE1_COMMAND: &str =
     "cargo run --release --bin experiment -- run experiments/emc-table1.toml && cargo run --release --bin experiment -- tables";
 
-fn stat(result: &RunResult, key: &str) -> f64 {
-    result.codec_stats.get(key).copied().unwrap_or(0.0)
+/// A statistic a table reads; one the result lacks is an error naming the file's codec and mesh.
+fn stat(result: &RunResult, stat: Stat) -> Result<f64> {
+    result
+        .codec_stats
+        .require(stat)
+        .map_err(|e| Error::Unsupported(format!("{} on {}: {e}", result.codec, result.mesh)))
 }
 
 fn load(results: &Path, codec: &str, stem: &str) -> Result<RunResult> {
@@ -109,10 +114,10 @@ pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
     let mut why = String::new();
     for (paper, (file, stem)) in EMC_TABLE1.iter().zip(EMC_TABLE1_MESHES) {
         let r = load(results, "emc-paper", stem)?;
-        let cliques = stat(&r, "cliques");
-        let conn = stat(&r, "connecting_flag_bits") + stat(&r, "edge_code_bits");
-        let pos = stat(&r, "refinement_bits") + stat(&r, "split_distance_bits");
-        let body_bytes = r.bytes as f64 - stat(&r, "header_bytes");
+        let cliques = stat(&r, Stat::Cliques)?;
+        let conn = stat(&r, Stat::ConnectingFlagBits)? + stat(&r, Stat::EdgeCodeBits)?;
+        let pos = stat(&r, Stat::RefinementBits)? + stat(&r, Stat::SplitDistanceBits)?;
+        let body_bytes = r.bytes as f64 - stat(&r, Stat::HeaderBytes)?;
         let _ = writeln!(
             md,
             "| {} (paper) | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} |",
@@ -138,8 +143,8 @@ pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
             conn / cliques,
             pos / r.vertices as f64
         );
-        let corrections = stat(&r, "face_correction_bits");
-        let _ = writeln!(extras, "| {file} | {} | {} | {} | {} | {} | {corrections} ({:.3} bits/vertex) | {} | {} | {} |", r.triangles, cliques, stat(&r, "false_triangles"), stat(&r, "double_sided_faces"), stat(&r, "orientation_exceptions"), corrections / r.vertices as f64, stat(&r, "header_bytes"), r.bytes, r.lossless);
+        let corrections = stat(&r, Stat::FaceCorrectionBits)?;
+        let _ = writeln!(extras, "| {file} | {} | {} | {} | {} | {} | {corrections} ({:.3} bits/vertex) | {} | {} | {} |", r.triangles, cliques, stat(&r, Stat::FalseTriangles)?, stat(&r, Stat::DoubleSidedFaces)?, stat(&r, Stat::OrientationExceptions)?, corrections / r.vertices as f64, stat(&r, Stat::HeaderBytes)?, r.bytes, r.lossless);
         let _ = writeln!(why, "- **{file}** vs {}: {:+.1}% bits/Δ, {:+.1}% bits/vertex, {:+.1}% EMC bytes; Vertex# {} vs {}.", paper.name, 100.0 * (conn / cliques / paper.bits_per_triangle - 1.0), 100.0 * (pos / r.vertices as f64 / paper.bits_per_vertex - 1.0), 100.0 * (body_bytes / paper.emc_bytes as f64 - 1.0), r.vertices, paper.vertices);
     }
     let _ = writeln!(
@@ -361,8 +366,20 @@ fn refused(results: &Path, codec: &str, mesh: &str) -> Option<String> {
         })
 }
 
-fn per_split(r: &RunResult, field: &str) -> f64 {
-    stat(r, &format!("bits_{field}")) / stat(r, "vsplits").max(1.0)
+fn per_split(r: &RunResult, field: PmField) -> Result<f64> {
+    Ok(stat(r, Stat::FieldBits(field))? / stat(r, Stat::Vsplits)?.max(1.0))
+}
+
+/// Bits per vsplit of each field, and their sum.
+fn per_split_fields<const N: usize>(
+    r: &RunResult,
+    fields: [PmField; N],
+) -> Result<([f64; N], f64)> {
+    let mut bits = [0.0; N];
+    for (b, f) in bits.iter_mut().zip(fields) {
+        *b = per_split(r, f)?;
+    }
+    Ok((bits, bits.iter().sum()))
 }
 
 /// Writes paper-tables/hoppe-pm.md: Tables 2, 3 and 4 of Hoppe's paper beside ours, and the
@@ -397,38 +414,26 @@ pub fn hoppe_tables(results: &Path, out: &Path) -> Result<PathBuf> {
             md,
             "| {mesh} (ours) | {} | {} / {} | {:.0} | {:.0} | {:.0} | {:.1} | {:.1} |",
             n.vertices,
-            stat(&n, "base_vertices"),
-            stat(&n, "base_faces"),
-            stat(&n, "goto_full_vertices_per_second"),
-            stat(&n, "goto_base_vertices_per_second"),
-            stat(&n, "stream_decode_vertices_per_second"),
+            stat(&n, Stat::BaseVertices)?,
+            stat(&n, Stat::BaseFaces)?,
+            stat(&n, Stat::GotoFullVerticesPerSecond)?,
+            stat(&n, Stat::GotoBaseVerticesPerSecond)?,
+            stat(&n, Stat::StreamDecodeVerticesPerSecond)?,
             n.bytes as f64 * 8.0 / n.vertices as f64,
             r.bytes as f64 * 8.0 / r.vertices as f64
         );
-        let total =
-            |x: &RunResult, fields: &[&str]| fields.iter().map(|f| per_split(x, f)).sum::<f64>();
-        let f3 = ["flclw", "vs_index", "vlr_rot", "ii", "vad_l", "vad_s"];
+        use PmField::{Flclw, Ii, VadL, VadS, VlrRot, VsIndex};
+        let (b, total) = per_split_fields(&n, [Flclw, VsIndex, VlrRot, Ii, VadL, VadS])?;
         let _ = writeln!(
             t3,
-            "| {mesh} (ours) | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | — | **{:.1}** |",
-            per_split(&n, "flclw"),
-            per_split(&n, "vs_index"),
-            per_split(&n, "vlr_rot"),
-            per_split(&n, "ii"),
-            per_split(&n, "vad_l"),
-            per_split(&n, "vad_s"),
-            total(&n, &f3)
+            "| {mesh} (ours) | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | — | **{total:.1}** |",
+            b[0], b[1], b[2], b[3], b[4], b[5]
         );
-        let f4 = ["flclw", "vs_index", "vlr_rot", "ii", "vad_l"];
+        let (b, total) = per_split_fields(&r, [Flclw, VsIndex, VlrRot, Ii, VadL])?;
         let _ = writeln!(
             t4,
-            "| {mesh} (ours) | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | **{:.1}** |",
-            per_split(&r, "flclw"),
-            per_split(&r, "vs_index"),
-            per_split(&r, "vlr_rot"),
-            per_split(&r, "ii"),
-            per_split(&r, "vad_l"),
-            total(&r, &f4)
+            "| {mesh} (ours) | {:.1} | {:.1} | {:.1} | {:.1} | {:.1} | **{total:.1}** |",
+            b[0], b[1], b[2], b[3], b[4]
         );
     }
     let _ = writeln!(md, "\n## Table 3: bits per vsplit, collapse order (`pm`)\n");

@@ -44,7 +44,7 @@ fn encode(seed: u64, codec: &str, bits: u8) -> Option<(CanonicalMesh, codecs::En
         grid: GridShape::Cubic,
     };
     let canonical = codecs::canonical_for(&mesh, &options).ok()?;
-    match codecs::by_name(codec).unwrap().encode(&canonical, &options) {
+    match codecs::by_name(codec).unwrap().encode(&canonical) {
         Ok(e) => Some((canonical, e)),
         // Coarse grids can weld a manifold into a non-manifold: refused, not a failure here.
         Err(Error::Unsupported(_)) => None,
@@ -144,7 +144,7 @@ fn non_manifold_meshes_are_refused_with_counts() {
         grid: GridShape::Cubic,
     };
     let canonical = codecs::canonical_for(&mesh, &options).unwrap();
-    match codecs::by_name("pm").unwrap().encode(&canonical, &options) {
+    match codecs::by_name("pm").unwrap().encode(&canonical) {
         Err(Error::Unsupported(why)) => assert!(why.contains("non-manifold"), "{why}"),
         other => panic!("expected a refusal, got {:?}", other.map(|e| e.bytes.len())),
     }

@@ -61,8 +61,8 @@ proptest! {
             // At very coarse grids every face may collapse: that is an error, not a panic.
             return Ok(());
         };
-        let encoded = codec.encode(&canonical, &options).unwrap();
-        let again = codec.encode(&canonical, &options).unwrap();
+        let encoded = codec.encode(&canonical).unwrap();
+        let again = codec.encode(&canonical).unwrap();
         prop_assert_eq!(&encoded.bytes, &again.bytes, "encoding is deterministic");
         let (decoded, _) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
         prop_assert_eq!(canonical.check_lossless(&decoded.mesh), Ok(()));
@@ -74,7 +74,7 @@ proptest! {
         let codec = codecs::by_name("raw").unwrap();
         let options = codec.default_options();
         let canonical = codecs::canonical_for(&mesh, &options).unwrap();
-        let bytes = codec.encode(&canonical, &options).unwrap().bytes;
+        let bytes = codec.encode(&canonical).unwrap().bytes;
         let cut = cut_at.index(bytes.len());
         if let Ok((level, n)) = codecs::decode(&bytes[..cut], Stop::All) {
             prop_assert_eq!(n, 0);

@@ -87,7 +87,7 @@ fn every_shared_mesh_round_trips_losslessly() {
                         grid,
                     };
                     let canonical = codecs::canonical_for(&mesh, &options).unwrap();
-                    let encoded = match codec.encode(&canonical, &options) {
+                    let encoded = match codec.encode(&canonical) {
                         Ok(e) => e,
                         Err(meshcodec::Error::Unsupported(why)) if pm => {
                             // Refused: the canonical mesh must really be no oriented manifold.

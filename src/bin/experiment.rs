@@ -5,10 +5,11 @@
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use meshcodec::codecs::{self, Codec};
-use meshcodec::harness::{self, RunOptions, RunResult};
+use meshcodec::harness::{self, RunOptions};
 use meshcodec::mesh::io::{mesh_name, resolve};
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::plot;
+use meshcodec::results::{self, RunResult};
 use serde::Deserialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -33,7 +34,7 @@ struct Settings {
     #[arg(long)]
     quant: Option<u8>,
     /// Grid shape: cubic (DESIGN.md A2) or per-axis.
-    #[arg(long, value_parser = parse_grid)]
+    #[arg(long, value_parser = meshcodec::cli::parse_grid)]
     grid: Option<GridShape>,
     /// Random samples per original triangle for the error metrics.
     #[arg(long, default_value_t = meshcodec::metrics::DEFAULT_SAMPLES_PER_TRIANGLE)]
@@ -73,14 +74,6 @@ enum Command {
     },
 }
 
-fn parse_grid(s: &str) -> Result<GridShape, String> {
-    match s {
-        "cubic" => Ok(GridShape::Cubic),
-        "per-axis" => Ok(GridShape::PerAxis),
-        _ => Err(format!("unknown grid '{s}' (cubic, per-axis)")),
-    }
-}
-
 /// An experiment set: every codec on every mesh at every quantization.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -115,7 +108,7 @@ fn main() -> ExitCode {
             )),
         },
     };
-    meshcodec::error::exit_code(outcome)
+    meshcodec::cli::exit_code(outcome)
 }
 
 fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
@@ -161,7 +154,7 @@ fn run_codec(
         result.bits_per_vertex(),
         result.bits_per_triangle(),
     );
-    print!("{}", harness::level_table(&result));
+    print!("{}", results::level_table(&result));
     meshcodec::outln!(
         "encode {:.3} s, decode {:.4} s ({:.0} vertices/s); lossless: {}",
         result.encode_seconds,
@@ -172,7 +165,7 @@ fn run_codec(
             Some(e) => format!("NO — {e}"),
         }
     );
-    let stem = harness::result_stem(codec, &result);
+    let stem = results::result_stem(&codec.default_options(), &result);
     let written = harness::write_result(&result, &stem, out)
         .with_context(|| format!("writing results to {}", out.display()))?;
     for path in written {
@@ -210,7 +203,7 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
         set.quant.iter().map(|&q| Some(q)).collect()
     };
     let grid = match &set.grid {
-        Some(g) => Some(parse_grid(g).map_err(anyhow::Error::msg)?),
+        Some(g) => Some(meshcodec::cli::parse_grid(g).map_err(anyhow::Error::msg)?),
         None => settings.grid,
     };
     let settings = Settings {

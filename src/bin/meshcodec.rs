@@ -34,7 +34,7 @@ enum Command {
         #[arg(long)]
         quant: Option<u8>,
         /// Grid shape: cubic or per-axis (default: the codec's).
-        #[arg(long, value_parser = parse_grid)]
+        #[arg(long, value_parser = meshcodec::cli::parse_grid)]
         grid: Option<GridShape>,
         /// Mesh file or name.
         input: String,
@@ -86,14 +86,6 @@ enum Command {
     },
 }
 
-fn parse_grid(s: &str) -> Result<GridShape, String> {
-    match s {
-        "cubic" => Ok(GridShape::Cubic),
-        "per-axis" => Ok(GridShape::PerAxis),
-        _ => Err(format!("unknown grid '{s}' (cubic, per-axis)")),
-    }
-}
-
 fn main() -> ExitCode {
     let outcome = match Cli::parse().command {
         Command::Encode {
@@ -120,7 +112,7 @@ fn main() -> ExitCode {
             write_samples,
         } => distance(&a, &b, samples, seed, json, write_samples.as_deref()),
     };
-    meshcodec::error::exit_code(outcome)
+    meshcodec::cli::exit_code(outcome)
 }
 
 fn load(name: &str) -> Result<(PathBuf, meshcodec::mesh::TriMesh)> {
@@ -149,7 +141,7 @@ fn encode(
     let canonical =
         codecs::canonical_for(&mesh, &options).with_context(|| path.display().to_string())?;
     let encoded = codec
-        .encode(&canonical, &options)
+        .encode(&canonical)
         .with_context(|| path.display().to_string())?;
     write_atomically(output, &encoded.bytes).with_context(|| output.display().to_string())?;
     let bits = encoded.bytes.len() as f64 * 8.0;
@@ -208,14 +200,15 @@ fn decode(
 fn info(input: &Path, json: bool) -> Result<()> {
     let stream = read_stream(input)?;
     let context = || input.display().to_string();
-    let mut reader = StreamReader::open(&stream).with_context(context)?;
+    let reader = StreamReader::open(&stream).with_context(context)?;
     let header = reader.header().clone();
     let codec = codecs::by_id(header.codec_id).with_context(context)?;
-    // Level sizes from the container, mesh sizes from decoding.
-    let mut sizes = Vec::new();
-    while let Some(level) = reader.next_level().with_context(context)? {
-        sizes.push((level.start, level.bytes.len()));
-    }
+    // Level sizes from the index, mesh sizes from decoding.
+    let declared = reader.index().len();
+    let sizes: Vec<(usize, usize)> = (0..declared)
+        .map_while(|i| reader.unit(i))
+        .map(|unit| (unit.start, unit.bytes.len()))
+        .collect();
     let mut decoder = codecs::open(&stream).with_context(context)?;
     let mut levels = Vec::new();
     for &(start, len) in &sizes {
@@ -240,7 +233,8 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "bits": header.grid.bits,
         "vertices": header.vertices,
         "triangles": header.triangles,
-        "levels_declared": header.levels,
+        "levels_declared": declared,
+        "payload_start": reader.payload_start(),
         "levels_present": sizes.len(),
         "truncated": reader.truncated(),
         "levels": levels,
@@ -269,7 +263,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         header.vertices,
         header.triangles,
         sizes.len(),
-        header.levels,
+        declared,
         if reader.truncated() {
             " (truncated)"
         } else {
@@ -293,7 +287,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
             cell("triangles")
         );
     }
-    meshcodec::error::write_stdout(&text)?;
+    meshcodec::cli::write_stdout(&text)?;
     Ok(())
 }
 
@@ -316,9 +310,7 @@ fn distance(
         .measure(&level)
         .context("the compared mesh has no vertex")?;
     let diag = reference.diagonal;
-    let hausdorff = m.forward.max.max(m.backward.max);
-    let n = (m.forward.samples + m.backward.samples) as f64;
-    let rms = ((m.forward.sum_squares + m.backward.sum_squares) / n).sqrt();
+    let (hausdorff, rms) = (m.hausdorff(), m.rms());
     if let Some(dump) = dump {
         let mut csv = String::from("direction,x,y,z,distance\n");
         let rows = [

@@ -1,40 +1,33 @@
 //! Codecs behind one object-safe trait, found by name or stream id in a registry.
 //!
-//! A codec encodes a [`CanonicalMesh`] into a stream of levels (DESIGN.md A3) and hands out a
+//! A codec encodes a [`CanonicalMesh`] into a stream of units (docs/FORMAT.md §2) and hands out a
 //! [`LevelDecoder`] that walks a stream level by level, coarse to fine, as Hoppe's PMeshIter
-//! walks vertex splits. The full decode of a stream is lossless: it equals the canonical mesh.
+//! walks vertex splits. The full decode of a stream is lossless: it equals the canonical mesh
+//! (docs/CONTRACT.md §3). What only some codecs do is a [`Capability`] a caller asks for, and a
+//! request for one a codec lacks is refused, never ignored.
 
 pub mod emc;
+pub mod names;
 pub mod pm;
 pub mod raw;
+pub mod stats;
 
 use crate::container::{Header, StreamReader};
+pub use crate::container::{LevelCost, LevelRecord};
 use crate::error::{Error, Result};
 use crate::mesh::quantize::GridShape;
 use crate::mesh::{CanonicalMesh, Grid, TriMesh, VertexId};
+pub use stats::{Stat, Stats};
 
-/// What an encoder is asked for.
-#[derive(Clone, Debug, PartialEq)]
+/// How a mesh is quantized before it is encoded: the grid of its canonical mesh
+/// (docs/CONTRACT.md §1). The canonical mesh carries its grid, so a codec is handed the mesh
+/// alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EncodeOptions {
-    /// Bits per axis of the quantization grid (Q of DESIGN.md A2).
+    /// Bits per axis of the quantization grid (Q).
     pub quant_bits: u8,
     /// How cells are shaped.
     pub grid: GridShape,
-}
-
-/// One level as the encoder wrote it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct LevelRecord {
-    /// Offset in the stream where this level ends (so bits so far = 8 × end_byte).
-    pub end_byte: usize,
-    /// Connectivity bits booked in this level and all before it.
-    pub connectivity_bits: u64,
-    /// Geometry bits booked in this level and all before it.
-    pub geometry_bits: u64,
-    /// Vertices of the mesh after this level.
-    pub vertices: usize,
-    /// Triangles of the mesh after this level.
-    pub triangles: usize,
 }
 
 /// An encoded stream and what each level cost.
@@ -45,7 +38,7 @@ pub struct Encoded {
     /// One record per level, in stream order.
     pub levels: Vec<LevelRecord>,
     /// Codec-specific counts (bits per syntax element, operation counts…) for tables.
-    pub stats: std::collections::BTreeMap<String, f64>,
+    pub stats: Stats,
 }
 
 /// The mesh a stream decodes to at some level: positions at cell centres (of the level's own,
@@ -59,54 +52,84 @@ pub struct LevelMesh {
     pub loose_edges: Vec<[VertexId; 2]>,
 }
 
+/// What only some codecs do. A caller asks [`Codec::capabilities`]; decoding with a stop that
+/// needs a capability the codec lacks is refused ([`decode`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Capability {
+    /// Stops after any pass inside a level (EMC: one direction of one octree level), through
+    /// [`LevelDecoder::pass_stops`].
+    PassStops,
+    /// Decodes what is present of a level the stream was cut in, through
+    /// [`LevelDecoder::partial_levels`].
+    PartialLevels,
+    /// Refines parts of the mesh view-dependently, units fetched by byte range (no codec of
+    /// this build).
+    SelectiveRefinement,
+    /// Carries appearance attributes: normals, texture coordinates, colours, materials (no
+    /// codec of this build: the readers keep positions and faces only).
+    Attributes,
+}
+
 /// A progressive mesh codec.
 pub trait Codec: Send + Sync {
-    /// Name on the command line and in results/ (`raw`, `emc`, `pm`, …).
+    /// Name on the command line and in results/ ([`names`]).
     fn name(&self) -> &'static str;
-    /// Identifier in the stream header.
+    /// Identifier in the stream header ([`names`]).
     fn id(&self) -> u8;
     /// One line on what the codec is.
     fn summary(&self) -> &'static str;
-    /// Options used when the user gives none.
-    fn default_options(&self) -> EncodeOptions {
-        EncodeOptions {
-            quant_bits: 12,
-            grid: GridShape::Cubic,
-        }
-    }
-    /// Encodes the canonical mesh; refuses with [`Error::Unsupported`] a mesh it cannot code.
-    fn encode(&self, mesh: &CanonicalMesh, options: &EncodeOptions) -> Result<Encoded>;
+    /// The quantization used when the user gives none.
+    fn default_options(&self) -> EncodeOptions;
+    /// What this codec does beyond decoding level by level.
+    fn capabilities(&self) -> &'static [Capability];
+    /// Encodes the canonical mesh (on its own grid); refuses with [`Error::Unsupported`] a mesh
+    /// it cannot code.
+    fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded>;
     /// A decoder positioned before the first level of `stream` (whose header names this codec).
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>>;
     /// Codec-specific measurements of an encoded stream (PM: iteration rates), stored with the
-    /// run's results.
-    fn measure(&self, _stream: &[u8]) -> Result<std::collections::BTreeMap<String, f64>> {
-        Ok(Default::default())
-    }
+    /// run's results; codecs with none return an empty set.
+    fn measure(&self, stream: &[u8]) -> Result<Stats>;
 }
 
 /// Walks a stream level by level.
 pub trait LevelDecoder {
     /// The stream's header.
     fn header(&self) -> &Header;
+    /// Levels the stream holds when whole.
+    fn levels(&self) -> usize;
     /// Levels decoded so far.
     fn levels_decoded(&self) -> usize;
     /// Decodes the next complete level; `Ok(false)` when none is left (the stream's end, or the
     /// prefix ends inside the next level).
     fn advance(&mut self) -> Result<bool>;
-    /// Decodes only the first `passes` passes of the next level and stops there (EMC: a pass is
-    /// one direction of one octree level); `Ok(false)` for codecs without passes. No level can
-    /// be decoded after it.
-    fn advance_passes(&mut self, _passes: usize) -> Result<bool> {
-        Ok(false)
-    }
-    /// Decodes what is present of a level the stream was cut in, where the codec's syntax allows
-    /// it; `Ok(false)` when nothing more could be decoded.
-    fn advance_partial(&mut self) -> Result<bool> {
-        Ok(false)
-    }
     /// The mesh after the levels decoded so far (an error where showing it would pass a limit).
     fn mesh(&self) -> Result<LevelMesh>;
+    /// Stops inside a level, for codecs with [`Capability::PassStops`]; `None` for the others.
+    fn pass_stops(&mut self) -> Option<&mut dyn PassStops> {
+        None
+    }
+    /// Decodes part of a cut level, for codecs with [`Capability::PartialLevels`]; `None` for
+    /// the others.
+    fn partial_levels(&mut self) -> Option<&mut dyn PartialLevels> {
+        None
+    }
+}
+
+/// A decoder that can stop after any pass of a level.
+pub trait PassStops {
+    /// Passes in one level.
+    fn passes_per_level(&self) -> usize;
+    /// Decodes only the first `passes` passes of the next level and stops there; no level can
+    /// be decoded after it. `Ok(false)` when the next level is not present.
+    fn advance_passes(&mut self, passes: usize) -> Result<bool>;
+}
+
+/// A decoder that can decode part of a level the stream was cut in.
+pub trait PartialLevels {
+    /// Decodes what is present of the level the stream was cut in; `Ok(false)` when nothing
+    /// more could be decoded.
+    fn advance_partial(&mut self) -> Result<bool>;
 }
 
 /// Every codec of this build.
@@ -130,10 +153,10 @@ pub fn by_name(name: &str) -> Result<&'static dyn Codec> {
         .into_iter()
         .find(|c| c.name() == name)
         .ok_or_else(|| {
-            let names: Vec<_> = registry().iter().map(|c| c.name()).collect();
+            let known: Vec<_> = registry().iter().map(|c| c.name()).collect();
             Error::Unsupported(format!(
                 "unknown codec '{name}' (codecs: {})",
-                names.join(", ")
+                known.join(", ")
             ))
         })
 }
@@ -146,7 +169,7 @@ pub fn by_id(id: u8) -> Result<&'static dyn Codec> {
         .ok_or_else(|| Error::malformed(0, 5, format!("unknown codec id {id}")))
 }
 
-/// The canonical mesh that `codec` would encode for `mesh` under `options`.
+/// The canonical mesh that a codec encodes for `mesh` quantized by `options`.
 pub fn canonical_for(mesh: &TriMesh, options: &EncodeOptions) -> Result<CanonicalMesh> {
     let grid = Grid::fit(mesh, options.quant_bits, options.grid)?;
     let canonical = CanonicalMesh::new(mesh, grid)?;
@@ -168,32 +191,116 @@ pub fn open(bytes: &[u8]) -> Result<Box<dyn LevelDecoder + '_>> {
 /// Where to stop decoding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stop {
-    /// Every level present.
+    /// Every level present (and, for codecs with [`Capability::PartialLevels`], what is present
+    /// of a cut level).
     All,
-    /// After this many levels (or all present, if fewer).
+    /// After this many levels (or all present, if the bytes hold fewer); more than the stream
+    /// holds is refused.
     Levels(usize),
-    /// After this many passes (EMC: three a level).
+    /// After this many passes, for codecs with [`Capability::PassStops`] (EMC: three a level);
+    /// refused for the others.
     Passes(usize),
 }
 
 /// Decodes `bytes` (a whole stream or any prefix) up to `stop`; returns the mesh and the number
-/// of levels decoded. A prefix too short to hold the header is an error.
+/// of levels decoded. A prefix too short to hold the header and index is an error, and so is a
+/// stop the stream or its codec cannot honour.
 pub fn decode(bytes: &[u8], stop: Stop) -> Result<(LevelMesh, usize)> {
-    let mut decoder = open(bytes)?;
+    let reader = StreamReader::open(bytes)?;
+    let codec = by_id(reader.header().codec_id)?;
+    let mut decoder = codec.decoder(reader)?;
+    let levels = decoder.levels();
+    let per_level = decoder.pass_stops().map(|p| p.passes_per_level());
     let wanted = match stop {
         Stop::All => usize::MAX,
+        Stop::Levels(n) if n > levels => {
+            return Err(Error::Unsupported(format!(
+                "cannot stop after level {n}: the stream has {levels} levels"
+            )))
+        }
         Stop::Levels(n) => n,
-        Stop::Passes(n) => n / 3,
+        Stop::Passes(n) => {
+            let Some(per_level) = per_level else {
+                return Err(Error::Unsupported(format!(
+                    "codec {} cannot stop inside a level (stop by level or by bytes)",
+                    codec.name()
+                )));
+            };
+            if n > per_level * levels {
+                return Err(Error::Unsupported(format!(
+                    "cannot stop after pass {n}: the stream has {} passes",
+                    per_level * levels
+                )));
+            }
+            n / per_level
+        }
     };
     while decoder.levels_decoded() < wanted && decoder.advance()? {}
     match stop {
         Stop::All => {
-            decoder.advance_partial()?;
+            if let Some(partial) = decoder.partial_levels() {
+                partial.advance_partial()?;
+            }
         }
-        Stop::Passes(n) if n % 3 > 0 && decoder.levels_decoded() == n / 3 => {
-            decoder.advance_passes(n % 3)?;
+        Stop::Passes(n) => {
+            let per_level = per_level.expect("checked above");
+            if n % per_level > 0 && decoder.levels_decoded() == n / per_level {
+                if let Some(passes) = decoder.pass_stops() {
+                    passes.advance_passes(n % per_level)?;
+                }
+            }
         }
-        _ => {}
+        Stop::Levels(_) => {}
     }
     Ok((decoder.mesh()?, decoder.levels_decoded()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::generate;
+
+    #[test]
+    fn names_and_stream_ids_are_unique_and_found_both_ways() {
+        let codecs = registry();
+        for (i, a) in codecs.iter().enumerate() {
+            for b in &codecs[i + 1..] {
+                assert_ne!(a.name(), b.name());
+                assert_ne!(a.id(), b.id(), "{} and {}", a.name(), b.name());
+            }
+            assert_eq!(by_name(a.name()).unwrap().id(), a.id());
+            assert_eq!(by_id(a.id()).unwrap().name(), a.name());
+        }
+        assert_eq!(codecs.len(), names::ALL.len());
+    }
+
+    #[test]
+    fn decoders_offer_exactly_the_capabilities_their_codecs_list() {
+        let mesh = generate::icosphere(2);
+        for codec in registry() {
+            let canonical = canonical_for(&mesh, &codec.default_options()).unwrap();
+            let bytes = codec.encode(&canonical).unwrap().bytes;
+            let mut decoder = open(&bytes).unwrap();
+            let has = |c| codec.capabilities().contains(&c);
+            assert_eq!(
+                decoder.pass_stops().is_some(),
+                has(Capability::PassStops),
+                "{}",
+                codec.name()
+            );
+            assert_eq!(
+                decoder.partial_levels().is_some(),
+                has(Capability::PartialLevels),
+                "{}",
+                codec.name()
+            );
+            if !has(Capability::PassStops) {
+                let e = decode(&bytes, Stop::Passes(1)).unwrap_err();
+                assert!(e.to_string().contains("cannot stop inside a level"), "{e}");
+            }
+            let levels = decoder.levels();
+            let e = decode(&bytes, Stop::Levels(levels + 1)).unwrap_err();
+            assert!(e.to_string().contains("has"), "{e}");
+        }
+    }
 }

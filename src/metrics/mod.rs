@@ -96,11 +96,9 @@ impl Reference {
     /// diagonal; `None` for a level with no vertex.
     pub fn compare(&self, level: &LevelMesh) -> Option<LevelDistance> {
         let m = self.measure(level)?;
-        let samples = (m.forward.samples + m.backward.samples).max(1) as f64;
-        let sum_squares = m.forward.sum_squares + m.backward.sum_squares;
         Some(LevelDistance {
-            hausdorff: m.forward.max.max(m.backward.max) / self.diagonal,
-            rms: (sum_squares / samples).sqrt() / self.diagonal,
+            hausdorff: m.hausdorff() / self.diagonal,
+            rms: m.rms() / self.diagonal,
             hausdorff_paper: m.paper / self.diagonal,
         })
     }
@@ -143,4 +141,17 @@ pub struct Measurement {
     pub to_level: Vec<f64>,
     /// Distance of each level sample to the original.
     pub to_original: Vec<f64>,
+}
+
+impl Measurement {
+    /// Symmetric Hausdorff distance: the larger one-sided maximum.
+    pub fn hausdorff(&self) -> f64 {
+        self.forward.max.max(self.backward.max)
+    }
+
+    /// RMS over the samples of both directions together.
+    pub fn rms(&self) -> f64 {
+        let samples = (self.forward.samples + self.backward.samples).max(1) as f64;
+        ((self.forward.sum_squares + self.backward.sum_squares) / samples).sqrt()
+    }
 }

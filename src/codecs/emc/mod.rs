@@ -43,7 +43,7 @@ pub mod modelled;
 pub mod paper;
 pub mod state;
 
-use crate::container::Header;
+use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::octree::{axes_by_extent, StepOrder};
 use crate::mesh::CanonicalMesh;
@@ -84,12 +84,13 @@ impl EmcParams {
             grid: mesh.grid,
             vertices: mesh.vertex_count() as u64,
             triangles: mesh.face_count() as u64,
-            levels: self.order.levels as u64,
         }
     }
 
     /// Reads and checks the parameters of a stream in `syntax`.
-    pub fn from_header(header: &Header, syntax: Syntax) -> Result<EmcParams> {
+    pub fn from_stream(stream: &StreamReader, syntax: Syntax) -> Result<EmcParams> {
+        stream.require_layered()?;
+        let header = stream.header();
         let bad = |what: &str| Error::malformed(0, 6, what);
         let p = &header.params;
         if p.len() != 4 || p[0] != syntax as u8 {
@@ -101,7 +102,7 @@ impl EmcParams {
         if sorted != [0, 1, 2] {
             return Err(bad("emc axis order is not a permutation of x, y, z"));
         }
-        if header.levels != header.grid.bits as u64 {
+        if stream.index().len() != header.grid.bits as usize {
             return Err(bad(
                 "emc stream with a level count other than its quantization bits",
             ));

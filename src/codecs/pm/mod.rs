@@ -31,11 +31,14 @@
 pub mod iter;
 pub mod syntax;
 
-use super::{Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, LevelRecord};
+use super::stats::PmField;
+use super::{
+    names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, Stat, Stats,
+};
 use crate::coding::arith::{ArithDecoder, ArithEncoder};
 use crate::coding::bits::index_bits;
-use crate::coding::{BitLedger, SyntaxClass};
-use crate::container::{Header, StreamReader, StreamWriter};
+use crate::coding::SyntaxClass;
+use crate::container::{Header, LevelCost, StreamReader, StreamWriter};
 use crate::error::{Error, Result};
 use crate::hierarchy::pmesh::PmMesh;
 use crate::hierarchy::simplify::{self, Placement};
@@ -43,7 +46,6 @@ use crate::mesh::quantize::GridShape;
 use crate::mesh::topology::analyze;
 use crate::mesh::{CanonicalMesh, TriMesh};
 use iter::PMeshIter;
-use std::collections::BTreeMap;
 use syntax::{FlclwCoding, SplitContexts};
 
 /// Ordering of the vertex splits.
@@ -103,6 +105,15 @@ impl PmParams {
 pub struct Pm {
     /// Which ordering this registry entry uses.
     pub ordering: Ordering,
+}
+
+impl Pm {
+    fn naming(&self) -> names::Naming {
+        match self.ordering {
+            Ordering::Natural => names::PM,
+            Ordering::Reordered => names::PM_REORDERED,
+        }
+    }
 }
 
 /// Refuses meshes that are not oriented 2-manifolds, with the counts that say why.
@@ -171,17 +182,11 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<PmMesh> {
 
 impl Codec for Pm {
     fn name(&self) -> &'static str {
-        match self.ordering {
-            Ordering::Natural => "pm",
-            Ordering::Reordered => "pm-reordered",
-        }
+        self.naming().name
     }
 
     fn id(&self) -> u8 {
-        match self.ordering {
-            Ordering::Natural => 2,
-            Ordering::Reordered => 3,
-        }
+        self.naming().id
     }
 
     fn summary(&self) -> &'static str {
@@ -198,7 +203,11 @@ impl Codec for Pm {
         }
     }
 
-    fn encode(&self, mesh: &CanonicalMesh, _options: &EncodeOptions) -> Result<Encoded> {
+    fn capabilities(&self) -> &'static [Capability] {
+        &[]
+    }
+
+    fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         check_manifold(mesh)?;
         let params = PmParams {
             ordering: self.ordering,
@@ -216,7 +225,7 @@ impl Codec for Pm {
         Ok(encode_pm(self.id(), params, mesh, &pm))
     }
 
-    fn measure(&self, stream: &[u8]) -> Result<BTreeMap<String, f64>> {
+    fn measure(&self, stream: &[u8]) -> Result<Stats> {
         // Hoppe's Table 2: iteration rates over a PMesh in memory, forwards to Mⁿ and back to
         // M⁰ (best of a few passes), and the full stream decode rate.
         let started = std::time::Instant::now();
@@ -236,30 +245,23 @@ impl Codec for Pm {
             memory.goto_nvertices(0)?;
             backward = backward.min(t.elapsed().as_secs_f64());
         }
-        let mut out = BTreeMap::new();
-        out.insert(
-            "goto_full_vertices_per_second".into(),
-            n / forward.max(1e-9),
-        );
-        out.insert(
-            "goto_base_vertices_per_second".into(),
-            n / backward.max(1e-9),
-        );
-        out.insert(
-            "stream_decode_vertices_per_second".into(),
-            n / decode.max(1e-9),
-        );
+        let mut out = Stats::default();
+        out.set(Stat::GotoFullVerticesPerSecond, n / forward.max(1e-9));
+        out.set(Stat::GotoBaseVerticesPerSecond, n / backward.max(1e-9));
+        out.set(Stat::StreamDecodeVerticesPerSecond, n / decode.max(1e-9));
         Ok(out)
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
+        stream.require_layered()?;
         let header = stream.header().clone();
         PmParams::from_header(&header)?;
         Ok(Box::new(PmDecoder {
+            levels: stream.index().len(),
             bytes: stream.bytes(),
             header,
             iter: None,
-            levels: 0,
+            decoded: 0,
         }))
     }
 }
@@ -287,12 +289,9 @@ fn encode_pm(
         grid: mesh.grid,
         vertices: mesh.vertex_count() as u64,
         triangles: mesh.face_count() as u64,
-        levels: 1 + schedule.len() as u64,
     };
     let mut writer = StreamWriter::new(&header);
-    let mut levels = Vec::new();
-    let mut total = BitLedger::default();
-    let mut stats: BTreeMap<String, f64> = BTreeMap::new();
+    let mut stats = Stats::default();
 
     // Level 1: the base mesh.
     let mut enc = ArithEncoder::default();
@@ -300,38 +299,34 @@ fn encode_pm(
     syntax::put_count(&mut enc, &mut ctx, base.positions.len() as u64);
     syntax::put_count(&mut enc, &mut ctx, base.faces.len() as u64);
     let q = mesh.grid.bits as u32;
+    let field = PmField::Base.name();
     for c in &base.positions {
         for &x in c {
-            enc.raw(x as u64, q, SyntaxClass::Geometry, "base");
+            enc.raw(x as u64, q, SyntaxClass::Geometry, field);
         }
     }
     let b = index_bits(base.positions.len() as u64);
     for f in &base.faces {
         for &v in &f.v {
-            enc.raw(v as u64, b, SyntaxClass::Connectivity, "base");
+            enc.raw(v as u64, b, SyntaxClass::Connectivity, field);
         }
     }
-    let mut push = |enc: ArithEncoder,
-                    vertices: usize,
-                    faces: usize,
-                    total: &mut BitLedger,
-                    stats: &mut BTreeMap<String, f64>| {
+    let mut push = |enc: ArithEncoder, vertices: usize, triangles: usize, stats: &mut Stats| {
         for (field, bits) in &enc.field_bits {
-            *stats.entry(format!("bits_{field}")).or_default() += bits;
+            stats.add_named(&format!("bits_{field}"), *bits);
         }
         let (payload, ledger) = enc.finish();
-        writer.push_level(&payload);
-        total.connectivity += ledger.connectivity;
-        total.geometry += ledger.geometry;
-        levels.push((*total, vertices, faces));
+        writer.push_level(
+            &payload,
+            LevelCost {
+                connectivity_bits: ledger.connectivity,
+                geometry_bits: ledger.geometry,
+                vertices,
+                triangles,
+            },
+        );
     };
-    push(
-        enc,
-        base.positions.len(),
-        base.faces.len(),
-        &mut total,
-        &mut stats,
-    );
+    push(enc, base.positions.len(), base.faces.len(), &mut stats);
 
     // Further levels: batches of vsplits, coded against the mesh as the decoder will hold it.
     let mut state = base.clone();
@@ -357,31 +352,15 @@ fn encode_pm(
             state.vsplit(split).expect("the encoder's own splits apply");
         }
         next += n;
-        push(
-            enc,
-            state.positions.len(),
-            state.faces.len(),
-            &mut total,
-            &mut stats,
-        );
+        push(enc, state.positions.len(), state.faces.len(), &mut stats);
     }
-    let (bytes, ends) = writer.finish();
-    stats.insert("vsplits".into(), pm.vsplits.len() as f64);
-    stats.insert("base_vertices".into(), base.positions.len() as f64);
-    stats.insert("base_faces".into(), base.faces.len() as f64);
+    let (bytes, levels) = writer.finish();
+    stats.set(Stat::Vsplits, pm.vsplits.len() as f64);
+    stats.set(Stat::BaseVertices, base.positions.len() as f64);
+    stats.set(Stat::BaseFaces, base.faces.len() as f64);
     Encoded {
         bytes,
-        levels: levels
-            .into_iter()
-            .zip(ends)
-            .map(|((ledger, vertices, triangles), end_byte)| LevelRecord {
-                end_byte,
-                connectivity_bits: ledger.connectivity,
-                geometry_bits: ledger.geometry,
-                vertices,
-                triangles,
-            })
-            .collect(),
+        levels,
         stats,
     }
 }
@@ -393,6 +372,7 @@ struct PmDecoder<'a> {
     header: Header,
     iter: Option<PMeshIter<'a>>,
     levels: usize,
+    decoded: usize,
 }
 
 impl LevelDecoder for PmDecoder<'_> {
@@ -400,8 +380,12 @@ impl LevelDecoder for PmDecoder<'_> {
         &self.header
     }
 
-    fn levels_decoded(&self) -> usize {
+    fn levels(&self) -> usize {
         self.levels
+    }
+
+    fn levels_decoded(&self) -> usize {
+        self.decoded
     }
 
     fn advance(&mut self) -> Result<bool> {
@@ -416,7 +400,7 @@ impl LevelDecoder for PmDecoder<'_> {
                 Err(e) => return Err(e),
             },
         };
-        self.levels += advanced as usize;
+        self.decoded += advanced as usize;
         Ok(advanced)
     }
 

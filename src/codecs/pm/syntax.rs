@@ -2,16 +2,12 @@
 //! coding, one context set per field, contexts kept across levels (the coder is flushed per
 //! level, the probabilities are not reset).
 
+use crate::codecs::stats::PmField;
 use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext, IntContext, UintContext};
 use crate::coding::bits::index_bits;
 use crate::coding::SyntaxClass::{Connectivity, Geometry};
 use crate::hierarchy::pmesh::{Rotation, Vsplit};
 use crate::hierarchy::simplify::vad_s_step;
-
-/// Field names, as Hoppe's Tables 3 and 4 report them.
-pub const FIELDS: [&str; 7] = [
-    "flclw", "vs_index", "vlr_rot", "ii", "vad_l", "vad_s", "count",
-];
 
 /// Contexts of every vsplit field.
 #[derive(Clone, Debug, Default)]
@@ -149,7 +145,7 @@ fn rotation_of(symbol: u64) -> Option<Rotation> {
 
 /// Writes the number of splits in a level.
 pub fn put_count(enc: &mut ArithEncoder, ctx: &mut SplitContexts, n: u64) {
-    enc.uint(&mut ctx.count, n, Connectivity, "count");
+    enc.uint(&mut ctx.count, n, Connectivity, PmField::Count.name());
 }
 
 /// Reads the number of splits in a level.
@@ -172,52 +168,57 @@ pub fn put_split(
             s.flclw as u64,
             index_bits(faces as u64),
             Connectivity,
-            "flclw",
+            PmField::Flclw.name(),
         ),
         FlclwCoding::Delta => {
             let delta = (s.flclw as u64 + faces as u64 - previous.min(faces) as u64) % faces as u64;
-            enc.uint(&mut ctx.delta_flclw, delta, Connectivity, "flclw");
+            enc.uint(
+                &mut ctx.delta_flclw,
+                delta,
+                Connectivity,
+                PmField::Flclw.name(),
+            );
         }
     }
     enc.bit(
         &mut ctx.vs_index[0],
         s.vs_index == 0,
         Connectivity,
-        "vs_index",
+        PmField::VsIndex.name(),
     );
     if s.vs_index != 0 {
         enc.bit(
             &mut ctx.vs_index[1],
             s.vs_index == 1,
             Connectivity,
-            "vs_index",
+            PmField::VsIndex.name(),
         );
     }
     enc.uint(
         &mut ctx.vlr_rot,
         rotation_symbol(s.vlr_rot),
         Connectivity,
-        "vlr_rot",
+        PmField::VlrRot.name(),
     );
-    enc.bit(&mut ctx.ii[0], s.ii == 2, Geometry, "ii");
+    enc.bit(&mut ctx.ii[0], s.ii == 2, Geometry, PmField::Ii.name());
     if s.ii != 2 {
-        enc.bit(&mut ctx.ii[1], s.ii == 0, Geometry, "ii");
+        enc.bit(&mut ctx.ii[1], s.ii == 0, Geometry, PmField::Ii.name());
     }
     let (i, j, k) = tangent.axes();
     enc.int(
         &mut ctx.vad_l[0],
         s.vad_l[i] as i64 - tangent.guess[i],
         Geometry,
-        "vad_l",
+        PmField::VadL.name(),
     );
     enc.int(
         &mut ctx.vad_l[1],
         s.vad_l[j] as i64 - tangent.guess[j],
         Geometry,
-        "vad_l",
+        PmField::VadL.name(),
     );
     let residual = s.vad_l[k] as i64 - tangent.predict(s.vad_l[i], s.vad_l[j]);
-    enc.int(&mut ctx.vad_l[2], residual, Geometry, "vad_l");
+    enc.int(&mut ctx.vad_l[2], residual, Geometry, PmField::VadL.name());
     if layout.with_vad_s {
         let step = vad_s_step(s.vad_l);
         for a in 0..3 {
@@ -225,7 +226,7 @@ pub fn put_split(
                 &mut ctx.vad_s[a],
                 (s.vad_s[a] / step) as i64,
                 Geometry,
-                "vad_s",
+                PmField::VadS.name(),
             );
         }
     }

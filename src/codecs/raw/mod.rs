@@ -5,11 +5,12 @@
 //!
 //! Glossary: Q = quantization bits per axis, V = vertices, T = triangles.
 
-use super::{Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, LevelRecord};
+use super::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, Stats};
 use crate::coding::bits::index_bits;
 use crate::coding::{BitSink, BitSource, SyntaxClass};
-use crate::container::{Header, StreamReader, StreamWriter};
+use crate::container::{Header, LevelCost, StreamReader, StreamWriter};
 use crate::error::{Error, Result};
+use crate::mesh::quantize::GridShape;
 use crate::mesh::{CanonicalMesh, TriMesh};
 
 /// The `raw` codec.
@@ -17,25 +18,39 @@ pub struct Raw;
 
 impl Codec for Raw {
     fn name(&self) -> &'static str {
-        "raw"
+        names::RAW.name
     }
 
     fn id(&self) -> u8 {
-        0
+        names::RAW.id
     }
 
     fn summary(&self) -> &'static str {
         "uncompressed baseline: 3·Q bits per vertex, 3·⌈log2 V⌉ bits per triangle, one level"
     }
 
-    fn encode(&self, mesh: &CanonicalMesh, _options: &EncodeOptions) -> Result<Encoded> {
+    fn default_options(&self) -> EncodeOptions {
+        EncodeOptions {
+            quant_bits: 12,
+            grid: GridShape::Cubic,
+        }
+    }
+
+    fn capabilities(&self) -> &'static [Capability] {
+        &[]
+    }
+
+    fn measure(&self, _stream: &[u8]) -> Result<Stats> {
+        Ok(Stats::default())
+    }
+
+    fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         let header = Header {
             codec_id: self.id(),
             params: Vec::new(),
             grid: mesh.grid,
             vertices: mesh.vertex_count() as u64,
             triangles: mesh.face_count() as u64,
-            levels: 1,
         };
         let mut sink = BitSink::default();
         let q = mesh.grid.bits as u32;
@@ -52,29 +67,32 @@ impl Codec for Raw {
         }
         let (payload, ledger) = sink.finish();
         let mut writer = StreamWriter::new(&header);
-        writer.push_level(&payload);
-        let (bytes, ends) = writer.finish();
-        Ok(Encoded {
-            levels: vec![LevelRecord {
-                end_byte: ends[0],
+        writer.push_level(
+            &payload,
+            LevelCost {
                 connectivity_bits: ledger.connectivity,
                 geometry_bits: ledger.geometry,
                 vertices: mesh.vertex_count(),
                 triangles: mesh.face_count(),
-            }],
+            },
+        );
+        let (bytes, levels) = writer.finish();
+        Ok(Encoded {
+            levels,
             bytes,
-            stats: Default::default(),
+            stats: Stats::default(),
         })
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
-        if stream.header().levels != 1 {
+        stream.require_layered()?;
+        if stream.index().len() != 1 {
             return Err(Error::malformed(
                 0,
                 0,
                 format!(
                     "raw streams have 1 level, this one declares {}",
-                    stream.header().levels
+                    stream.index().len()
                 ),
             ));
         }
@@ -95,6 +113,10 @@ struct RawDecoder<'a> {
 impl LevelDecoder for RawDecoder<'_> {
     fn header(&self) -> &Header {
         self.stream.header()
+    }
+
+    fn levels(&self) -> usize {
+        1
     }
 
     fn levels_decoded(&self) -> usize {
@@ -171,9 +193,8 @@ mod tests {
     #[test]
     fn raw_is_lossless_and_costs_what_it_says() {
         let mesh = generate::messy(3);
-        let options = Raw.default_options();
-        let canonical = canonical_for(&mesh, &options).unwrap();
-        let encoded = Raw.encode(&canonical, &options).unwrap();
+        let canonical = canonical_for(&mesh, &Raw.default_options()).unwrap();
+        let encoded = Raw.encode(&canonical).unwrap();
         let (decoded, levels) = decode(&encoded.bytes, Stop::All).unwrap();
         assert_eq!(levels, 1);
         assert_eq!(canonical.check_lossless(&decoded.mesh), Ok(()));
@@ -189,9 +210,8 @@ mod tests {
     #[test]
     fn every_prefix_decodes_or_fails_cleanly() {
         let mesh = generate::icosphere(1);
-        let options = Raw.default_options();
-        let canonical = canonical_for(&mesh, &options).unwrap();
-        let bytes = Raw.encode(&canonical, &options).unwrap().bytes;
+        let canonical = canonical_for(&mesh, &Raw.default_options()).unwrap();
+        let bytes = Raw.encode(&canonical).unwrap().bytes;
         for cut in 0..bytes.len() {
             match decode(&bytes[..cut], Stop::All) {
                 Ok((level, n)) => assert!(n == 0 && level.mesh.faces.is_empty()),

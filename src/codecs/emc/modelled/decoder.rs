@@ -3,7 +3,7 @@
 
 use super::walk::{Question, Side, Stop, Walker};
 use crate::codecs::emc::state::FaceCorrections;
-use crate::codecs::{LevelDecoder, LevelMesh};
+use crate::codecs::{LevelDecoder, LevelMesh, PassStops};
 use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
@@ -147,6 +147,10 @@ impl LevelDecoder for EmcDecoder<'_> {
         &self.header
     }
 
+    fn levels(&self) -> usize {
+        self.walker.state.order.levels as usize
+    }
+
     fn levels_decoded(&self) -> usize {
         self.levels_done
     }
@@ -157,13 +161,23 @@ impl LevelDecoder for EmcDecoder<'_> {
         Ok(advanced)
     }
 
-    fn advance_passes(&mut self, passes: usize) -> Result<bool> {
-        self.decode_passes(passes)
-    }
-
     fn mesh(&self) -> Result<LevelMesh> {
         self.walker
             .state
             .shown_mesh(self.final_mesh.as_ref(), &self.header)
+    }
+
+    fn pass_stops(&mut self) -> Option<&mut dyn PassStops> {
+        Some(self)
+    }
+}
+
+impl PassStops for EmcDecoder<'_> {
+    fn passes_per_level(&self) -> usize {
+        3
+    }
+
+    fn advance_passes(&mut self, passes: usize) -> Result<bool> {
+        self.decode_passes(passes)
     }
 }

@@ -5,13 +5,12 @@ use super::walk::{Question, Side, Stop, Walker};
 use crate::codecs::emc::clusters::{Clusters, SplitPlan};
 use crate::codecs::emc::state::{face_corrections, EdgeCode, EmcState};
 use crate::codecs::emc::EmcParams;
-use crate::codecs::{Encoded, LevelRecord};
+use crate::codecs::{Encoded, Stats};
 use crate::coding::arith::{ArithEncoder, BitContext, UintContext};
-use crate::coding::{BitLedger, SyntaxClass};
-use crate::container::{Header, StreamWriter};
+use crate::coding::SyntaxClass;
+use crate::container::{Header, LevelCost, StreamWriter};
 use crate::hierarchy::octree::KeyTrie;
 use crate::mesh::CanonicalMesh;
-use std::collections::BTreeMap;
 
 struct EncoderSide {
     coder: ArithEncoder,
@@ -96,9 +95,7 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
         plan: SplitPlan::default(),
     };
     let mut writer = StreamWriter::new(&header);
-    let mut stats: BTreeMap<String, f64> = BTreeMap::new();
-    let mut ledger = BitLedger::default();
-    let mut records = Vec::with_capacity(order.levels as usize);
+    let mut stats = Stats::default();
     for level in 1..=order.levels as usize {
         walker
             .level(&mut side, level, 3, n, mesh.face_count() as u64)
@@ -121,39 +118,30 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
             ];
             for (i, (list, field)) in lists.into_iter().enumerate() {
                 put_list(&mut coder, &mut walker.contexts.corrections[i], list, field);
-                *stats.entry(field.to_string()).or_default() += list.len() as f64;
+                stats.add_named(field, list.len() as f64);
             }
         }
         for (field, bits) in &coder.field_bits {
-            *stats.entry(format!("{field}_bits")).or_default() += bits;
+            stats.add_named(&format!("{field}_bits"), *bits);
         }
         let (payload, level_ledger) = coder.finish();
-        writer.push_level(&payload);
-        ledger.connectivity += level_ledger.connectivity;
-        ledger.geometry += level_ledger.geometry;
-        records.push((ledger, walker.state.len()));
-    }
-    stats.insert(
-        "leaves".into(),
-        walker.leaf.iter().filter(|&&l| l).count() as f64,
-    );
-    let (bytes, ends) = writer.finish();
-    let levels = records
-        .into_iter()
-        .zip(ends)
-        .enumerate()
-        .map(|(i, ((ledger, vertices), end_byte))| LevelRecord {
-            end_byte,
-            connectivity_bits: ledger.connectivity,
-            geometry_bits: ledger.geometry,
-            vertices,
-            triangles: if i + 1 == order.levels as usize {
-                mesh.face_count()
-            } else {
-                0
+        writer.push_level(
+            &payload,
+            LevelCost {
+                connectivity_bits: level_ledger.connectivity,
+                geometry_bits: level_ledger.geometry,
+                vertices: walker.state.len(),
+                // Triangles are listed once, from the last level's edge graph.
+                triangles: if level == order.levels as usize {
+                    mesh.face_count()
+                } else {
+                    0
+                },
             },
-        })
-        .collect();
+        );
+    }
+    stats.add_named("leaves", walker.leaf.iter().filter(|&&l| l).count() as f64);
+    let (bytes, levels) = writer.finish();
     Ok(Encoded {
         bytes,
         levels,

@@ -98,9 +98,10 @@ mod encoder;
 pub mod walk;
 
 use super::{EmcParams, Syntax};
-use crate::codecs::{Codec, EncodeOptions, Encoded, LevelDecoder};
+use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
 use crate::container::StreamReader;
 use crate::error::Result;
+use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
 
 /// The `emc` codec.
@@ -108,25 +109,40 @@ pub struct Emc;
 
 impl Codec for Emc {
     fn name(&self) -> &'static str {
-        "emc"
+        names::EMC.name
     }
 
     fn id(&self) -> u8 {
-        4
+        names::EMC.id
     }
 
     fn summary(&self) -> &'static str {
         "embedded mesh coding with context-modelled arithmetic coding: octree splits whose positions and edges are predicted from decoded neighbours"
     }
 
-    fn encode(&self, mesh: &CanonicalMesh, _options: &EncodeOptions) -> Result<Encoded> {
+    fn default_options(&self) -> EncodeOptions {
+        EncodeOptions {
+            quant_bits: 12,
+            grid: GridShape::Cubic,
+        }
+    }
+
+    fn capabilities(&self) -> &'static [Capability] {
+        &[Capability::PassStops]
+    }
+
+    fn measure(&self, _stream: &[u8]) -> Result<Stats> {
+        Ok(Stats::default())
+    }
+
+    fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         let params = EmcParams::for_mesh(mesh);
         let header = params.header(Syntax::Modelled, self.id(), mesh);
         encoder::encode(mesh, &params, header)
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
-        let params = EmcParams::from_header(stream.header(), Syntax::Modelled)?;
+        let params = EmcParams::from_stream(&stream, Syntax::Modelled)?;
         Ok(Box::new(decoder::EmcDecoder::new(stream, params.order)))
     }
 }

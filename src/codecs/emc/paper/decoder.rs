@@ -4,7 +4,7 @@
 
 use super::super::state::{EmcState, FaceCorrections, NO_SPLIT};
 use super::syntax;
-use crate::codecs::{LevelDecoder, LevelMesh};
+use crate::codecs::{LevelDecoder, LevelMesh, PartialLevels, PassStops};
 use crate::coding::BitSource;
 use crate::container::{Header, LevelPayload, StreamReader};
 use crate::error::{Error, Result};
@@ -137,6 +137,10 @@ impl LevelDecoder for EmcDecoder<'_> {
         &self.header
     }
 
+    fn levels(&self) -> usize {
+        self.state.order.levels as usize
+    }
+
     fn levels_decoded(&self) -> usize {
         self.levels_done
     }
@@ -159,6 +163,25 @@ impl LevelDecoder for EmcDecoder<'_> {
         }
     }
 
+    fn mesh(&self) -> Result<LevelMesh> {
+        self.state
+            .shown_mesh(self.final_mesh.as_ref(), &self.header)
+    }
+
+    fn pass_stops(&mut self) -> Option<&mut dyn PassStops> {
+        Some(self)
+    }
+
+    fn partial_levels(&mut self) -> Option<&mut dyn PartialLevels> {
+        Some(self)
+    }
+}
+
+impl PassStops for EmcDecoder<'_> {
+    fn passes_per_level(&self) -> usize {
+        3
+    }
+
     fn advance_passes(&mut self, passes: usize) -> Result<bool> {
         let Some(payload) = self.stream.next_level()? else {
             return Ok(false);
@@ -173,7 +196,9 @@ impl LevelDecoder for EmcDecoder<'_> {
             )),
         }
     }
+}
 
+impl PartialLevels for EmcDecoder<'_> {
     fn advance_partial(&mut self) -> Result<bool> {
         let Some(payload) = self.stream.partial_level() else {
             return Ok(false);
@@ -185,10 +210,5 @@ impl LevelDecoder for EmcDecoder<'_> {
         }
         let after = self.state.depth.iter().map(|&d| d as usize).sum::<usize>();
         Ok(after > before)
-    }
-
-    fn mesh(&self) -> Result<LevelMesh> {
-        self.state
-            .shown_mesh(self.final_mesh.as_ref(), &self.header)
     }
 }

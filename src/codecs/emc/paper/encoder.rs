@@ -8,18 +8,17 @@ use super::super::clusters::{Clusters, SplitPlan};
 use super::super::state::{face_corrections, EmcState, NO_SPLIT};
 use super::super::EmcParams;
 use super::syntax::{self, EdgeCode};
-use crate::codecs::{Encoded, LevelRecord};
-use crate::coding::{BitLedger, BitSink, SyntaxClass};
-use crate::container::{Header, StreamWriter};
+use crate::codecs::{Encoded, Stat, Stats};
+use crate::coding::{BitSink, SyntaxClass};
+use crate::container::{Header, LevelCost, StreamWriter};
 use crate::hierarchy::octree::KeyTrie;
 use crate::mesh::CanonicalMesh;
-use std::collections::BTreeMap;
 
 /// Bits and counts per syntax element, for the paper's table. The per-operation counters are
 /// plain fields (the encoder's inner loop touches them); the rest are named once.
 #[derive(Default)]
 struct Tally {
-    counts: BTreeMap<String, f64>,
+    counts: Stats,
     refinement_bits: u64,
     connecting_flag_bits: u64,
     edge_code_bits: u64,
@@ -30,16 +29,21 @@ struct Tally {
 }
 
 impl Tally {
-    fn add(&mut self, key: &str, value: f64) {
-        *self.counts.entry(key.to_string()).or_default() += value;
+    fn add(&mut self, stat: Stat, value: f64) {
+        self.counts.add(stat, value);
     }
 
-    fn into_counts(mut self) -> BTreeMap<String, f64> {
+    fn into_counts(mut self) -> Stats {
         let fields = [
-            ("refinement_bits", self.refinement_bits),
-            ("connecting_flag_bits", self.connecting_flag_bits),
-            ("edge_code_bits", self.edge_code_bits),
-            ("split_distance_bits", self.split_distance_bits),
+            (Stat::RefinementBits, self.refinement_bits),
+            (Stat::ConnectingFlagBits, self.connecting_flag_bits),
+            (Stat::EdgeCodeBits, self.edge_code_bits),
+            (Stat::SplitDistanceBits, self.split_distance_bits),
+        ];
+        for (stat, value) in fields {
+            self.add(stat, value as f64);
+        }
+        let named = [
             ("splits", self.splits),
             ("edge_stay", self.edge_codes[EdgeCode::Stay as usize]),
             ("edge_move", self.edge_codes[EdgeCode::Move as usize]),
@@ -48,8 +52,8 @@ impl Tally {
                 self.edge_codes[EdgeCode::Duplicate as usize],
             ),
         ];
-        for (key, value) in fields {
-            self.add(key, value as f64);
+        for (key, value) in named {
+            self.counts.add_named(key, value as f64);
         }
         let distances = std::mem::take(&mut self.distances);
         for (d, &n) in distances.iter().enumerate().filter(|(_, &n)| n > 0) {
@@ -58,7 +62,7 @@ impl Tally {
             } else {
                 format!("distance_{d}")
             };
-            self.add(&key, n as f64);
+            self.counts.add_named(&key, n as f64);
         }
         self.counts
     }
@@ -75,11 +79,8 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
         ..Tally::default()
     };
     let mut writer = StreamWriter::new(&header);
-    let mut header_bytes = Vec::new();
-    header.write(&mut header_bytes);
-    tally.add("header_bytes", header_bytes.len() as f64);
-    let mut levels = Vec::with_capacity(order.levels as usize);
-    let mut total = BitLedger::default();
+    let mut payload_bytes = 0;
+    let final_triangles = mesh.face_count();
 
     for level in 1..=order.levels as usize {
         let mut sink = BitSink::default();
@@ -120,43 +121,47 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
             let corrections = face_corrections(mesh, &state, &clusters.ranges, &clusters.trie)?;
             let cliques = mesh.face_count() - corrections.double_sided.len()
                 + corrections.false_triangles.len();
-            tally.add("cliques", cliques as f64);
-            tally.add("false_triangles", corrections.false_triangles.len() as f64);
-            tally.add("double_sided_faces", corrections.double_sided.len() as f64);
+            tally.add(Stat::Cliques, cliques as f64);
             tally.add(
-                "orientation_exceptions",
+                Stat::FalseTriangles,
+                corrections.false_triangles.len() as f64,
+            );
+            tally.add(
+                Stat::DoubleSidedFaces,
+                corrections.double_sided.len() as f64,
+            );
+            tally.add(
+                Stat::OrientationExceptions,
                 corrections.orientation_exceptions.len() as f64,
             );
             let before = sink_total(&sink);
             syntax::put_list(&mut sink, &corrections.false_triangles);
             syntax::put_list(&mut sink, &corrections.double_sided);
             syntax::put_list(&mut sink, &corrections.orientation_exceptions);
-            tally.add("face_correction_bits", (sink_total(&sink) - before) as f64);
+            tally.add(
+                Stat::FaceCorrectionBits,
+                (sink_total(&sink) - before) as f64,
+            );
         }
         let (payload, ledger) = sink.finish();
-        writer.push_level(&payload);
-        total.connectivity += ledger.connectivity;
-        total.geometry += ledger.geometry;
-        levels.push((total, state.len(), 0usize));
-    }
-    let (bytes, ends) = writer.finish();
-    let final_triangles = mesh.face_count();
-    let levels = levels
-        .into_iter()
-        .zip(ends)
-        .enumerate()
-        .map(|(i, ((ledger, vertices, _), end_byte))| LevelRecord {
-            end_byte,
-            connectivity_bits: ledger.connectivity,
-            geometry_bits: ledger.geometry,
-            vertices,
-            triangles: if i + 1 == order.levels as usize {
-                final_triangles
-            } else {
-                0
+        payload_bytes += payload.len();
+        writer.push_level(
+            &payload,
+            LevelCost {
+                connectivity_bits: ledger.connectivity,
+                geometry_bits: ledger.geometry,
+                vertices: state.len(),
+                // The paper's decoder knows its triangles only once the last level is read.
+                triangles: if level == order.levels as usize {
+                    final_triangles
+                } else {
+                    0
+                },
             },
-        })
-        .collect();
+        );
+    }
+    let (bytes, levels) = writer.finish();
+    tally.add(Stat::HeaderBytes, (bytes.len() - payload_bytes) as f64);
     Ok(Encoded {
         bytes,
         levels,

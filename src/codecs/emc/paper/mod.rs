@@ -51,7 +51,7 @@ mod encoder;
 pub mod syntax;
 
 use super::{EmcParams, Syntax};
-use crate::codecs::{Codec, EncodeOptions, Encoded, LevelDecoder};
+use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
 use crate::container::StreamReader;
 use crate::error::Result;
 use crate::mesh::quantize::GridShape;
@@ -62,11 +62,11 @@ pub struct EmcPaper;
 
 impl Codec for EmcPaper {
     fn name(&self) -> &'static str {
-        "emc-paper"
+        names::EMC_PAPER.name
     }
 
     fn id(&self) -> u8 {
-        1
+        names::EMC_PAPER.id
     }
 
     fn summary(&self) -> &'static str {
@@ -80,14 +80,22 @@ impl Codec for EmcPaper {
         }
     }
 
-    fn encode(&self, mesh: &CanonicalMesh, _options: &EncodeOptions) -> Result<Encoded> {
+    fn capabilities(&self) -> &'static [Capability] {
+        &[Capability::PassStops, Capability::PartialLevels]
+    }
+
+    fn measure(&self, _stream: &[u8]) -> Result<Stats> {
+        Ok(Stats::default())
+    }
+
+    fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         let params = EmcParams::for_mesh(mesh);
         let header = params.header(Syntax::Paper, self.id(), mesh);
         encoder::encode(mesh, &params, header)
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
-        let params = EmcParams::from_header(stream.header(), Syntax::Paper)?;
+        let params = EmcParams::from_stream(&stream, Syntax::Paper)?;
         Ok(Box::new(decoder::EmcDecoder::new(stream, params.order)))
     }
 }

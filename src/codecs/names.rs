@@ -1,0 +1,46 @@
+//! The one place that names the codecs of this build and the ids their streams carry
+//! (docs/FORMAT.md §1). An id, once written into streams, is never given to another codec.
+
+/// A codec's name on the command line and in results/, and its id in stream headers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Naming {
+    /// Name on the command line and in results/.
+    pub name: &'static str,
+    /// Codec id in the stream header.
+    pub id: u8,
+}
+
+/// The uncompressed baseline.
+pub const RAW: Naming = Naming { name: "raw", id: 0 };
+/// Magnor & Girod's embedded mesh coding as published.
+pub const EMC_PAPER: Naming = Naming {
+    name: "emc-paper",
+    id: 1,
+};
+/// Hoppe's progressive meshes in collapse order.
+pub const PM: Naming = Naming { name: "pm", id: 2 };
+/// Hoppe's progressive meshes, reordered.
+pub const PM_REORDERED: Naming = Naming {
+    name: "pm-reordered",
+    id: 3,
+};
+/// Embedded mesh coding, context-modelled.
+pub const EMC: Naming = Naming { name: "emc", id: 4 };
+
+/// Every codec of this build.
+pub const ALL: [Naming; 5] = [RAW, EMC_PAPER, PM, PM_REORDERED, EMC];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_and_ids_are_unique() {
+        for (i, a) in ALL.iter().enumerate() {
+            for b in &ALL[i + 1..] {
+                assert_ne!(a.name, b.name);
+                assert_ne!(a.id, b.id, "{} and {}", a.name, b.name);
+            }
+        }
+    }
+}

@@ -1,0 +1,172 @@
+//! What a run measured: the result files of results/ (docs/CONTRACT.md §6), their names, and
+//! their CSV and text forms. Harness, plots and tables all read these types; none of them
+//! imports another for them.
+
+use crate::codecs::{EncodeOptions, Stats};
+use crate::error::{Error, Result};
+use crate::mesh::quantize::GridShape;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// One level of a run (docs/CONTRACT.md §6).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LevelRow {
+    /// Level number, from 1 (level 0 would be the empty stream).
+    pub level: usize,
+    /// Bits from the stream's first byte to the end of this level.
+    pub bits: u64,
+    /// Connectivity bits up to this level.
+    pub connectivity_bits: u64,
+    /// Geometry bits up to this level.
+    pub geometry_bits: u64,
+    /// Vertices of the decoded level.
+    pub vertices: usize,
+    /// Triangles of the decoded level.
+    pub triangles: usize,
+    /// `bits` over the full mesh's vertex count.
+    pub bits_per_vertex: f64,
+    /// `bits` over the full mesh's triangle count.
+    pub bits_per_triangle: f64,
+    /// Symmetric Hausdorff distance over the original's bounding-box diagonal.
+    pub hausdorff: Option<f64>,
+    /// RMS distance over both directions' samples, over the diagonal.
+    pub rms: Option<f64>,
+    /// Largest original-vertex-to-level distance, over the diagonal (EMC's measure).
+    pub hausdorff_paper: Option<f64>,
+}
+
+/// One codec on one mesh (docs/CONTRACT.md §6), as stored in results/<codec>/<mesh>.json.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    /// Codec name.
+    pub codec: String,
+    /// Mesh name (file stem).
+    pub mesh: String,
+    /// Path the mesh was read from.
+    pub source: String,
+    /// Vertices of the canonical mesh at `quant_bits`.
+    pub vertices: usize,
+    /// Triangles of the canonical mesh at `quant_bits`.
+    pub triangles: usize,
+    /// Quantization bits per axis.
+    pub quant_bits: u8,
+    /// Stream size.
+    pub bytes: usize,
+    /// Wall-clock time of the encoder (canonical mesh in, bytes out).
+    pub encode_seconds: f64,
+    /// Wall-clock time to decode every level (best of a few runs for short decodes).
+    pub decode_seconds: f64,
+    /// Whether the full decode equals the canonical mesh exactly.
+    pub lossless: bool,
+    /// What differed, when not lossless.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lossless_error: Option<String>,
+    /// Grid shape used.
+    #[serde(default)]
+    pub grid: GridShape,
+    /// Random samples per original triangle used by the metrics.
+    #[serde(default)]
+    pub samples_per_triangle: usize,
+    /// Codec-specific counts: bits per syntax element, operation counts.
+    #[serde(default, skip_serializing_if = "Stats::is_empty")]
+    pub codec_stats: Stats,
+    /// Per-level rows.
+    pub levels: Vec<LevelRow>,
+}
+
+impl RunResult {
+    /// Whole-stream bits per vertex of the canonical mesh.
+    pub fn bits_per_vertex(&self) -> f64 {
+        self.bytes as f64 * 8.0 / self.vertices as f64
+    }
+
+    /// Whole-stream bits per triangle of the canonical mesh.
+    pub fn bits_per_triangle(&self) -> f64 {
+        self.bytes as f64 * 8.0 / self.triangles as f64
+    }
+}
+
+/// File stem of a run's results: the mesh name, with `-q<bits>` when the quantization is not the
+/// codec's default and `-per-axis` / `-cubic` when the grid is not.
+pub fn result_stem(defaults: &EncodeOptions, result: &RunResult) -> String {
+    let mut stem = result.mesh.clone();
+    if result.quant_bits != defaults.quant_bits {
+        stem.push_str(&format!("-q{}", result.quant_bits));
+    }
+    if result.grid != defaults.grid {
+        stem.push_str(match result.grid {
+            GridShape::Cubic => "-cubic",
+            GridShape::PerAxis => "-per-axis",
+        });
+    }
+    stem
+}
+
+/// The level rows as CSV.
+pub fn levels_csv(result: &RunResult) -> String {
+    let opt = |v: Option<f64>| v.map(|x| format!("{x:e}")).unwrap_or_default();
+    let mut csv = String::from(
+        "level,bits,connectivity_bits,geometry_bits,vertices,triangles,bits_per_vertex,\
+         bits_per_triangle,hausdorff,rms,hausdorff_paper\n",
+    );
+    for r in &result.levels {
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{:.4},{:.4},{},{},{}\n",
+            r.level,
+            r.bits,
+            r.connectivity_bits,
+            r.geometry_bits,
+            r.vertices,
+            r.triangles,
+            r.bits_per_vertex,
+            r.bits_per_triangle,
+            opt(r.hausdorff),
+            opt(r.rms),
+            opt(r.hausdorff_paper)
+        ));
+    }
+    csv
+}
+
+/// The level table printed by `experiment`.
+pub fn level_table(result: &RunResult) -> String {
+    let opt = |v: Option<f64>| v.map(|x| format!("{x:.3e}")).unwrap_or_else(|| "-".into());
+    let mut out = format!(
+        "{:>5} {:>9} {:>9} {:>11} {:>8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>10}\n",
+        "level",
+        "vertices",
+        "triangles",
+        "bits",
+        "bpv",
+        "bpt",
+        "conn bpv",
+        "geom bpv",
+        "hausdorff",
+        "rms",
+        "paper"
+    );
+    let v = result.vertices as f64;
+    for r in &result.levels {
+        out.push_str(&format!(
+            "{:>5} {:>9} {:>9} {:>11} {:>8.3} {:>8.3} {:>9.3} {:>9.3} {:>10} {:>10} {:>10}\n",
+            r.level,
+            r.vertices,
+            r.triangles,
+            r.bits,
+            r.bits_per_vertex,
+            r.bits_per_triangle,
+            r.connectivity_bits as f64 / v,
+            r.geometry_bits as f64 / v,
+            opt(r.hausdorff),
+            opt(r.rms),
+            opt(r.hausdorff_paper)
+        ));
+    }
+    out
+}
+
+/// Reads a result file.
+pub fn read_result(path: &Path) -> Result<RunResult> {
+    let text = std::fs::read_to_string(path)?;
+    serde_json::from_str(&text).map_err(|e| Error::Unsupported(format!("not a result file: {e}")))
+}
