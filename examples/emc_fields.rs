@@ -7,7 +7,7 @@ use meshcodec::codecs::{self, EncodeOptions};
 use meshcodec::mesh::io::{read_mesh, resolve};
 use meshcodec::mesh::quantize::GridShape;
 
-fn main() -> anyhow::Result<()> {
+fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let codec = codecs::by_name(&args.next().unwrap_or_else(|| "emc".into()))?;
     let mut meshes: Vec<String> = args.collect();

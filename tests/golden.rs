@@ -1,0 +1,185 @@
+//! Golden streams and rate pins: an accidental change to the bytes a codec writes, or to how
+//! well it compresses, fails here.
+//!
+//! - `tests/golden/v<FORMAT_VERSION>/<codec>-<mesh>.mc` is each codec's stream of a small shared
+//!   mesh at its default quantization, and `<mesh>-q<bits>.ply` the canonical mesh it decodes to.
+//!   The encoder must reproduce every stream byte for byte, and each stream must decode exactly
+//!   to that canonical mesh (docs/CONTRACT.md §3: same cells, same oriented faces).
+//! - `tests/golden/rates.txt` pins each codec's bits per vertex on three meshes; a codec that
+//!   codes any of them in more bits fails.
+//!
+//! Both are regenerated on purpose with `UPDATE_GOLDEN=1 cargo test --release --test golden`,
+//! which a change of syntax must come with (and a new format version: docs/FORMAT.md, History).
+
+use meshcodec::codecs::{self, Codec, Stop};
+use meshcodec::container::FORMAT_VERSION;
+use meshcodec::mesh::io::{read_mesh, resolve, write_mesh};
+use meshcodec::mesh::CanonicalMesh;
+use meshcodec::Error;
+use std::fmt::Write as _;
+use std::path::PathBuf;
+
+/// Small shared meshes every codec takes: a closed genus-2 surface and a bust of three
+/// components.
+const GOLDEN_MESHES: [&str; 2] = ["eight", "beethoven"];
+/// Meshes whose rates are pinned.
+const RATE_MESHES: [&str; 3] = ["eight", "beethoven", "spot"];
+
+fn golden_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden")
+        .join(format!("v{FORMAT_VERSION}"))
+}
+
+fn rates_file() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden/rates.txt")
+}
+
+fn updating() -> bool {
+    std::env::var_os("UPDATE_GOLDEN").is_some_and(|v| v == "1")
+}
+
+fn canonical(codec: &dyn Codec, mesh: &str) -> CanonicalMesh {
+    let path = resolve(mesh).unwrap_or_else(|e| panic!("{mesh}: {e}"));
+    let original = read_mesh(&path).unwrap();
+    codecs::canonical_for(&original, &codec.default_options()).unwrap()
+}
+
+#[test]
+fn encoders_reproduce_the_golden_streams_and_these_decode_exactly() {
+    let dir = golden_dir();
+    if updating() {
+        std::fs::create_dir_all(&dir).unwrap();
+    }
+    let mut failures = Vec::new();
+    for codec in codecs::registry() {
+        for mesh in GOLDEN_MESHES {
+            let canonical = canonical(codec, mesh);
+            let bytes = codec.encode(&canonical).unwrap().bytes;
+            let stream_path = dir.join(format!("{}-{mesh}.mc", codec.name()));
+            let mesh_path = dir.join(format!("{mesh}-q{}.ply", canonical.grid.bits));
+            if updating() {
+                std::fs::write(&stream_path, &bytes).unwrap();
+                write_mesh(&canonical.to_mesh(), &mesh_path).unwrap();
+            }
+            let Ok(golden) = std::fs::read(&stream_path) else {
+                failures.push(format!(
+                    "{} missing (make it with UPDATE_GOLDEN=1)",
+                    stream_path.display()
+                ));
+                continue;
+            };
+            if golden != bytes {
+                let first = golden.iter().zip(&bytes).position(|(a, b)| a != b);
+                failures.push(format!(
+                    "{} on {mesh}: the encoder's {} bytes differ from the golden stream's {} (first at byte {})",
+                    codec.name(),
+                    bytes.len(),
+                    golden.len(),
+                    first.unwrap_or(golden.len().min(bytes.len()))
+                ));
+            }
+            // The stored canonical mesh, on the stream's grid (its cell centres re-quantize
+            // exactly), must be today's canonical mesh, and the golden stream must decode to it.
+            let stored = CanonicalMesh::new(&read_mesh(&mesh_path).unwrap(), canonical.grid).unwrap();
+            if stored.normal_form() != canonical.normal_form() {
+                failures.push(format!(
+                    "{}: not the canonical mesh of {mesh} at {} bits",
+                    mesh_path.display(),
+                    canonical.grid.bits
+                ));
+            }
+            match codecs::decode(&golden, Stop::All) {
+                Ok((decoded, _)) => {
+                    if let Err(e) = stored.check_lossless(&decoded.mesh) {
+                        failures.push(format!(
+                            "{} on {mesh}: the golden stream does not decode to {}: {e}",
+                            codec.name(),
+                            mesh_path.display()
+                        ));
+                    }
+                }
+                Err(e) => failures.push(format!(
+                    "{} on {mesh}: the golden stream does not decode: {e}",
+                    codec.name()
+                )),
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn streams_of_another_format_version_are_refused_in_one_line() {
+    let codec = codecs::by_name("raw").unwrap();
+    let mut bytes = codec.encode(&canonical(codec, "eight")).unwrap().bytes;
+    for version in [0, FORMAT_VERSION - 1, FORMAT_VERSION + 1, 255] {
+        bytes[4] = version;
+        match codecs::decode(&bytes, Stop::All) {
+            Err(e @ Error::Unsupported(_)) => {
+                let text = e.to_string();
+                assert!(!text.contains('\n'), "{text}");
+                assert!(text.contains(&format!("version {version}")), "{text}");
+            }
+            other => panic!("version {version}: {:?}", other.map(|(_, n)| n)),
+        }
+    }
+}
+
+/// (codec, mesh, bits per vertex) rows of the pin file.
+fn pinned_rates() -> Vec<(String, String, f64)> {
+    let text = std::fs::read_to_string(rates_file()).unwrap_or_default();
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| {
+            let cells: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!(cells.len(), 3, "bad rate pin line: {l}");
+            (
+                cells[0].to_string(),
+                cells[1].to_string(),
+                cells[2].parse().expect("bits per vertex"),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn no_codec_codes_a_pinned_mesh_in_more_bits_than_its_pin() {
+    let mut measured = Vec::new();
+    for codec in codecs::registry() {
+        for mesh in RATE_MESHES {
+            let canonical = canonical(codec, mesh);
+            let bytes = codec.encode(&canonical).unwrap().bytes.len();
+            let bpv = bytes as f64 * 8.0 / canonical.vertex_count() as f64;
+            measured.push((codec.name().to_string(), mesh.to_string(), bpv));
+        }
+    }
+    if updating() {
+        let mut text = String::from(
+            "# Bits per vertex of each codec's whole stream at its default quantization.\n\
+             # A codec that needs more on any of these meshes fails tests/golden.rs; regenerate\n\
+             # on purpose with UPDATE_GOLDEN=1 cargo test --release --test golden.\n",
+        );
+        for (codec, mesh, bpv) in &measured {
+            let _ = writeln!(text, "{codec:<14} {mesh:<10} {bpv:.4}");
+        }
+        std::fs::write(rates_file(), text).unwrap();
+    }
+    let pins = pinned_rates();
+    let mut failures = Vec::new();
+    for (codec, mesh, bpv) in &measured {
+        match pins.iter().find(|(c, m, _)| c == codec && m == mesh) {
+            // Pins are written to 4 decimals; allow for that rounding only.
+            Some((_, _, pin)) if *bpv > pin + 0.00005 => failures.push(format!(
+                "{codec} on {mesh}: {bpv:.4} bits/vertex, pinned at {pin:.4} (+{:.2}%)",
+                (bpv / pin - 1.0) * 100.0
+            )),
+            Some(_) => {}
+            None => failures.push(format!(
+                "{codec} on {mesh}: no pin in {} (make it with UPDATE_GOLDEN=1)",
+                rates_file().display()
+            )),
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
