@@ -81,7 +81,8 @@ fn encoders_reproduce_the_golden_streams_and_these_decode_exactly() {
             }
             // The stored canonical mesh, on the stream's grid (its cell centres re-quantize
             // exactly), must be today's canonical mesh, and the golden stream must decode to it.
-            let stored = CanonicalMesh::new(&read_mesh(&mesh_path).unwrap(), canonical.grid).unwrap();
+            let stored =
+                CanonicalMesh::new(&read_mesh(&mesh_path).unwrap(), canonical.grid).unwrap();
             if stored.normal_form() != canonical.normal_form() {
                 failures.push(format!(
                     "{}: not the canonical mesh of {mesh} at {} bits",
