@@ -112,7 +112,8 @@ impl Index {
         self.units.is_empty()
     }
 
-    fn write(&self, out: &mut Vec<u8>) {
+    /// Appends the index's bytes to `out`.
+    pub fn write(&self, out: &mut Vec<u8>) {
         varint::put(out, self.units.len() as u64);
         varint::put(out, self.payload_bytes);
         for (i, unit) in self.units.iter().enumerate() {

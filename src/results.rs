@@ -35,7 +35,7 @@ pub struct LevelRow {
     pub hausdorff_paper: Option<f64>,
 }
 
-/// One codec on one mesh (docs/CONTRACT.md §6), as stored in results/<codec>/<mesh>.json.
+/// One codec on one mesh (docs/CONTRACT.md §6), as stored in `results/<codec>/<mesh>.json`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunResult {
     /// Codec name.

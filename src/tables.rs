@@ -177,7 +177,7 @@ pub fn emc_table1(results: &Path, out: &Path) -> Result<PathBuf> {
     }
     let _ = writeln!(md, "\nThe rendered levels are in [emc-fig5.png](emc-fig5.png); the rate-resolution curves (Fig. 4) in [emc-fig4.png](emc-fig4.png).");
     let _ = writeln!(md, "\n## What exact losslessness costs beyond the paper\n");
-    let _ = writeln!(md, "The paper's decoder outputs every 3-clique; ours then applies three correction lists coded in the last level (see `src/codecs/emc/paper/mod.rs`), so that the full decode equals the canonical mesh exactly (DESIGN.md A2). They are connectivity bits, not included in Conn. bits above.\n");
+    let _ = writeln!(md, "The paper's decoder outputs every 3-clique; ours then applies three correction lists coded in the last level (see `src/codecs/emc/paper/mod.rs`), so that the full decode equals the canonical mesh exactly (docs/CONTRACT.md §3). They are connectivity bits, not included in Conn. bits above.\n");
     let _ = writeln!(md, "| mesh | faces | 3-cliques | false triangles | double-sided faces | orientation exceptions | correction bits | header bytes | stream bytes | lossless |");
     let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     md.push_str(&extras);
@@ -581,7 +581,7 @@ pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
         "# EMC against the anchors: lossless bits per vertex at 12 bits\n"
     );
     let _ = writeln!(md, "Regenerate: `{ANCHORS_COMMAND}` (our codecs, then Draco through DracoPy in the same run, then this table).\n");
-    let _ = writeln!(md, "Every row of ours is the full decode of the stream on the 12-bit cubic grid of DESIGN.md A2 (bits over the canonical mesh's vertex count; bunny.ply has 34,834 referenced vertices). Draco (DracoPy, compression_level 10, quantization_bits 12) is single-rate, quantizes on its own grid and is not checked for losslessness; its split between connectivity and geometry is not reported by DracoPy. Decode rates are one thread on this machine (Draco's from Python, best of five).\n");
+    let _ = writeln!(md, "Every row of ours is the full decode of the stream on the 12-bit cubic grid of docs/CONTRACT.md §1 (bits over the canonical mesh's vertex count; bunny.ply has 34,834 referenced vertices). Draco (DracoPy, compression_level 10, quantization_bits 12) is single-rate, quantizes on its own grid and is not checked for losslessness; its split between connectivity and geometry is not reported by DracoPy. Decode rates are one thread on this machine (Draco's from Python, best of five).\n");
     for mesh in ["bunny", "armadillo-43k"] {
         let _ = writeln!(md, "## {mesh}\n");
         let _ = writeln!(

@@ -1,5 +1,5 @@
 //! Bad input through the binaries: every fault exits 1 with one line on stderr naming the file,
-//! writes no output file, and never panics (DESIGN.md A6).
+//! writes no output file, and never panics (docs/CONTRACT.md §7).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -156,6 +156,69 @@ fn garbage_and_cut_streams_fail_cleanly() {
     let whole = run(MESHCODEC, &["decode", "b.mc", "out.obj"], d);
     assert_eq!(whole.code, Some(0), "{}", whole.stderr);
     assert!(d.join("out.obj").exists());
+}
+
+/// `stream` with its index replaced by `edit` of it.
+fn with_index(stream: &[u8], edit: impl Fn(&mut meshcodec::container::Index)) -> Vec<u8> {
+    let (header, mut index, payload_start) =
+        meshcodec::container::read_header_and_index(stream).unwrap();
+    edit(&mut index);
+    let mut out = Vec::new();
+    header.write(&mut out);
+    index.write(&mut out);
+    out.extend_from_slice(&stream[payload_start..]);
+    out
+}
+
+#[test]
+fn foreign_versions_lying_indexes_and_impossible_stops_fail_cleanly() {
+    let dir = scratch();
+    let d = dir.path();
+    let encoded = run(MESHCODEC, &["encode", "--codec", "emc", "eight", "e.mc"], d);
+    assert_eq!(encoded.code, Some(0), "{}", encoded.stderr);
+    let stream = std::fs::read(d.join("e.mc")).unwrap();
+    let mut old = stream.clone();
+    old[4] = 1;
+    let past = with_index(&stream, |index| index.units[11].length += 1000);
+    let overlapping = with_index(&stream, |index| {
+        index.units[4].offset = index.units[3].offset;
+    });
+    let cases: [(&str, &[u8], &str); 3] = [
+        ("old.mc", &old, "format version 1"),
+        ("past.mc", &past, "runs past"),
+        ("overlapping.mc", &overlapping, "overlap"),
+    ];
+    for (name, bytes, mentions) in cases {
+        write(d, name, bytes);
+        for args in [
+            &["decode", name, "out.ply"][..],
+            &["info", name][..],
+            &["info", name, "--json"][..],
+        ] {
+            assert_clean_failure(&run(MESHCODEC, args, d), mentions);
+            assert!(!d.join("out.ply").exists());
+        }
+    }
+    // Stops the stream or the codec cannot honour are refused, not approximated.
+    assert_clean_failure(
+        &run(
+            MESHCODEC,
+            &["decode", "e.mc", "out.ply", "--level", "13"],
+            d,
+        ),
+        "the stream has 12 levels",
+    );
+    let raw = run(MESHCODEC, &["encode", "--codec", "raw", "eight", "r.mc"], d);
+    assert_eq!(raw.code, Some(0), "{}", raw.stderr);
+    assert_clean_failure(
+        &run(
+            MESHCODEC,
+            &["decode", "r.mc", "out.ply", "--passes", "2"],
+            d,
+        ),
+        "cannot stop inside a level",
+    );
+    assert!(!d.join("out.ply").exists());
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //!
 //! A target fails (panics) only when meshcodec breaks a promise: a decoder or reader panics, a
 //! decoded mesh is not a valid mesh within the header's counts, or an encode → decode round trip
-//! is not lossless (DESIGN.md A2). Errors returned for bad input are the expected outcome.
+//! is not lossless (docs/CONTRACT.md §3). Errors returned for bad input are the expected outcome.
 
 use arbitrary::{Arbitrary, Result as ArbitraryResult, Unstructured};
 use meshcodec::codecs::pm::iter::PMeshIter;
@@ -301,7 +301,7 @@ impl<'a> Arbitrary<'a> for GeneratedMesh {
 }
 
 /// Encodes `input` with every codec that accepts it and checks that the full decode is lossless
-/// (DESIGN.md A2) and that every level decodes to a valid mesh; then decodes the stream again
+/// (docs/CONTRACT.md §3) and that every level decodes to a valid mesh; then decodes the stream again
 /// with the input's edits applied.
 pub fn round_trip(input: &GeneratedMesh) {
     let options = EncodeOptions {

@@ -33,7 +33,7 @@ struct Settings {
     /// Quantization bits per axis (default: the codec's).
     #[arg(long)]
     quant: Option<u8>,
-    /// Grid shape: cubic (DESIGN.md A2) or per-axis.
+    /// Grid shape: cubic (docs/CONTRACT.md §1) or per-axis.
     #[arg(long, value_parser = meshcodec::cli::parse_grid)]
     grid: Option<GridShape>,
     /// Random samples per original triangle for the error metrics.
@@ -42,7 +42,7 @@ struct Settings {
     /// Folder for results.
     #[arg(long, default_value = "results")]
     out: PathBuf,
-    /// Also write the stream as results/<codec>/<stem>.mc (figures decode it).
+    /// Also write the stream as results/CODEC/STEM.mc (figures decode it).
     #[arg(long)]
     keep_stream: bool,
 }

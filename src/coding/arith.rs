@@ -231,7 +231,7 @@ impl ArithEncoder {
         context.update(bit);
     }
 
-    /// Codes three bits at once ([`Triple`]), `bits[k]` under `contexts[index[k]]`; adapts the
+    /// Codes three bits at once (one three-bit symbol, docs/FORMAT.md §3.2), `bits[k]` under `contexts[index[k]]`; adapts the
     /// contexts in that order afterwards.
     pub fn bits3(
         &mut self,

@@ -8,7 +8,7 @@ pub mod varint;
 
 pub use bits::{BitSink, BitSource};
 
-/// What a syntax element describes, for the rate split of DESIGN.md A4.
+/// What a syntax element describes, for the rate split of docs/CONTRACT.md §5.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SyntaxClass {
     /// Which vertices form which faces (and, for progressive codecs, how they split).

@@ -2,7 +2,7 @@
 //! two transformations, vsplit and its inverse ecol, applied in place.
 //!
 //! Conventions (ours, in Hoppe's vocabulary). Faces are counter-clockwise; `nei[k]` is the face
-//! across edge (v[k], v[k+1]). A vsplit of vertex vs creates vt and the faces
+//! across edge `(v[k], v[k+1])`. A vsplit of vertex vs creates vt and the faces
 //! fl = (vs, vl, vt) and, unless vr is nil, fr = (vs, vt, vr). Around vs, counter-clockwise from vl
 //! to vr, lie the faces that move to vt; `flclw` is the first of them (the face (vs, vl, ·)),
 //! `vs_index` is vs's corner in it, and `vlr_rot` counts the further faces to reach vr. When no
@@ -19,7 +19,7 @@ pub const NIL: u32 = u32::MAX;
 pub struct Face {
     /// Corners, counter-clockwise.
     pub v: [u32; 3],
-    /// `nei[k]`: the face across edge (v[k], v[(k+1) % 3]), or [`NIL`] on a boundary.
+    /// `nei[k]`: the face across edge `(v[k], v[(k+1) % 3])`, or [`NIL`] on a boundary.
     pub nei: [u32; 3],
 }
 

@@ -1,4 +1,4 @@
-//! The canonical mesh at Q bits (DESIGN.md A2) and the one test of losslessness.
+//! The canonical mesh at Q bits (docs/CONTRACT.md §2) and the one test of losslessness.
 //!
 //! Canonical mesh: drop unreferenced vertices; quantize; weld vertices that share a cell; drop
 //! faces that then repeat a vertex; drop repeated faces (the same oriented triangle up to

@@ -1,4 +1,4 @@
-//! The quantization grid of DESIGN.md A2.
+//! The quantization grid of docs/CONTRACT.md §1.
 //!
 //! Cell index q = min(floor((x − origin) / c), 2^Q − 1) per axis; a decoded vertex sits at the
 //! cell centre origin + (q + ½)c, so decoded positions re-quantize to the same cell.
@@ -15,7 +15,7 @@ pub const MAX_QUANT_BITS: u8 = 30;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "kebab-case")]
 pub enum GridShape {
-    /// One cell size on every axis: (largest extent) / 2^Q, as Draco (DESIGN.md A2 default).
+    /// One cell size on every axis: (largest extent) / 2^Q, as Draco (the default: docs/CONTRACT.md §1).
     #[default]
     Cubic,
     /// Each axis divided into 2^Q cells of its own extent (EMC's box).

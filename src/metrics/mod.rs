@@ -1,4 +1,4 @@
-//! Metrics of DESIGN.md A4: surface sampling, exact point-to-surface distance through a BVH, and
+//! Metrics of docs/CONTRACT.md §5: surface sampling, exact point-to-surface distance through a BVH, and
 //! the symmetric Hausdorff / RMS / paper measures of a decoded level against the original.
 
 pub mod distance;
@@ -11,7 +11,7 @@ use crate::codecs::LevelMesh;
 use crate::mesh::TriMesh;
 use serde::Serialize;
 
-/// Samples per original triangle when the user does not say (DESIGN.md A4).
+/// Samples per original triangle when the user does not say (docs/CONTRACT.md §5).
 pub const DEFAULT_SAMPLES_PER_TRIANGLE: usize = 10;
 /// Seed of the sampler, so that every run measures the same points.
 pub const DEFAULT_SEED: u64 = 0x5eed_f3e5;

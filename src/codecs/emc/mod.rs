@@ -20,8 +20,8 @@
 //! | RF, Refinement | one bit: which half of its cell a vertex takes at a step |
 //! | VM, Vertex Merge (bottom-up) / VS, Vertex Split (top-down) | `EmcState::split`: the old vertex keeps the left half, a new vertex takes the right |
 //! | connecting edge | one flag bit per split |
-//! | STAY / MOVE / DUPLICATE | [`syntax::EdgeCode`], one per neighbour of the splitting vertex |
-//! | distance to the next split, fixed Huffman table | [`syntax::SPLIT_DISTANCE_CODE_LENGTHS`]; symbol 0 = "no further split" |
+//! | STAY / MOVE / DUPLICATE | [`paper::syntax::EdgeCode`], one per neighbour of the splitting vertex |
+//! | distance to the next split, fixed Huffman table | [`paper::syntax::SPLIT_DISTANCE_CODE_LENGTHS`]; symbol 0 = "no further split" |
 //! | triangles from edges | `hierarchy::cliques`: every 3-clique of the edge graph |
 //!
 //! # The direction order
@@ -33,7 +33,7 @@
 //!
 //! # Grids
 //! `--grid per-axis` is the paper's box (each axis divided into 2^L cells of its own length);
-//! `--grid cubic` (the default) is the cubic grid of DESIGN.md A2 used to compare codecs. With the
+//! `--grid cubic` (the default) is the cubic grid of docs/CONTRACT.md §1 used to compare codecs. With the
 //! cubic grid the shorter axes start inside the box's first half, and their first refinement bits
 //! are the same for every vertex.
 //!

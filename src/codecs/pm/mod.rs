@@ -23,7 +23,7 @@
 //! doubling per level, the last level reaching Mⁿ. Every field is arithmetic-coded with an
 //! adaptive binary context of its own ([`syntax`]); the coder is flushed per level.
 //!
-//! Positions are the canonical mesh's cells (DESIGN.md A2, 16 bits by default as Hoppe §6.2), so
+//! Positions are the canonical mesh's cells (docs/CONTRACT.md §2, 16 bits by default as Hoppe §6.2), so
 //! the full level is lossless. Wedges (normals, texture coordinates) and material ids are not
 //! coded: the shared meshes carry none that the canonical mesh keeps; the `Vsplit` record leaves
 //! room for Hoppe's `corners` and `matid_predict` fields after `ii`.

@@ -1,5 +1,5 @@
 //! Mesh files: readers for OBJ, PLY, OFF, STL and Hoppe's `.m`; writers for PLY and OBJ; and the
-//! lookup of mesh names in the data folders (DESIGN.md A1).
+//! lookup of mesh names in the data folders (`$MESHCODEC_DATA`, then ../shared/meshes).
 //!
 //! Readers return the mesh as stored (unreferenced vertices kept where the format keeps them),
 //! validated: finite coordinates, indices in range, at least one face.

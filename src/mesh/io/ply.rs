@@ -80,7 +80,7 @@ impl PropertyAccess for Record {
 
 pub fn read(bytes: &[u8]) -> Result<TriMesh> {
     let parser = Parser::<Record>::new();
-    // ply-rs reports over several lines; errors here are one line (DESIGN.md A6).
+    // ply-rs reports over several lines; errors here are one line (docs/CONTRACT.md §7).
     let fault = |e: ply_rs_bw::parser::ParseError| {
         Error::mesh(format!("PLY: {}", one_line(&e.to_string())))
     };
