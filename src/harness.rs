@@ -8,7 +8,7 @@ use crate::mesh::io::{mesh_name, read_mesh};
 use crate::mesh::quantize::GridShape;
 use crate::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
 use crate::plot;
-use crate::results::{levels_csv, LevelRow, RunResult};
+use crate::results::{self, levels_csv, LevelRow, RunResult};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -175,12 +175,12 @@ fn progress_bar(show: bool, levels: usize, codec: &str, path: &Path) -> indicati
 /// Writes `<out>/<codec>/<stem>.json`, `.csv` and the two plots (PNG and SVG); returns the
 /// paths written.
 pub fn write_result(result: &RunResult, stem: &str, out: &Path) -> Result<Vec<PathBuf>> {
-    let dir = out.join(&result.codec);
-    std::fs::create_dir_all(&dir)?;
-    let json_path = dir.join(format!("{stem}.json"));
+    std::fs::create_dir_all(out.join(&result.codec))?;
+    let file = |suffix: &str| results::path(out, &result.codec, stem, suffix);
+    let json_path = file(".json");
     let json = serde_json::to_string_pretty(result).map_err(std::io::Error::other)?;
     crate::mesh::io::write_atomically(&json_path, format!("{json}\n").as_bytes())?;
-    let csv_path = dir.join(format!("{stem}.csv"));
+    let csv_path = file(".csv");
     crate::mesh::io::write_atomically(&csv_path, levels_csv(result).as_bytes())?;
     let mut written = vec![json_path, csv_path];
     let title = format!(
@@ -188,11 +188,7 @@ pub fn write_result(result: &RunResult, stem: &str, out: &Path) -> Result<Vec<Pa
         result.codec, result.mesh, result.quant_bits
     );
     let runs = std::slice::from_ref(result);
-    written.extend(
-        plot::rate_resolution(runs, &title).draw(&dir.join(format!("{stem}-rate-resolution")))?,
-    );
-    written.extend(
-        plot::rate_distortion(runs, &title).draw(&dir.join(format!("{stem}-rate-distortion")))?,
-    );
+    written.extend(plot::rate_resolution(runs, &title).draw(&file("-rate-resolution"))?);
+    written.extend(plot::rate_distortion(runs, &title).draw(&file("-rate-distortion"))?);
     Ok(written)
 }

@@ -6,7 +6,7 @@ use crate::codecs::{EncodeOptions, Stats};
 use crate::error::{Error, Result};
 use crate::mesh::quantize::GridShape;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// One level of a run (docs/CONTRACT.md §6).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -87,19 +87,39 @@ impl RunResult {
 }
 
 /// File stem of a run's results: the mesh name, with `-q<bits>` when the quantization is not the
-/// codec's default and `-per-axis` / `-cubic` when the grid is not.
-pub fn result_stem(defaults: &EncodeOptions, result: &RunResult) -> String {
-    let mut stem = result.mesh.clone();
-    if result.quant_bits != defaults.quant_bits {
-        stem.push_str(&format!("-q{}", result.quant_bits));
+/// codec's default (`defaults`) and `-per-axis` / `-cubic` when the grid is not.
+pub fn stem(defaults: &EncodeOptions, mesh: &str, quantization: &EncodeOptions) -> String {
+    let mut stem = mesh.to_string();
+    if quantization.quant_bits != defaults.quant_bits {
+        stem.push_str(&format!("-q{}", quantization.quant_bits));
     }
-    if result.grid != defaults.grid {
-        stem.push_str(match result.grid {
+    if quantization.grid != defaults.grid {
+        stem.push_str(match quantization.grid {
             GridShape::Cubic => "-cubic",
             GridShape::PerAxis => "-per-axis",
         });
     }
     stem
+}
+
+/// [`stem`] of a run's result.
+pub fn result_stem(defaults: &EncodeOptions, result: &RunResult) -> String {
+    let quantization = EncodeOptions {
+        quant_bits: result.quant_bits,
+        grid: result.grid,
+    };
+    stem(defaults, &result.mesh, &quantization)
+}
+
+/// `<results>/<codec>/<stem><suffix>`: where every file of a run lives (`.json`, `.csv`, `.mc`,
+/// `-rate-resolution.png`, …).
+pub fn path(results: &Path, codec: &str, stem: &str, suffix: &str) -> PathBuf {
+    results.join(codec).join(format!("{stem}{suffix}"))
+}
+
+/// Where an experiment set leaves the reason `codec` refused `mesh`.
+pub fn refusal_path(results: &Path, codec: &str, mesh: &str) -> PathBuf {
+    path(results, codec, mesh, ".refused.txt")
 }
 
 /// The level rows as CSV.

@@ -3,12 +3,13 @@
 //! decodes the streams that the experiments kept.
 
 use crate::codecs::stats::{PmField, Stat};
+use crate::codecs::EncodeOptions;
 use crate::codecs::{self, Stop};
 use crate::error::{Error, Result};
 use crate::mesh::io::{read_mesh, write_atomically};
 use crate::plot;
 use crate::render::{render, View};
-use crate::results::{read_result, RunResult};
+use crate::results::{self, read_result, RunResult};
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -90,7 +91,7 @@ fn stat(result: &RunResult, stat: Stat) -> Result<f64> {
 }
 
 fn load(results: &Path, codec: &str, stem: &str) -> Result<RunResult> {
-    let path = results.join(codec).join(format!("{stem}.json"));
+    let path = results::path(results, codec, stem, ".json");
     read_result(&path).map_err(|e| {
         Error::Unsupported(format!(
             "{}: {e} (make it with: {EMC_TABLE1_COMMAND})",
@@ -238,7 +239,7 @@ pub fn emc_fig5(results: &Path, out: &Path) -> Result<PathBuf> {
     root.fill(&WHITE).map_err(|e| fail(&e))?;
     for (col, (file, stem)) in EMC_TABLE1_MESHES.iter().enumerate() {
         let result = load(results, "emc-paper", stem)?;
-        let stream_path = results.join("emc-paper").join(format!("{stem}.mc"));
+        let stream_path = results::path(results, "emc-paper", stem, ".mc");
         let stream = std::fs::read(&stream_path).map_err(|e| {
             Error::Unsupported(format!(
                 "{}: {e} (make it with: {EMC_TABLE1_COMMAND})",
@@ -355,7 +356,7 @@ const HOPPE_ROWS: [HoppeRow; 2] = [
 ];
 
 fn refused(results: &Path, codec: &str, mesh: &str) -> Option<String> {
-    std::fs::read_to_string(results.join(codec).join(format!("{mesh}.refused.txt")))
+    std::fs::read_to_string(results::refusal_path(results, codec, mesh))
         .ok()
         .map(|s| {
             s.trim()
@@ -550,15 +551,13 @@ const PUBLISHED_ANCHORS: [(&str, Rates); 3] = [
 
 /// The result of `codec` on `mesh` at `quant` bits (cubic grid), by the harness's file naming.
 fn load_at(results: &Path, codec: &str, mesh: &str, quant: u8) -> Result<RunResult> {
-    let defaults = crate::codecs::by_name(codec)
-        .map(|c| c.default_options().quant_bits)
-        .unwrap_or(0);
-    let stem = if quant == defaults {
-        mesh.to_string()
-    } else {
-        format!("{mesh}-q{quant}")
+    let defaults = crate::codecs::by_name(codec)?.default_options();
+    let quantization = EncodeOptions {
+        quant_bits: quant,
+        grid: defaults.grid,
     };
-    let path = results.join(codec).join(format!("{stem}.json"));
+    let stem = results::stem(&defaults, mesh, &quantization);
+    let path = results::path(results, codec, &stem, ".json");
     read_result(&path).map_err(|e| {
         Error::Unsupported(format!(
             "{}: {e} (make it with: {ANCHORS_COMMAND})",

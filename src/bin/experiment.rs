@@ -172,7 +172,7 @@ fn run_codec(
         meshcodec::outln!("wrote {}", path.display());
     }
     if keep_stream {
-        let path = out.join(&result.codec).join(format!("{stem}.mc"));
+        let path = results::path(out, &result.codec, &stem, ".mc");
         meshcodec::mesh::io::write_atomically(&path, &stream)?;
         meshcodec::outln!("wrote {}", path.display());
     }
@@ -231,7 +231,7 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
                         let dir = settings.out.join(codec.name());
                         std::fs::create_dir_all(&dir)?;
                         let why = format!("{e:#}");
-                        let file = dir.join(format!("{name}.refused.txt"));
+                        let file = results::refusal_path(&settings.out, codec.name(), &name);
                         meshcodec::mesh::io::write_atomically(
                             &file,
                             format!("{why}\n").as_bytes(),

@@ -2,7 +2,13 @@
 //! cost, the checks a collapse must pass (link condition, boundary rules, no duplicate face, no
 //! fold-over), and greedy loops of collapses cheapest first.
 
-use super::*;
+use super::quadric::Quadric;
+use super::{vad_s_step, Collapse, Placement};
+use crate::hierarchy::pmesh::{anchor, NIL};
+use glam::DVec3;
+use orx_priority_queue::{DaryHeapOfIndices, PriorityQueue, PriorityQueueDecKey};
+use rayon::prelude::*;
+use smallvec::SmallVec;
 
 /// Heap key of an edge: its cost's bits above its id. Costs are never negative, so their bits
 /// order as the costs do; the id breaks ties, for determinism.

@@ -22,10 +22,6 @@
 //! is located from and which corners hold vs, and once the face ids a decoder will assign are
 //! known (one pass in split order), every Vsplit record follows from its collapse alone.
 
-use crate::hierarchy::pmesh::{anchor, PmMesh, Rotation, Vsplit, NIL};
-use glam::DVec3;
-use orx_priority_queue::{DaryHeapOfIndices, PriorityQueue, PriorityQueueDecKey};
-use rayon::prelude::*;
 use smallvec::SmallVec;
 
 mod engine;
@@ -37,9 +33,9 @@ mod reorder;
 pub use records::{progressive_mesh, ProgressiveMesh};
 pub use reorder::reordered_progressive_mesh;
 
-use engine::*;
-use quadric::*;
-use regions::*;
+use engine::{topology, State};
+use quadric::initial_quadrics;
+use regions::{simplify_in_regions, REGION_MIN_FACES};
 
 /// Where a collapse puts the remaining vertex.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

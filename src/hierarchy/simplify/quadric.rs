@@ -1,7 +1,9 @@
 //! Garland–Heckbert quadrics: a symmetric 4 × 4 matrix per vertex, summed from the planes of its
 //! faces (area-weighted) and, on boundaries, from constraint planes through the boundary edges.
 
-use super::*;
+use super::engine::{to_f, Topology};
+use glam::DVec3;
+use rayon::prelude::*;
 
 /// A symmetric 4 × 4 quadric: a2 ab ac ad b2 bc bd c2 cd d2.
 #[derive(Clone, Copy, Debug, Default)]

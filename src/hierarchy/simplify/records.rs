@@ -1,7 +1,9 @@
 //! Hoppe's vertex-split records from the collapse records: base mesh, then the collapses in
 //! reverse as Vsplits, made in parallel without replaying the splits.
 
-use super::*;
+use super::{vad_s_step, Simplified};
+use crate::hierarchy::pmesh::{anchor, PmMesh, Rotation, Vsplit, NIL};
+use rayon::prelude::*;
 
 /// A progressive mesh: the base mesh and the splits that rebuild the full mesh, with the order
 /// in which the full mesh's vertices and faces are created.

@@ -2,7 +2,11 @@
 //! simplified greedily on a compact copy with its shared vertices frozen, the regions'
 //! collapses interleaved cheapest first; then a second round across the seams.
 
-use super::*;
+use super::engine::{topology, State};
+use super::quadric::{initial_quadrics, Quadric};
+use super::{Collapse, Placement, Simplified};
+use crate::hierarchy::pmesh::NIL;
+use rayon::prelude::*;
 
 /// Meshes below this many faces are simplified by one greedy loop; larger ones first in
 /// regions, in parallel.

@@ -1,8 +1,9 @@
 //! Hoppe's reordering of the vertex splits (§6.2, Table 4) along their dependency graph, so that
 //! successive records name nearby faces.
 
-use super::records::build;
-use super::*;
+use super::records::{build, ProgressiveMesh};
+use super::Simplified;
+use crate::hierarchy::pmesh::NIL;
 
 /// The progressive mesh of a simplification with its splits reordered so that successive
 /// records name nearby faces (Hoppe §6.2, Table 4): among the splits whose dependencies are met,
