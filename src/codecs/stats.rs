@@ -51,7 +51,7 @@ impl PmField {
 /// A statistic the paper tables read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Stat {
-    /// emc-paper: bytes of the stream before its first level (header and index).
+    /// emc-paper: bytes of the stream's header (without the index).
     HeaderBytes,
     /// emc-paper: 3-cliques of the final edge graph.
     Cliques,

@@ -79,7 +79,11 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
         ..Tally::default()
     };
     let mut writer = StreamWriter::new(&header);
-    let mut payload_bytes = 0;
+    // The paper leaves its header out of its byte counts; ours is the container's header
+    // without the index (which, like the paper's lack of one, is framing: docs/FORMAT.md §2).
+    let mut header_bytes = Vec::new();
+    header.write(&mut header_bytes);
+    tally.add(Stat::HeaderBytes, header_bytes.len() as f64);
     let final_triangles = mesh.face_count();
 
     for level in 1..=order.levels as usize {
@@ -144,7 +148,6 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
             );
         }
         let (payload, ledger) = sink.finish();
-        payload_bytes += payload.len();
         writer.push_level(
             &payload,
             LevelCost {
@@ -161,7 +164,6 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
         );
     }
     let (bytes, levels) = writer.finish();
-    tally.add(Stat::HeaderBytes, (bytes.len() - payload_bytes) as f64);
     Ok(Encoded {
         bytes,
         levels,
