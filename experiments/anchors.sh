@@ -4,6 +4,7 @@
 # to 16 in the same run, then the tables.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+bash tests/libusb.sh
 cargo build --release --bins
 cargo run --release --bin experiment -- run experiments/anchors.toml
 if [ ! -x .venv/bin/python ]; then

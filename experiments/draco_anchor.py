@@ -3,7 +3,7 @@
 For each mesh and quantization, encodes the mesh's referenced vertices and faces with DracoPy
 (compression_level 10, quantization_bits Q — both set), decodes it, times both (best of five),
 measures the decoded mesh against the original with `meshcodec distance`, and writes
-results/draco/<mesh>-q<Q>.json in the schema of DESIGN.md A5 (one level), with bits per vertex
+results/draco/<mesh>-q<Q>.json in the schema of docs/CONTRACT.md §6 (one level), with bits per vertex
 over the canonical mesh's vertex count at Q bits (from `meshcodec info`), as every other codec.
 
 Run (after tests/run.sh has made the venv and the release build):
@@ -103,7 +103,7 @@ def main():
                 "codec": "draco", "mesh": name, "source": str(path),
                 "vertices": vertices, "triangles": triangles, "quant_bits": q, "bytes": len(data),
                 "encode_seconds": enc_s, "decode_seconds": dec_s, "lossless": False,
-                "lossless_error": "Draco is single-rate and quantizes on its own grid; not checked against DESIGN.md A2",
+                "lossless_error": "Draco is single-rate and quantizes on its own grid; not checked against docs/CONTRACT.md §3",
                 "draco": {"compression_level": 10, "quantization_bits": q, "version": getattr(DracoPy, "__version__", "")},
                 "levels": [{
                     "level": 1, "bits": bits, "connectivity_bits": 0, "geometry_bits": 0,

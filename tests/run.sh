@@ -4,13 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# Open3D's wheel links libusb; Debian ships it as libusb-1.0-0.
-if ! ldconfig -p | grep -q 'libusb-1.0.so.0'; then
-  as_root=""
-  [ "$(id -u)" -eq 0 ] || as_root="sudo"
-  $as_root apt-get update -qq
-  $as_root apt-get install -y -qq libusb-1.0-0 >/dev/null
-fi
+bash tests/libusb.sh
 
 cargo build --release --bins
 cargo test --release
