@@ -99,7 +99,24 @@ impl Index {
 
     /// True when the units are levels: back to back in order, each depending on the one before.
     pub fn is_layered(&self) -> bool {
-        *self == Index::layered(&self.units.iter().map(|u| u.length).collect::<Vec<_>>())
+        let mut offset = 0;
+        self.units.iter().enumerate().all(|(i, unit)| {
+            let in_place = unit.offset == offset && unit.parent == i.checked_sub(1);
+            offset += unit.length;
+            in_place
+        })
+    }
+
+    /// Refuses an index whose units are not levels (`at`: the payload's offset, for the error).
+    pub fn require_layered(&self, at: usize) -> Result<()> {
+        if !self.is_layered() {
+            return Err(Error::malformed(
+                0,
+                at,
+                "index: this codec's units are levels, laid out in order, each after the one before",
+            ));
+        }
+        Ok(())
     }
 
     /// Number of units.
@@ -363,7 +380,7 @@ impl StreamWriter {
 
     /// The stream and, for each level, where it ends and what the stream cost up to there.
     pub fn finish(self) -> (Vec<u8>, Vec<LevelRecord>) {
-        let mut bytes = Vec::new();
+        let mut bytes = Vec::with_capacity(self.payload.len() + 64 + 12 * self.lengths.len());
         self.header.write(&mut bytes);
         Index::layered(&self.lengths).write(&mut bytes);
         let mut end = bytes.len();
@@ -435,23 +452,9 @@ impl<'a> StreamReader<'a> {
         })
     }
 
-    /// Opens a stream whose units must be levels (back to back, each after the one before).
-    pub fn open_layered(bytes: &'a [u8]) -> Result<Self> {
-        let reader = StreamReader::open(bytes)?;
-        reader.require_layered()?;
-        Ok(reader)
-    }
-
     /// Refuses a stream whose units are not levels.
     pub fn require_layered(&self) -> Result<()> {
-        if !self.index.is_layered() {
-            return Err(Error::malformed(
-                0,
-                self.payload_start,
-                "index: this codec's units are levels, laid out in order, each after the one before",
-            ));
-        }
-        Ok(())
+        self.index.require_layered(self.payload_start)
     }
 
     /// The stream's header.
@@ -488,12 +491,12 @@ impl<'a> StreamReader<'a> {
 
     /// The next complete level, or `None` when the stream has no more (all levels read, or the
     /// bytes end inside the next one: then [`StreamReader::truncated`] is true).
-    pub fn next_level(&mut self) -> Result<Option<LevelPayload<'a>>> {
+    pub fn next_level(&mut self) -> Option<LevelPayload<'a>> {
         let unit = self.unit(self.next_level);
         if unit.is_some() {
             self.next_level += 1;
         }
-        Ok(unit)
+        unit
     }
 
     /// True when the bytes end before the payload does.
@@ -540,7 +543,7 @@ impl LevelSource for StreamReader<'_> {
     }
 
     fn next_owned_level(&mut self) -> Result<Option<OwnedLevel>> {
-        Ok(self.next_level()?.map(|l| OwnedLevel {
+        Ok(self.next_level().map(|l| OwnedLevel {
             index: l.index,
             start: l.start,
             bytes: l.bytes.to_vec(),
@@ -566,21 +569,14 @@ impl<R: std::io::Read> ReadLevels<R> {
         loop {
             match read_header_and_index(&bytes) {
                 Ok((header, index, offset)) => {
-                    let levels = ReadLevels {
+                    index.require_layered(offset)?;
+                    return Ok(ReadLevels {
                         offset,
                         reader,
                         header,
                         index,
                         next_level: 0,
-                    };
-                    if !levels.index.is_layered() {
-                        return Err(Error::malformed(
-                            0,
-                            offset,
-                            "index: the units are not levels in order",
-                        ));
-                    }
-                    return Ok(levels);
+                    });
                 }
                 Err(Error::Truncated(what)) => {
                     let mut byte = [0u8];
@@ -660,11 +656,12 @@ mod tests {
     #[test]
     fn header_and_levels_round_trip_and_every_prefix_reads_cleanly() {
         let (bytes, records) = two_levels();
-        let mut reader = StreamReader::open_layered(&bytes).unwrap();
+        let mut reader = StreamReader::open(&bytes).unwrap();
+        assert!(reader.require_layered().is_ok());
         assert_eq!(reader.header(), &header());
-        assert_eq!(reader.next_level().unwrap().unwrap().bytes, &[9; 5]);
-        assert_eq!(reader.next_level().unwrap().unwrap().bytes.len(), 300);
-        assert!(reader.next_level().unwrap().is_none());
+        assert_eq!(reader.next_level().unwrap().bytes, &[9; 5]);
+        assert_eq!(reader.next_level().unwrap().bytes.len(), 300);
+        assert!(reader.next_level().is_none());
         assert_eq!(records.last().map(|r| r.end_byte), Some(bytes.len()));
         for cut in 0..bytes.len() {
             match StreamReader::open(&bytes[..cut]) {
@@ -672,7 +669,7 @@ mod tests {
                 Err(e) => panic!("cut {cut}: {e}"),
                 Ok(mut r) => {
                     let mut complete = 0;
-                    while r.next_level().unwrap().is_some() {
+                    while r.next_level().is_some() {
                         complete += 1;
                     }
                     let expected = records.iter().filter(|r| r.end_byte <= cut).count();
@@ -756,7 +753,10 @@ mod tests {
         };
         let bytes = with_index(&swapped, &[0; 8]);
         assert!(StreamReader::open(&bytes).is_ok());
-        assert!(StreamReader::open_layered(&bytes).is_err());
+        assert!(StreamReader::open(&bytes)
+            .unwrap()
+            .require_layered()
+            .is_err());
     }
 
     #[test]

@@ -14,7 +14,7 @@
 use meshcodec::codecs::{self, Codec, Stop};
 use meshcodec::container::FORMAT_VERSION;
 use meshcodec::mesh::io::{read_mesh, resolve, write_mesh};
-use meshcodec::mesh::CanonicalMesh;
+use meshcodec::mesh::{CanonicalMesh, TriMesh};
 use meshcodec::Error;
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -39,10 +39,16 @@ fn updating() -> bool {
     std::env::var_os("UPDATE_GOLDEN").is_some_and(|v| v == "1")
 }
 
-fn canonical(codec: &dyn Codec, mesh: &str) -> CanonicalMesh {
-    let path = resolve(mesh).unwrap_or_else(|e| panic!("{mesh}: {e}"));
-    let original = read_mesh(&path).unwrap();
-    codecs::canonical_for(&original, &codec.default_options()).unwrap()
+/// Each of `meshes` as read, once.
+fn read_all<const N: usize>(meshes: [&'static str; N]) -> [(&'static str, TriMesh); N] {
+    meshes.map(|mesh| {
+        let path = resolve(mesh).unwrap_or_else(|e| panic!("{mesh}: {e}"));
+        (mesh, read_mesh(&path).unwrap())
+    })
+}
+
+fn canonical(codec: &dyn Codec, original: &TriMesh) -> CanonicalMesh {
+    codecs::canonical_for(original, &codec.default_options()).unwrap()
 }
 
 #[test]
@@ -51,10 +57,11 @@ fn encoders_reproduce_the_golden_streams_and_these_decode_exactly() {
     if updating() {
         std::fs::create_dir_all(&dir).unwrap();
     }
+    let originals = read_all(GOLDEN_MESHES);
     let mut failures = Vec::new();
     for codec in codecs::registry() {
-        for mesh in GOLDEN_MESHES {
-            let canonical = canonical(codec, mesh);
+        for (mesh, original) in &originals {
+            let canonical = canonical(codec, original);
             let bytes = codec.encode(&canonical).unwrap().bytes;
             let stream_path = dir.join(format!("{}-{mesh}.mc", codec.name()));
             let mesh_path = dir.join(format!("{mesh}-q{}.ply", canonical.grid.bits));
@@ -113,7 +120,8 @@ fn encoders_reproduce_the_golden_streams_and_these_decode_exactly() {
 #[test]
 fn streams_of_another_format_version_are_refused_in_one_line() {
     let codec = codecs::by_name("raw").unwrap();
-    let mut bytes = codec.encode(&canonical(codec, "eight")).unwrap().bytes;
+    let [(_, eight)] = read_all(["eight"]);
+    let mut bytes = codec.encode(&canonical(codec, &eight)).unwrap().bytes;
     for version in [0, FORMAT_VERSION - 1, FORMAT_VERSION + 1, 255] {
         bytes[4] = version;
         match codecs::decode(&bytes, Stop::All) {
@@ -146,10 +154,11 @@ fn pinned_rates() -> Vec<(String, String, f64)> {
 
 #[test]
 fn no_codec_codes_a_pinned_mesh_in_more_bits_than_its_pin() {
+    let originals = read_all(RATE_MESHES);
     let mut measured = Vec::new();
     for codec in codecs::registry() {
-        for mesh in RATE_MESHES {
-            let canonical = canonical(codec, mesh);
+        for (mesh, original) in &originals {
+            let canonical = canonical(codec, original);
             let bytes = codec.encode(&canonical).unwrap().bytes.len();
             let bpv = bytes as f64 * 8.0 / canonical.vertex_count() as f64;
             measured.push((codec.name().to_string(), mesh.to_string(), bpv));

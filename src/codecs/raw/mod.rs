@@ -124,7 +124,7 @@ impl LevelDecoder for RawDecoder<'_> {
     }
 
     fn advance(&mut self) -> Result<bool> {
-        let Some(level) = self.stream.next_level()? else {
+        let Some(level) = self.stream.next_level() else {
             return Ok(false);
         };
         let header = self.stream.header().clone();

@@ -85,7 +85,7 @@ impl<'a> EmcDecoder<'a> {
 
     /// Decodes the first `passes` (1..=3) passes of the next level.
     fn decode_passes(&mut self, passes: usize) -> Result<bool> {
-        let Some(payload) = self.stream.next_level()? else {
+        let Some(payload) = self.stream.next_level() else {
             return Ok(false);
         };
         let level = self.levels_done + 1;

@@ -146,7 +146,7 @@ impl LevelDecoder for EmcDecoder<'_> {
     }
 
     fn advance(&mut self) -> Result<bool> {
-        let Some(payload) = self.stream.next_level()? else {
+        let Some(payload) = self.stream.next_level() else {
             return Ok(false);
         };
         match self.decode_level(&payload) {
@@ -183,7 +183,7 @@ impl PassStops for EmcDecoder<'_> {
     }
 
     fn advance_passes(&mut self, passes: usize) -> Result<bool> {
-        let Some(payload) = self.stream.next_level()? else {
+        let Some(payload) = self.stream.next_level() else {
             return Ok(false);
         };
         match self.decode_passes(&payload, passes) {
