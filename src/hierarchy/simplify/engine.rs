@@ -16,12 +16,12 @@ pub(super) fn heap_key(cost: f64, edge: u32) -> u64 {
     (u64::from((cost as f32).to_bits()) << 32) | u64::from(edge)
 }
 
-pub(super) fn to_f(c: [i32; 3]) -> DVec3 {
+pub(in crate::hierarchy) fn to_f(c: [i32; 3]) -> DVec3 {
     DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
 }
 
 /// Faces or edges around one vertex: most vertices have few, kept inline.
-pub(super) type Incident = SmallVec<[u32; 8]>;
+pub(in crate::hierarchy) type Incident = SmallVec<[u32; 8]>;
 
 /// A collapse that passed the checks: (vs, vt, fl, fr, vl, vr) as in [`Collapse`].
 pub(super) type Checked = (u32, u32, u32, u32, u32, u32);
@@ -388,14 +388,14 @@ impl State {
 
 /// Faces around each vertex, the edges of the live faces (sorted by their ends) with how many
 /// faces hold each (1: a boundary edge), and the edges around each vertex.
-pub(super) struct Topology {
+pub(in crate::hierarchy) struct Topology {
     pub(super) vfaces: Vec<Incident>,
     pub(super) edges: Vec<[u32; 2]>,
     pub(super) edge_faces: Vec<u32>,
     pub(super) vedges: Vec<Incident>,
 }
 
-pub(super) fn topology(n: usize, faces: &[[u32; 3]], alive: &[bool]) -> Topology {
+pub(in crate::hierarchy) fn topology(n: usize, faces: &[[u32; 3]], alive: &[bool]) -> Topology {
     let mut vfaces = vec![Incident::new(); n];
     for (f, t) in faces.iter().enumerate().filter(|&(f, _)| alive[f]) {
         for &v in t {

@@ -24,8 +24,8 @@
 
 use smallvec::SmallVec;
 
-mod engine;
-mod quadric;
+pub(in crate::hierarchy) mod engine;
+pub(in crate::hierarchy) mod quadric;
 mod records;
 mod regions;
 mod reorder;

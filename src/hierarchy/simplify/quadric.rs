@@ -7,10 +7,10 @@ use rayon::prelude::*;
 
 /// A symmetric 4 × 4 quadric: a2 ab ac ad b2 bc bd c2 cd d2.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Quadric(pub(super) [f64; 10]);
+pub(in crate::hierarchy) struct Quadric(pub(super) [f64; 10]);
 
 impl Quadric {
-    pub(super) fn plane(n: DVec3, d: f64, w: f64) -> Quadric {
+    pub(in crate::hierarchy) fn plane(n: DVec3, d: f64, w: f64) -> Quadric {
         let (a, b, c) = (n.x, n.y, n.z);
         Quadric(
             [
@@ -28,17 +28,17 @@ impl Quadric {
             .map(|x| x * w),
         )
     }
-    pub(super) fn add(&mut self, o: &Quadric) {
+    pub(in crate::hierarchy) fn add(&mut self, o: &Quadric) {
         for i in 0..10 {
             self.0[i] += o.0[i];
         }
     }
-    pub(super) fn sum(a: &Quadric, b: &Quadric) -> Quadric {
+    pub(in crate::hierarchy) fn sum(a: &Quadric, b: &Quadric) -> Quadric {
         let mut q = *a;
         q.add(b);
         q
     }
-    pub(super) fn error(&self, p: DVec3) -> f64 {
+    pub(in crate::hierarchy) fn error(&self, p: DVec3) -> f64 {
         let q = &self.0;
         let (x, y, z) = (p.x, p.y, p.z);
         x * x * q[0]
@@ -52,7 +52,7 @@ impl Quadric {
             + 2.0 * z * q[8]
             + q[9]
     }
-    pub(super) fn minimizer(&self) -> Option<DVec3> {
+    pub(in crate::hierarchy) fn minimizer(&self) -> Option<DVec3> {
         let q = &self.0;
         let m = glam::DMat3::from_cols(
             DVec3::new(q[0], q[1], q[2]),
@@ -69,7 +69,7 @@ impl Quadric {
 }
 
 /// Face planes (area-weighted) and boundary constraint planes, summed per vertex in parallel.
-pub(super) fn initial_quadrics(
+pub(in crate::hierarchy) fn initial_quadrics(
     cells: &[[i32; 3]],
     faces: &[[u32; 3]],
     topology: &Topology,
