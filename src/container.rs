@@ -352,12 +352,16 @@ pub struct LevelRecord {
     pub triangles: usize,
 }
 
-/// Builds a layered stream level by level: the header and index are written when it finishes.
+/// Builds a stream unit by unit: the header and index are written when it finishes. A layered
+/// codec pushes one unit per level ([`StreamWriter::push_level`]); a hierarchical one pushes its
+/// units with their parents ([`StreamWriter::push_unit`]) and marks where each level ends
+/// ([`StreamWriter::mark_level`]).
 pub struct StreamWriter {
     header: Header,
     payload: Vec<u8>,
-    lengths: Vec<u64>,
-    costs: Vec<LevelCost>,
+    units: Vec<(u64, Option<usize>)>,
+    /// Per level: payload bytes up to its end, and its cost.
+    marks: Vec<(u64, LevelCost)>,
 }
 
 impl StreamWriter {
@@ -366,36 +370,66 @@ impl StreamWriter {
         StreamWriter {
             header: header.clone(),
             payload: Vec::new(),
-            lengths: Vec::new(),
-            costs: Vec::new(),
+            units: Vec::new(),
+            marks: Vec::new(),
         }
     }
 
-    /// Appends one level's payload and what it cost.
+    /// Appends one level's payload and what it cost: a unit whose parent is the level before.
     pub fn push_level(&mut self, payload: &[u8], cost: LevelCost) {
+        let parent = self.units.len().checked_sub(1);
+        self.push_unit(payload, parent);
+        self.mark_level(cost);
+    }
+
+    /// Appends one unit that depends on unit `parent` (an earlier one), or on none; returns its
+    /// number.
+    pub fn push_unit(&mut self, payload: &[u8], parent: Option<usize>) -> usize {
+        debug_assert!(parent.is_none_or(|p| p < self.units.len()));
         self.payload.extend_from_slice(payload);
-        self.lengths.push(payload.len() as u64);
-        self.costs.push(cost);
+        self.units.push((payload.len() as u64, parent));
+        self.units.len() - 1
+    }
+
+    /// Ends a level after the units pushed so far; `cost` is what this level added.
+    pub fn mark_level(&mut self, cost: LevelCost) {
+        self.marks.push((self.payload.len() as u64, cost));
     }
 
     /// The stream and, for each level, where it ends and what the stream cost up to there.
     pub fn finish(self) -> (Vec<u8>, Vec<LevelRecord>) {
-        let mut bytes = Vec::with_capacity(self.payload.len() + 64 + 12 * self.lengths.len());
+        let mut bytes = Vec::with_capacity(self.payload.len() + 64 + 12 * self.units.len());
         self.header.write(&mut bytes);
-        Index::layered(&self.lengths).write(&mut bytes);
-        let mut end = bytes.len();
+        let mut offset = 0;
+        let units = self
+            .units
+            .iter()
+            .map(|&(length, parent)| {
+                let unit = UnitEntry {
+                    offset,
+                    length,
+                    parent,
+                };
+                offset += length;
+                unit
+            })
+            .collect();
+        Index {
+            units,
+            payload_bytes: offset,
+        }
+        .write(&mut bytes);
+        let start = bytes.len();
         bytes.extend_from_slice(&self.payload);
         let (mut connectivity, mut geometry) = (0, 0);
         let records = self
-            .lengths
+            .marks
             .iter()
-            .zip(&self.costs)
-            .map(|(&length, cost)| {
-                end += length as usize;
+            .map(|&(end, cost)| {
                 connectivity += cost.connectivity_bits;
                 geometry += cost.geometry_bits;
                 LevelRecord {
-                    end_byte: end,
+                    end_byte: start + end as usize,
                     connectivity_bits: connectivity,
                     geometry_bits: geometry,
                     vertices: cost.vertices,

@@ -6,6 +6,7 @@
 //! (docs/CONTRACT.md §3). What only some codecs do is a [`Capability`] a caller asks for, and a
 //! request for one a codec lacks is refused, never ignored.
 
+pub mod came;
 pub mod emc;
 pub mod names;
 pub mod pm;
@@ -17,7 +18,7 @@ pub use crate::container::{LevelCost, LevelRecord};
 use crate::error::{Error, Result};
 use crate::mesh::quantize::GridShape;
 use crate::mesh::{CanonicalMesh, Grid, TriMesh, VertexId};
-pub use stats::{Stat, Stats};
+pub use stats::{CameField, Stat, Stats};
 
 /// How a mesh is quantized before it is encoded: the grid of its canonical mesh
 /// (docs/CONTRACT.md §1). The canonical mesh carries its grid, so a codec is handed the mesh
@@ -144,6 +145,7 @@ pub fn registry() -> Vec<&'static dyn Codec> {
         &pm::Pm {
             ordering: pm::Ordering::Reordered,
         },
+        &came::modelled::Came,
     ]
 }
 

@@ -48,6 +48,39 @@ impl PmField {
     }
 }
 
+/// A part of a CAME stream, as Table 3 of the paper splits it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum CameField {
+    /// Tree shape and triangles' corner paths (n1, n2, n3).
+    Connectivity,
+    /// Dependencies.
+    Dependencies,
+    /// Difference vectors (and, in `came-paper`, the meta-nodes' frames).
+    Coordinates,
+    /// Multiresolution data: error-sphere radii.
+    MrData,
+}
+
+impl CameField {
+    /// The field's name in the coder's per-field bit count.
+    pub fn name(self) -> &'static str {
+        match self {
+            CameField::Connectivity => "connectivity",
+            CameField::Dependencies => "dependencies",
+            CameField::Coordinates => "coordinates",
+            CameField::MrData => "spheres",
+        }
+    }
+
+    /// Every field.
+    pub const ALL: [CameField; 4] = [
+        CameField::Connectivity,
+        CameField::Dependencies,
+        CameField::Coordinates,
+        CameField::MrData,
+    ];
+}
+
 /// A statistic the paper tables read.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Stat {
@@ -85,6 +118,18 @@ pub enum Stat {
     GotoBaseVerticesPerSecond,
     /// pm: decoding the stream, vertex splits a second.
     StreamDecodeVerticesPerSecond,
+    /// came, came-paper: depth of the vertex hierarchy.
+    HierarchyDepth,
+    /// came, came-paper: meta-nodes (units) of the stream.
+    MetaNodes,
+    /// came, came-paper: dependencies per inner node after the redundant ones are dropped.
+    DependenciesPerNode,
+    /// came, came-paper: dependencies per inner node before.
+    RawDependenciesPerNode,
+    /// came, came-paper: seconds to build the hierarchy.
+    HierarchySeconds,
+    /// came, came-paper: bits of one part of the stream, summed over its units.
+    CameBits(CameField),
 }
 
 impl Stat {
@@ -108,6 +153,12 @@ impl Stat {
             Stat::GotoFullVerticesPerSecond => "goto_full_vertices_per_second".into(),
             Stat::GotoBaseVerticesPerSecond => "goto_base_vertices_per_second".into(),
             Stat::StreamDecodeVerticesPerSecond => "stream_decode_vertices_per_second".into(),
+            Stat::HierarchyDepth => "hierarchy_depth".into(),
+            Stat::MetaNodes => "meta_nodes".into(),
+            Stat::DependenciesPerNode => "dependencies_per_node".into(),
+            Stat::RawDependenciesPerNode => "raw_dependencies_per_node".into(),
+            Stat::HierarchySeconds => "hierarchy_seconds".into(),
+            Stat::CameBits(field) => format!("came_bits_{}", field.name()),
         }
     }
 }
@@ -184,6 +235,17 @@ mod tests {
                 DoubleSidedFaces,
                 OrientationExceptions,
             ],
+            "came" | "came-paper" => {
+                let mut stats = vec![
+                    HierarchyDepth,
+                    MetaNodes,
+                    DependenciesPerNode,
+                    RawDependenciesPerNode,
+                    HierarchySeconds,
+                ];
+                stats.extend(CameField::ALL.map(CameBits));
+                stats
+            }
             "pm" | "pm-reordered" => {
                 let mut stats = vec![
                     BaseVertices,
@@ -207,7 +269,7 @@ mod tests {
     #[test]
     fn every_stat_is_recorded_by_its_codecs() {
         let mesh = generate::torus(1.0, 0.4, 40, 20);
-        for name in ["emc-paper", "pm", "pm-reordered"] {
+        for name in ["emc-paper", "pm", "pm-reordered", "came", "came-paper"] {
             let codec = by_name(name).unwrap();
             let canonical = canonical_for(&mesh, &codec.default_options()).unwrap();
             let encoded = codec.encode(&canonical).unwrap();

@@ -222,7 +222,10 @@ impl Contraction {
                 if !self.face_dead[fu] {
                     self.face_dead[fu] = true;
                     self.births[fu] = k;
-                    let w = *c.iter().find(|&&x| x != k).expect("a face has three corners");
+                    let w = *c
+                        .iter()
+                        .find(|&&x| x != k)
+                        .expect("a face has three corners");
                     vanishing.push((f, w));
                 }
                 return false;
@@ -474,8 +477,14 @@ mod tests {
             let k = (n + i) as u32;
             assert_eq!(tree.parent[t as usize], k);
             assert_eq!(tree.parent[u as usize], k);
-            assert_eq!(tree.ids[t as usize], tree.ids[k as usize].child(false).unwrap());
-            assert_eq!(tree.ids[u as usize], tree.ids[k as usize].child(true).unwrap());
+            assert_eq!(
+                tree.ids[t as usize],
+                tree.ids[k as usize].child(false).unwrap()
+            );
+            assert_eq!(
+                tree.ids[u as usize],
+                tree.ids[k as usize].child(true).unwrap()
+            );
         }
         // A face is born at the lowest common ancestor of its corners that splits two of them.
         for (f, face) in faces.iter().enumerate() {
@@ -512,8 +521,11 @@ mod tests {
         let mut mesh = generate::icosphere(1);
         let far = generate::icosphere(1);
         let offset = mesh.positions.len() as u32;
-        mesh.positions
-            .extend(far.positions.iter().map(|p| *p + glam::DVec3::new(9.0, 0.0, 0.0)));
+        mesh.positions.extend(
+            far.positions
+                .iter()
+                .map(|p| *p + glam::DVec3::new(9.0, 0.0, 0.0)),
+        );
         mesh.faces
             .extend(far.faces.iter().map(|f| f.map(|v| v + offset)));
         // A loose triangle of its own vertices, and one sharing an edge non-manifoldly.

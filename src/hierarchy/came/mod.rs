@@ -91,7 +91,9 @@ impl VertexTree {
         order.push(self.root);
         let mut at = 0;
         while at < order.len() {
-            let [t, u] = self.children_of(order[at]).expect("only inner nodes are queued");
+            let [t, u] = self
+                .children_of(order[at])
+                .expect("only inner nodes are queued");
             at += 1;
             for c in [t, u] {
                 if !self.is_leaf(c) {

@@ -88,9 +88,7 @@ impl NodeId {
             return self;
         }
         NodeId(
-            (self.up() as u64) << UP_SHIFT
-                | (len as u64) << LEN_SHIFT
-                | self.path() >> (own - len),
+            (self.up() as u64) << UP_SHIFT | (len as u64) << LEN_SHIFT | self.path() >> (own - len),
         )
     }
 
@@ -151,7 +149,8 @@ mod tests {
     use super::*;
 
     fn id(bits: &str) -> NodeId {
-        bits.chars().fold(NodeId::ROOT, |n, c| n.child(c == '1').unwrap())
+        bits.chars()
+            .fold(NodeId::ROOT, |n, c| n.child(c == '1').unwrap())
     }
 
     /// The example of the paper's Figure 2: three corners and their paths relative to the split.

@@ -1,0 +1,429 @@
+//! The decoder's hierarchy: nodes as units decode them, triangles with their corners' leaf paths,
+//! dependencies; the mesh at any depth of the front; and the level decoder both CAME codecs
+//! share (levels = depths of the front, coarse to fine).
+
+use super::knowledge::{status, Status};
+use super::Params;
+use crate::codecs::{LevelDecoder, LevelMesh};
+use crate::container::{Header, StreamReader};
+use crate::error::{Error, Result};
+use crate::hierarchy::came::NodeId;
+use crate::mesh::TriMesh;
+use glam::DVec3;
+use std::collections::{HashMap, VecDeque};
+
+/// A decoded node.
+#[derive(Clone, Debug)]
+pub struct Node {
+    /// Its path.
+    pub id: NodeId,
+    /// Whether it is a leaf.
+    pub leaf: bool,
+    /// Its children, once its split is decoded.
+    pub children: Option<[u32; 2]>,
+    /// Its position (grid units).
+    pub position: [f64; 3],
+    /// Its error sphere's radius (grid units).
+    pub radius: f64,
+    /// Root of the unit that decoded the split creating it.
+    pub created_unit: NodeId,
+    /// Root of the unit that decoded its split.
+    pub split_unit: Option<NodeId>,
+}
+
+/// A decoded triangle: its corners' leaf paths in face order, and the depth of its split.
+#[derive(Clone, Copy, Debug)]
+pub struct Triangle {
+    /// Leaf paths of the corners, oriented.
+    pub corners: [NodeId; 3],
+    /// Depth of the node whose split creates it.
+    pub birth_depth: u8,
+}
+
+/// Everything decoded so far.
+#[derive(Debug)]
+pub struct DecodedTree {
+    /// Nodes in decoding order; the root first.
+    pub nodes: Vec<Node>,
+    /// Node by packed path.
+    pub lookup: HashMap<u64, u32>,
+    /// Triangles in decoding order.
+    pub triangles: Vec<Triangle>,
+    /// Per split decoded: the node and the splits it depends on.
+    pub dependencies: Vec<(NodeId, Vec<NodeId>)>,
+    max_nodes: usize,
+    max_triangles: usize,
+}
+
+impl DecodedTree {
+    /// A tree of `vertices` leaves to be, holding at most `triangles` triangles.
+    pub fn new(vertices: u64, triangles: u64) -> DecodedTree {
+        DecodedTree {
+            nodes: Vec::new(),
+            lookup: HashMap::new(),
+            triangles: Vec::new(),
+            dependencies: Vec::new(),
+            max_nodes: (2 * vertices).saturating_sub(1) as usize,
+            max_triangles: triangles as usize,
+        }
+    }
+
+    /// Adds the root (an inner node: the meshes CAME codes have triangles).
+    pub fn add_root(&mut self, position: [f64; 3], radius: f64) {
+        self.nodes.push(Node {
+            id: NodeId::ROOT,
+            leaf: false,
+            children: None,
+            position,
+            radius,
+            created_unit: NodeId::ROOT,
+            split_unit: None,
+        });
+        self.lookup.insert(NodeId::ROOT.packed(), 0);
+    }
+
+    /// The node at `id`, if decoded.
+    pub fn get(&self, id: NodeId) -> Option<u32> {
+        self.lookup.get(&id.packed()).copied()
+    }
+
+    /// The status of `id` from the unit rooted at `unit`, and the node if decoded.
+    pub fn status(&self, id: NodeId, unit: NodeId) -> (Status, Option<u32>) {
+        match self.get(id) {
+            None => (Status::Unknown, None),
+            Some(i) => {
+                let n = &self.nodes[i as usize];
+                (status(n.leaf, n.split_unit, n.created_unit, unit), Some(i))
+            }
+        }
+    }
+
+    /// Splits node `s` into children with the given leaf flags, positions and radii, decoded by
+    /// the unit rooted at `unit`.
+    pub fn split(
+        &mut self,
+        s: u32,
+        leaf: [bool; 2],
+        positions: [[f64; 3]; 2],
+        radii: [f64; 2],
+        unit: NodeId,
+        at: usize,
+    ) -> Result<[u32; 2]> {
+        if self.nodes.len() + 2 > self.max_nodes {
+            return Err(Error::malformed(
+                0,
+                at,
+                "the hierarchy has more nodes than its vertices allow",
+            ));
+        }
+        let first = self.nodes.len() as u32;
+        let parent = &mut self.nodes[s as usize];
+        if parent.children.is_some() || parent.leaf {
+            return Err(Error::malformed(0, at, "a node is split twice"));
+        }
+        parent.split_unit = Some(unit);
+        let id = parent.id;
+        parent.children = Some([first, first + 1]);
+        for side in 0..2 {
+            let child = id
+                .child(side == 1)
+                .ok_or_else(|| Error::malformed(0, at, "the hierarchy is deeper than 52 levels"))?;
+            self.lookup.insert(child.packed(), first + side as u32);
+            self.nodes.push(Node {
+                id: child,
+                leaf: leaf[side],
+                children: None,
+                position: positions[side],
+                radius: radii[side],
+                created_unit: unit,
+                split_unit: None,
+            });
+        }
+        Ok([first, first + 1])
+    }
+
+    /// Adds a triangle, within the header's count.
+    pub fn add_triangle(&mut self, triangle: Triangle, at: usize) -> Result<()> {
+        if self.triangles.len() >= self.max_triangles {
+            return Err(Error::malformed(
+                0,
+                at,
+                "more triangles than the header declares",
+            ));
+        }
+        self.triangles.push(triangle);
+        Ok(())
+    }
+
+    /// The mesh of the front at `depth`: every node at that depth and every leaf above it, at
+    /// their positions mapped through `to_world`.
+    pub fn mesh_at(&self, depth: u8, to_world: impl Fn([f64; 3]) -> DVec3) -> Result<TriMesh> {
+        let mut index = vec![u32::MAX; self.nodes.len()];
+        let mut positions = Vec::new();
+        for (i, n) in self.nodes.iter().enumerate() {
+            let len = n.id.len();
+            if len == depth || (n.leaf && len < depth) {
+                index[i] = positions.len() as u32;
+                positions.push(to_world(n.position));
+            }
+        }
+        let mut faces = Vec::new();
+        for t in self.triangles.iter().filter(|t| t.birth_depth < depth) {
+            let mut face = [0u32; 3];
+            for (k, corner) in t.corners.iter().enumerate() {
+                let v = self
+                    .get(corner.ancestor(depth))
+                    .map(|i| index[i as usize])
+                    .filter(|&v| v != u32::MAX)
+                    .ok_or_else(|| {
+                        Error::malformed(0, 0, "a triangle's corner is no node of the front")
+                    })?;
+                face[k] = v;
+            }
+            faces.push(face);
+        }
+        Ok(TriMesh { positions, faces })
+    }
+}
+
+/// Decodes one unit into the tree: what differs between `came-paper` and `came`.
+pub trait UnitDecoder {
+    /// Decodes the unit rooted at node `root` (`first`: whether it is the stream's first) from
+    /// `bytes` (starting at stream offset `at`); returns the roots of its child units, in
+    /// order.
+    fn decode_unit(
+        &self,
+        tree: &mut DecodedTree,
+        header: &Header,
+        params: &Params,
+        root: u32,
+        bytes: &[u8],
+        at: usize,
+    ) -> Result<Vec<u32>>;
+}
+
+/// The level decoder of both CAME codecs.
+pub struct CameDecoder<'a, U: UnitDecoder> {
+    stream: StreamReader<'a>,
+    params: Params,
+    units: U,
+    tree: DecodedTree,
+    /// Units to decode, in stream order: root node, parent unit.
+    pending: VecDeque<(u32, Option<usize>)>,
+    units_decoded: usize,
+    levels_decoded: usize,
+}
+
+impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
+    /// A decoder before the first level.
+    pub fn new(stream: StreamReader<'a>, params: Params, units: U) -> Result<Self> {
+        let header = stream.header();
+        if header.vertices < 3 || header.triangles == 0 {
+            return Err(Error::malformed(
+                0,
+                0,
+                "a CAME stream codes a mesh of at least one triangle",
+            ));
+        }
+        if stream
+            .index()
+            .units
+            .first()
+            .is_some_and(|u| u.parent.is_some())
+        {
+            return Err(Error::malformed(
+                0,
+                0,
+                "the first unit cannot have a parent",
+            ));
+        }
+        let tree = DecodedTree::new(header.vertices, header.triangles);
+        let mut pending = VecDeque::new();
+        pending.push_back((0, None));
+        Ok(CameDecoder {
+            stream,
+            params,
+            units,
+            tree,
+            pending,
+            units_decoded: 0,
+            levels_decoded: 0,
+        })
+    }
+
+    /// Everything decoded so far.
+    pub fn tree(&self) -> &DecodedTree {
+        &self.tree
+    }
+
+    /// Decodes the next unit; `Ok(false)` if the prefix ends before it.
+    fn decode_next_unit(&mut self) -> Result<bool> {
+        let i = self.units_decoded;
+        let index_len = self.stream.index().len();
+        if i >= index_len {
+            return Err(Error::malformed(
+                0,
+                self.stream.payload_start(),
+                format!("the hierarchy needs more units than the index's {index_len}"),
+            ));
+        }
+        let entry = self.stream.index().units[i].clone();
+        let Some(unit) = self.stream.unit(i) else {
+            return Ok(false);
+        };
+        let (root, parent) = self.pending.pop_front().expect("a unit is pending");
+        if entry.parent != parent {
+            return Err(Error::malformed(
+                i + 1,
+                unit.start,
+                format!("unit {i} does not depend on the unit its meta-node lies under"),
+            ));
+        }
+        if i == 0 {
+            // The root unit decodes the root itself.
+        } else if self.tree.nodes[root as usize].children.is_some() {
+            return Err(Error::malformed(
+                i + 1,
+                unit.start,
+                "a meta-node decoded twice",
+            ));
+        }
+        let header = self.stream.header();
+        let children = self.units.decode_unit(
+            &mut self.tree,
+            header,
+            &self.params,
+            root,
+            unit.bytes,
+            unit.start,
+        )?;
+        self.pending
+            .extend(children.into_iter().map(|c| (c, Some(i))));
+        self.units_decoded += 1;
+        Ok(true)
+    }
+
+    /// Depth of the next pending unit's root.
+    fn next_unit_depth(&self) -> Option<u8> {
+        self.pending.front().map(|&(root, _)| {
+            if self.units_decoded == 0 {
+                0
+            } else {
+                self.tree.nodes[root as usize].id.len()
+            }
+        })
+    }
+
+    fn check_complete(&self) -> Result<()> {
+        let at = self.stream.payload_start();
+        let header = self.stream.header();
+        if self.units_decoded != self.stream.index().len() {
+            return Err(Error::malformed(
+                0,
+                at,
+                format!(
+                    "the hierarchy ends after {} of the index's {} units",
+                    self.units_decoded,
+                    self.stream.index().len()
+                ),
+            ));
+        }
+        let leaves = self.tree.nodes.iter().filter(|n| n.leaf).count() as u64;
+        let open = self
+            .tree
+            .nodes
+            .iter()
+            .any(|n| !n.leaf && n.children.is_none());
+        if leaves != header.vertices || open {
+            return Err(Error::malformed(
+                0,
+                at,
+                format!(
+                    "the hierarchy has {leaves} leaves, the header {} vertices",
+                    header.vertices
+                ),
+            ));
+        }
+        if self.tree.triangles.len() as u64 != header.triangles {
+            return Err(Error::malformed(
+                0,
+                at,
+                format!(
+                    "{} triangles decoded, the header declares {}",
+                    self.tree.triangles.len(),
+                    header.triangles
+                ),
+            ));
+        }
+        let cells = header.grid.cells_per_axis() as f64;
+        for n in self.tree.nodes.iter().filter(|n| n.leaf) {
+            if n.position.iter().any(|&x| !(0.0..cells).contains(&x)) {
+                return Err(Error::malformed(0, at, "a vertex lies outside the grid"));
+            }
+        }
+        for t in &self.tree.triangles {
+            for c in t.corners {
+                if !self
+                    .tree
+                    .get(c)
+                    .is_some_and(|i| self.tree.nodes[i as usize].leaf)
+                {
+                    return Err(Error::malformed(0, at, "a triangle's corner is no vertex"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl<U: UnitDecoder> LevelDecoder for CameDecoder<'_, U> {
+    fn header(&self) -> &Header {
+        self.stream.header()
+    }
+
+    fn levels(&self) -> usize {
+        self.params.depth as usize
+    }
+
+    fn levels_decoded(&self) -> usize {
+        self.levels_decoded
+    }
+
+    fn advance(&mut self) -> Result<bool> {
+        let depth = self.params.depth as usize;
+        if self.levels_decoded >= depth {
+            return Ok(false);
+        }
+        // The front at depth k needs every split above depth k.
+        let k = self.levels_decoded + 1;
+        while let Some(top) = self.next_unit_depth() {
+            if top as usize >= k {
+                break;
+            }
+            if !self.decode_next_unit()? {
+                return Ok(false);
+            }
+        }
+        self.levels_decoded = k;
+        if k == depth {
+            self.check_complete()?;
+        }
+        Ok(true)
+    }
+
+    fn mesh(&self) -> Result<LevelMesh> {
+        let grid = self.stream.header().grid;
+        let to_world = |p: [f64; 3]| {
+            DVec3::new(
+                grid.origin[0] + (p[0] + 0.5) * grid.cell[0],
+                grid.origin[1] + (p[1] + 0.5) * grid.cell[1],
+                grid.origin[2] + (p[2] + 0.5) * grid.cell[2],
+            )
+        };
+        let mesh = self.tree.mesh_at(self.levels_decoded as u8, to_world)?;
+        Ok(LevelMesh {
+            mesh,
+            loose_edges: Vec::new(),
+        })
+    }
+}

@@ -1,0 +1,174 @@
+//! CAME: Grabner's *Compressed Adaptive Multiresolution Encoding* — a binary vertex hierarchy of
+//! any mesh coded compactly enough to be a compression format and completely enough to drive
+//! view-dependent refinement (docs/FORMAT.md §8–§9).
+//!
+//! Based on: M. Grabner, "Compressed Adaptive Multiresolution Encoding", WSCG 2002; the
+//! dependencies follow H. Hoppe, "View-dependent refinement of progressive meshes",
+//! SIGGRAPH 1997.
+//!
+//! Glossary (the paper's symbols; the hierarchy's own are in [`crate::hierarchy::came`]):
+//! - v_s, v_t, v_u: a split node and its left and right children; d_t = v_t − v_s and
+//!   d_u = v_u − v_s its difference vectors.
+//! - n1, n2, n3 (n3.up): a triangle's corners as paths relative to the split creating it.
+//! - L: levels per meta-node (8); l: depth below the meta-node's root.
+//! - d̃ = c·2^(l/2)·d: a normalized difference vector, |d̃| ≤ 1 by the meta-node's constant c;
+//!   e1, e2, e3: the eigenvectors of M = (1/N)·Σ dᵢdᵢᵀ, largest eigenvalue first.
+//! - q_ij = r_j / r_i: an error-sphere radius ratio, rounded up.
+//!
+//! The codecs share the hierarchy, the meta-node partition and the decoder:
+//! - `came` ([`modelled`]): every element arithmetic-coded with contexts from what the decoder
+//!   of the unit already has; inner nodes at a representative vertex, so one integer difference
+//!   vector a split and the full decode exactly the canonical mesh.
+//!
+//! Levels are the depths of the front, coarse to fine: level k shows every node at depth k and
+//! every leaf above it, once every meta-node rooted above depth k is decoded.
+
+pub mod decoded;
+pub mod knowledge;
+pub mod modelled;
+pub mod partition;
+
+use crate::container::{Header, LevelCost, StreamWriter};
+use crate::error::{Error, Result};
+use crate::hierarchy::came::VertexTree;
+use crate::mesh::CanonicalMesh;
+use partition::Partition;
+
+/// Levels of the hierarchy per meta-node (the paper's L).
+pub const META_LEVELS: u8 = 8;
+
+/// A CAME stream's parameters (the header's codec parameters, docs/FORMAT.md §8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Params {
+    /// Levels per meta-node (L).
+    pub meta_levels: u8,
+    /// Depth of the hierarchy: the number of levels.
+    pub depth: u8,
+    /// Bits per PCA component (`came-paper`; 0 for `came`).
+    pub component_bits: u8,
+    /// Bits per radius ratio.
+    pub radius_bits: u8,
+}
+
+impl Params {
+    /// The header bytes.
+    pub fn to_bytes(self) -> Vec<u8> {
+        vec![
+            self.meta_levels,
+            self.depth,
+            self.component_bits,
+            self.radius_bits,
+        ]
+    }
+
+    /// Parameters from header bytes; `components`: the range bits per component may take.
+    pub fn from_bytes(bytes: &[u8], components: std::ops::RangeInclusive<u8>) -> Result<Params> {
+        let bad = |what: &str| Error::malformed(0, 0, format!("CAME parameters: {what}"));
+        let &[meta_levels, depth, component_bits, radius_bits] = bytes else {
+            return Err(bad("4 bytes expected"));
+        };
+        if !(1..=16).contains(&meta_levels) {
+            return Err(bad("levels per meta-node outside 1..16"));
+        }
+        if !(1..=crate::hierarchy::came::MAX_DEPTH).contains(&depth) {
+            return Err(bad("depth outside 1..52"));
+        }
+        if !components.contains(&component_bits) {
+            return Err(bad("bits per component out of range"));
+        }
+        if !(1..=8).contains(&radius_bits) {
+            return Err(bad("radius bits outside 1..8"));
+        }
+        Ok(Params {
+            meta_levels,
+            depth,
+            component_bits,
+            radius_bits,
+        })
+    }
+}
+
+/// A triangle as the split creating it codes it: n1's leaf (under v_t), n2's (under v_u), n3's,
+/// and whether the face runs n2, n1, n3 rather than n1, n2, n3.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub struct BornTriangle {
+    /// Leaves of n1, n2, n3.
+    pub leaves: [u32; 3],
+    /// Orientation: the face is (n2, n1, n3).
+    pub flipped: bool,
+}
+
+/// The triangles each inner node's split creates, in coding order.
+pub fn born_triangles(tree: &VertexTree, mesh: &CanonicalMesh) -> Vec<Vec<BornTriangle>> {
+    let mut born = vec![Vec::new(); tree.children.len()];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let s = tree.births[f];
+        let [t, _] = tree.children_of(s).expect("faces are born at inner nodes");
+        let (sid, tid) = (tree.ids[s as usize], tree.ids[t as usize]);
+        let under_s = |k: usize| sid.is_ancestor_of(tree.ids[face[k] as usize]);
+        let third = (0..3)
+            .find(|&k| !under_s(k))
+            .expect("one corner lies outside");
+        // The face from its third corner on: (third, a, b).
+        let (a, b) = (face[(third + 1) % 3], face[(third + 2) % 3]);
+        let a_left = tid.is_ancestor_of(tree.ids[a as usize]);
+        let (n1, n2) = if a_left { (a, b) } else { (b, a) };
+        // (third, n1, n2) is the cyclic order n1, n2, n3 when a is n1.
+        born[s as usize - tree.leaves].push(BornTriangle {
+            leaves: [n1, n2, face[third]],
+            flipped: !a_left,
+        });
+    }
+    for list in &mut born {
+        list.sort_unstable();
+    }
+    born
+}
+
+/// Writes the units of `partition` (payloads and costs in unit order) as a stream whose levels
+/// are the depths of the front.
+pub fn write_stream(
+    header: &Header,
+    tree: &VertexTree,
+    partition: &Partition,
+    units: Vec<(Vec<u8>, LevelCost)>,
+) -> (Vec<u8>, Vec<crate::container::LevelRecord>) {
+    let depth = tree.depth();
+    // Front size and triangles at each depth.
+    let mut at_depth = vec![0usize; depth as usize + 2];
+    let mut leaves_above = vec![0usize; depth as usize + 2];
+    for (i, id) in tree.ids.iter().enumerate() {
+        at_depth[id.len() as usize] += 1;
+        if tree.is_leaf(i as u32) {
+            leaves_above[id.len() as usize + 1] += 1;
+        }
+    }
+    for k in 1..leaves_above.len() {
+        leaves_above[k] += leaves_above[k - 1];
+    }
+    let mut born_above = vec![0usize; depth as usize + 2];
+    for &s in &tree.births {
+        born_above[tree.ids[s as usize].len() as usize + 1] += 1;
+    }
+    for k in 1..born_above.len() {
+        born_above[k] += born_above[k - 1];
+    }
+    let mut writer = StreamWriter::new(header);
+    let mut next = 0;
+    let mut cost = LevelCost::default();
+    for k in 1..=depth {
+        while next < units.len() && tree.ids[partition.units[next].root as usize].len() < k {
+            let (payload, unit_cost) = &units[next];
+            writer.push_unit(payload, partition.units[next].parent);
+            cost.connectivity_bits += unit_cost.connectivity_bits;
+            cost.geometry_bits += unit_cost.geometry_bits;
+            next += 1;
+        }
+        writer.mark_level(LevelCost {
+            vertices: at_depth[k as usize] + leaves_above[k as usize],
+            triangles: born_above[k as usize],
+            ..std::mem::take(&mut cost)
+        });
+    }
+    writer.finish()
+}

@@ -1,0 +1,862 @@
+//! `came`: the CAME hierarchy with every syntax element arithmetic-coded, losslessly
+//! (docs/FORMAT.md §9).
+//!
+//! Inner nodes sit at their representative vertex (left children followed down), so v_t = v_s
+//! and a split codes one integer vector d_u = v_u − v_s, with contexts from the parent's sphere.
+//! A unit codes its splits' shape, positions and spheres first (pass 1), then their triangles and
+//! dependencies (pass 2), so that paths walk a known shape: no length is coded where the decoder
+//! knows where leaves are, and each direction is coded as "towards the child nearer the other
+//! corner" where both children's positions are known. Contexts start afresh in every unit.
+
+use super::decoded::{CameDecoder, DecodedTree, Triangle, UnitDecoder};
+use super::knowledge::Status;
+use super::partition::{partition, Partition};
+use super::{born_triangles, write_stream, BornTriangle, Params, META_LEVELS};
+use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
+use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext, IntContext, UintContext};
+use crate::coding::SyntaxClass;
+use crate::container::{Header, LevelCost, StreamReader};
+use crate::error::{Error, Result};
+use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
+use crate::hierarchy::came::{build, BuildOptions, NodeId, VertexTree};
+use crate::mesh::quantize::GridShape;
+use crate::mesh::CanonicalMesh;
+
+/// Bits of a radius ratio.
+const RADIUS_BITS: u8 = 4;
+/// Depth contexts (paths are at most 52 bits).
+const DEPTHS: usize = 53;
+/// Magnitude classes of the parent's radius, for the difference vector's contexts.
+const SCALES: usize = 40;
+
+/// Path kinds, for the direction contexts.
+#[derive(Clone, Copy)]
+enum Kind {
+    N1 = 0,
+    N2 = 1,
+    N3 = 2,
+    Dependency = 3,
+}
+
+/// The `came` codec.
+pub struct Came;
+
+/// Every adaptive context of one unit.
+struct Contexts {
+    whole: BitContext,
+    leaf_child: Vec<[BitContext; 2]>,
+    coordinate: Vec<[IntContext; 3]>,
+    ratio: [Vec<BitContext>; 2],
+    triangles: [UintContext; 4],
+    up: UintContext,
+    towards: [BitContext; 4],
+    blind: [BitContext; 4],
+    leaf_on_path: Vec<BitContext>,
+    orientation: [BitContext; 3],
+    dependencies: UintContext,
+    dependency_on: UintContext,
+    dependency_rise: UintContext,
+    dependency_up: UintContext,
+    stop: [BitContext; 16],
+}
+
+impl Contexts {
+    fn new() -> Contexts {
+        Contexts {
+            whole: BitContext::default(),
+            leaf_child: vec![[BitContext::default(); 2]; DEPTHS],
+            coordinate: vec![Default::default(); SCALES],
+            ratio: [
+                vec![BitContext::default(); 1 << RADIUS_BITS],
+                vec![BitContext::default(); 1 << RADIUS_BITS],
+            ],
+            triangles: Default::default(),
+            up: UintContext::default(),
+            towards: [BitContext::default(); 4],
+            blind: [BitContext::default(); 4],
+            leaf_on_path: vec![BitContext::default(); DEPTHS],
+            orientation: [BitContext::default(); 3],
+            dependencies: UintContext::default(),
+            dependency_on: UintContext::default(),
+            dependency_rise: UintContext::default(),
+            dependency_up: UintContext::default(),
+            stop: [BitContext::default(); 16],
+        }
+    }
+}
+
+/// The context class of a parent radius: its bit length.
+fn scale(radius: f64) -> usize {
+    let r = radius.ceil().min(u64::MAX as f64) as u64;
+    ((64 - r.leading_zeros()) as usize).min(SCALES - 1)
+}
+
+/// Which child (true: v_u) lies nearer `target`; ties go to v_t.
+fn nearer(children: [[f64; 3]; 2], target: [f64; 3]) -> bool {
+    let d = |p: [f64; 3]| {
+        (p[0] - target[0]).powi(2) + (p[1] - target[1]).powi(2) + (p[2] - target[2]).powi(2)
+    };
+    d(children[1]) < d(children[0])
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// The stream's header for `mesh` and `params`.
+pub(super) fn header(id: u8, mesh: &CanonicalMesh, params: Params) -> Header {
+    Header {
+        codec_id: id,
+        params: params.to_bytes(),
+        grid: mesh.grid,
+        vertices: mesh.vertex_count() as u64,
+        triangles: mesh.face_count() as u64,
+    }
+}
+
+/// The hierarchy CAME codes, or a refusal for meshes it cannot take.
+pub(super) fn hierarchy(mesh: &CanonicalMesh) -> Result<VertexTree> {
+    if mesh.vertex_count() < 3 || mesh.faces.is_empty() {
+        return Err(Error::Unsupported(
+            "CAME codes meshes of at least one triangle".into(),
+        ));
+    }
+    build(&mesh.cells, &mesh.faces, &BuildOptions::default())
+}
+
+/// Records what every CAME encoder reports.
+pub(super) fn hierarchy_stats(
+    tree: &VertexTree,
+    partition: &Partition,
+    seconds: f64,
+    field_bits: &std::collections::BTreeMap<&'static str, f64>,
+    stats: &mut Stats,
+) {
+    use crate::codecs::{CameField, Stat};
+    stats.set(Stat::HierarchySeconds, seconds);
+    for field in CameField::ALL {
+        let bits = field_bits.get(field.name()).copied().unwrap_or(0.0);
+        stats.set(Stat::CameBits(field), bits);
+    }
+    stats.set(Stat::HierarchyDepth, tree.depth() as f64);
+    stats.set(Stat::MetaNodes, partition.units.len() as f64);
+    stats.set(Stat::DependenciesPerNode, tree.dependencies_per_node());
+    stats.set(
+        Stat::RawDependenciesPerNode,
+        tree.raw_dependencies as f64 / tree.children.len().max(1) as f64,
+    );
+}
+
+impl Codec for Came {
+    fn name(&self) -> &'static str {
+        names::CAME.name
+    }
+
+    fn id(&self) -> u8 {
+        names::CAME.id
+    }
+
+    fn summary(&self) -> &'static str {
+        "Grabner's compressed vertex hierarchy of any mesh, context-modelled and lossless"
+    }
+
+    fn default_options(&self) -> EncodeOptions {
+        EncodeOptions {
+            quant_bits: 12,
+            grid: GridShape::Cubic,
+        }
+    }
+
+    fn capabilities(&self) -> &'static [Capability] {
+        &[]
+    }
+
+    fn measure(&self, _stream: &[u8]) -> Result<Stats> {
+        Ok(Stats::default())
+    }
+
+    fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
+        let started = std::time::Instant::now();
+        let tree = hierarchy(mesh)?;
+        let seconds = started.elapsed().as_secs_f64();
+        let part = partition(&tree, META_LEVELS);
+        let params = Params {
+            meta_levels: META_LEVELS,
+            depth: tree.depth(),
+            component_bits: 0,
+            radius_bits: RADIUS_BITS,
+        };
+        let encoder = Encoder::new(&tree, mesh, &part);
+        let mut fields = std::collections::BTreeMap::<&'static str, f64>::new();
+        let units: Vec<(Vec<u8>, LevelCost)> = (0..part.units.len())
+            .map(|m| {
+                let (bytes, ledger, unit_fields) = encoder.unit(m);
+                for (k, v) in unit_fields {
+                    *fields.entry(k).or_default() += v;
+                }
+                let cost = LevelCost {
+                    connectivity_bits: ledger.connectivity,
+                    geometry_bits: ledger.geometry,
+                    ..Default::default()
+                };
+                (bytes, cost)
+            })
+            .collect();
+        let (bytes, levels) = write_stream(&header(self.id(), mesh, params), &tree, &part, units);
+        let mut stats = Stats::default();
+        hierarchy_stats(&tree, &part, seconds, &fields, &mut stats);
+        Ok(Encoded {
+            bytes,
+            levels,
+            stats,
+        })
+    }
+
+    fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
+        let params = Params::from_bytes(&stream.header().params, 0..=0)?;
+        if params.radius_bits != RADIUS_BITS {
+            return Err(Error::malformed(
+                0,
+                0,
+                "came streams use 4-bit radius ratios",
+            ));
+        }
+        Ok(Box::new(CameDecoder::new(stream, params, ModelledUnits)?))
+    }
+}
+
+/// What the encoder derives once for all units.
+struct Encoder<'a> {
+    tree: &'a VertexTree,
+    part: &'a Partition,
+    grid_bits: u8,
+    /// Position of each node: its representative vertex.
+    positions: Vec<[f64; 3]>,
+    /// Exact sphere radii and the decoder's (rounded-up) ones.
+    exact: Vec<f64>,
+    radii: Vec<f64>,
+    born: Vec<Vec<BornTriangle>>,
+}
+
+impl<'a> Encoder<'a> {
+    fn new(tree: &'a VertexTree, mesh: &CanonicalMesh, part: &'a Partition) -> Encoder<'a> {
+        let n = tree.leaves;
+        let leaf: Vec<[f64; 3]> = mesh.cells.iter().map(|c| c.map(|x| x as f64)).collect();
+        let positions: Vec<[f64; 3]> = (0..tree.node_count() as u32)
+            .map(|v| leaf[tree.representative(v) as usize])
+            .collect();
+        let exact = exact_radii(&leaf, &tree.children, &positions);
+        let mut radii = vec![0.0; tree.node_count()];
+        radii[tree.root as usize] = exact[tree.root as usize].ceil();
+        for s in tree.breadth_first() {
+            let [t, u] = tree.children_of(s).expect("inner");
+            for c in [t, u] {
+                if (c as usize) >= n {
+                    let base = ratio_base(
+                        radii[s as usize],
+                        positions[s as usize],
+                        positions[c as usize],
+                    );
+                    let code = ratio_code(exact[c as usize], base, RADIUS_BITS);
+                    radii[c as usize] = decoded_radius(code, base, RADIUS_BITS);
+                }
+            }
+        }
+        Encoder {
+            tree,
+            part,
+            grid_bits: mesh.grid.bits,
+            positions,
+            exact,
+            radii,
+            born: born_triangles(tree, mesh),
+        }
+    }
+
+    fn status(&self, x: u32, unit: NodeId) -> Status {
+        self.part.knowledge.status(x, self.tree.is_leaf(x), unit)
+    }
+
+    /// Codes unit `m`: its bytes, ledger and bits per field.
+    fn unit(
+        &self,
+        m: usize,
+    ) -> (
+        Vec<u8>,
+        crate::coding::BitLedger,
+        std::collections::BTreeMap<&'static str, f64>,
+    ) {
+        let tree = self.tree;
+        let meta = &self.part.units[m];
+        let unit = tree.ids[meta.root as usize];
+        let mut enc = ArithEncoder::default();
+        let mut ctx = Contexts::new();
+        use SyntaxClass::{Connectivity as C, Geometry as G};
+        enc.bit(&mut ctx.whole, meta.whole, C, "connectivity");
+        if m == 0 {
+            let p = self.positions[tree.root as usize];
+            for x in p {
+                enc.raw(x as u64, self.grid_bits as u32, G, "coordinates");
+            }
+            let r = self.radii[tree.root as usize] as u64;
+            enc.uint(&mut UintContext::default(), r, G, "spheres");
+        }
+        // Pass 1: shape, positions, spheres.
+        for &s in &meta.nodes {
+            let [t, u] = tree.children_of(s).expect("inner");
+            let depth = tree.ids[s as usize].len() as usize + 1;
+            for (side, c) in [t, u].into_iter().enumerate() {
+                let ctx_leaf = &mut ctx.leaf_child[depth.min(DEPTHS - 1)][side];
+                enc.bit(ctx_leaf, tree.is_leaf(c), C, "connectivity");
+            }
+            let class = scale(self.radii[s as usize]);
+            let d = sub(self.positions[u as usize], self.positions[s as usize]);
+            for (axis, &x) in d.iter().enumerate() {
+                enc.int(&mut ctx.coordinate[class][axis], x as i64, G, "coordinates");
+            }
+            for (side, c) in [t, u].into_iter().enumerate() {
+                if tree.is_leaf(c) {
+                    continue;
+                }
+                let base = ratio_base(
+                    self.radii[s as usize],
+                    self.positions[s as usize],
+                    self.positions[c as usize],
+                );
+                let code = ratio_code(self.exact[c as usize], base, RADIUS_BITS);
+                put_symbol(
+                    &mut enc,
+                    &mut ctx.ratio[side],
+                    code,
+                    RADIUS_BITS,
+                    G,
+                    "spheres",
+                );
+            }
+        }
+        // Pass 2: triangles and dependencies.
+        for &s in &meta.nodes {
+            let [t, u] = tree.children_of(s).expect("inner");
+            let sid = tree.ids[s as usize];
+            let born = &self.born[s as usize - tree.leaves];
+            let shape = tree.is_leaf(t) as usize * 2 + tree.is_leaf(u) as usize;
+            enc.uint(
+                &mut ctx.triangles[shape],
+                born.len() as u64,
+                C,
+                "connectivity",
+            );
+            let mut previous = 0;
+            for tri in born {
+                let [l1, l2, l3] = tri.leaves;
+                let (pt, pu, ps) = (
+                    self.positions[t as usize],
+                    self.positions[u as usize],
+                    self.positions[s as usize],
+                );
+                self.put_leaf_path(&mut enc, &mut ctx, t, l1, pu, Kind::N1, unit);
+                self.put_leaf_path(&mut enc, &mut ctx, u, l2, pt, Kind::N2, unit);
+                let junction = tree.ids[l3 as usize].common_len(sid);
+                let up = sid.len() - junction;
+                enc.uint(&mut ctx.up, up as u64 - 1, C, "connectivity");
+                let start = self.other_child(s, up);
+                self.put_leaf_path(&mut enc, &mut ctx, start, l3, ps, Kind::N3, unit);
+                enc.bit(
+                    &mut ctx.orientation[previous],
+                    tri.flipped,
+                    C,
+                    "connectivity",
+                );
+                previous = 1 + tri.flipped as usize;
+            }
+            let deps = &tree.dependencies[s as usize - tree.leaves];
+            enc.uint(&mut ctx.dependencies, deps.len() as u64, C, "dependencies");
+            for &y in deps {
+                // Almost always an ancestor of an n3 corner below its junction: which
+                // triangle's, and how far above the corner.
+                let yid = tree.ids[y as usize];
+                let on = born.iter().position(|t| {
+                    let leaf = tree.ids[t.leaves[2] as usize];
+                    yid.is_ancestor_of(leaf) && yid.len() > leaf.common_len(sid)
+                });
+                let which = on.unwrap_or(born.len());
+                enc.uint(&mut ctx.dependency_on, which as u64, C, "dependencies");
+                if let Some(k) = on {
+                    let leaf = tree.ids[born[k].leaves[2] as usize];
+                    let rise = leaf.len() - yid.len() - 1;
+                    enc.uint(&mut ctx.dependency_rise, rise as u64, C, "dependencies");
+                    continue;
+                }
+                let junction = yid.common_len(sid);
+                let up = sid.len() - junction;
+                enc.uint(&mut ctx.dependency_up, up as u64 - 1, C, "dependencies");
+                let start = self.other_child(s, up);
+                self.put_dependency_path(&mut enc, &mut ctx, start, y, unit);
+            }
+        }
+        let fields = std::mem::take(&mut enc.field_bits);
+        let (bytes, ledger) = enc.finish();
+        (bytes, ledger, fields)
+    }
+
+    /// The child of s's ancestor `up` levels above that is not on s's path.
+    fn other_child(&self, s: u32, up: u8) -> u32 {
+        let mut x = s;
+        for _ in 1..up {
+            x = self.tree.parent[x as usize];
+        }
+        let j = self.tree.parent[x as usize];
+        let [a, b] = self.tree.children_of(j).expect("a junction is inner");
+        if a == x {
+            b
+        } else {
+            a
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn put_leaf_path(
+        &self,
+        enc: &mut ArithEncoder,
+        ctx: &mut Contexts,
+        start: u32,
+        leaf: u32,
+        target: [f64; 3],
+        kind: Kind,
+        unit: NodeId,
+    ) {
+        let tree = self.tree;
+        let lid = tree.ids[leaf as usize];
+        let mut x = start;
+        let c = SyntaxClass::Connectivity;
+        loop {
+            let status = self.status(x, unit);
+            let depth = tree.ids[x as usize].len();
+            match status {
+                Status::Leaf => return,
+                Status::Unknown => {
+                    let is_leaf = tree.is_leaf(x);
+                    enc.bit(
+                        &mut ctx.leaf_on_path[(depth as usize).min(DEPTHS - 1)],
+                        is_leaf,
+                        c,
+                        "connectivity",
+                    );
+                    if is_leaf {
+                        return;
+                    }
+                }
+                _ => {}
+            }
+            let [a, b] = tree.children_of(x).expect("paths pass inner nodes");
+            let bit = lid.bit(depth);
+            if status == Status::Inner {
+                let near = nearer(
+                    [self.positions[a as usize], self.positions[b as usize]],
+                    target,
+                );
+                enc.bit(
+                    &mut ctx.towards[kind as usize],
+                    bit == near,
+                    c,
+                    "connectivity",
+                );
+            } else {
+                enc.bit(&mut ctx.blind[kind as usize], bit, c, "connectivity");
+            }
+            x = if bit { b } else { a };
+        }
+    }
+
+    fn put_dependency_path(
+        &self,
+        enc: &mut ArithEncoder,
+        ctx: &mut Contexts,
+        start: u32,
+        target: u32,
+        unit: NodeId,
+    ) {
+        let tree = self.tree;
+        let tid = tree.ids[target as usize];
+        let c = SyntaxClass::Connectivity;
+        let mut x = start;
+        let mut steps = 0usize;
+        loop {
+            let status = self.status(x, unit);
+            enc.bit(&mut ctx.stop[steps.min(15)], x == target, c, "dependencies");
+            if x == target {
+                return;
+            }
+            let [a, b] = tree.children_of(x).expect("paths pass inner nodes");
+            let bit = tid.bit(tree.ids[x as usize].len());
+            if status == Status::Inner {
+                let leaves =
+                    [self.status(a, unit), self.status(b, unit)].map(|s| s == Status::Leaf);
+                if !leaves[0] && !leaves[1] {
+                    let near = nearer(
+                        [self.positions[a as usize], self.positions[b as usize]],
+                        self.positions[start as usize],
+                    );
+                    enc.bit(
+                        &mut ctx.towards[Kind::Dependency as usize],
+                        bit == near,
+                        c,
+                        "dependencies",
+                    );
+                }
+            } else {
+                enc.bit(
+                    &mut ctx.blind[Kind::Dependency as usize],
+                    bit,
+                    c,
+                    "dependencies",
+                );
+            }
+            x = if bit { b } else { a };
+            steps += 1;
+        }
+    }
+}
+
+/// Codes `value` (< 2^bits) bit by bit down a binary tree of contexts.
+fn put_symbol(
+    enc: &mut ArithEncoder,
+    contexts: &mut [BitContext],
+    value: u32,
+    bits: u8,
+    class: SyntaxClass,
+    field: &'static str,
+) {
+    let mut node = 1usize;
+    for i in (0..bits).rev() {
+        let bit = value >> i & 1 == 1;
+        enc.bit(&mut contexts[node], bit, class, field);
+        node = node * 2 + bit as usize;
+    }
+}
+
+fn get_symbol(dec: &mut ArithDecoder, contexts: &mut [BitContext], bits: u8) -> Option<u32> {
+    let mut node = 1usize;
+    let mut value = 0;
+    for _ in 0..bits {
+        let bit = dec.bit(&mut contexts[node])?;
+        value = value << 1 | bit as u32;
+        node = node * 2 + bit as usize;
+    }
+    Some(value)
+}
+
+/// The unit decoder of `came`.
+pub struct ModelledUnits;
+
+struct UnitReader<'t> {
+    tree: &'t mut DecodedTree,
+    dec: ArithDecoder,
+    ctx: Contexts,
+    unit: NodeId,
+    at: usize,
+}
+
+impl UnitReader<'_> {
+    fn cut(&self) -> Error {
+        Error::malformed(0, self.at, "a CAME unit ends inside a syntax element")
+    }
+
+    fn bit(&mut self, pick: impl FnOnce(&mut Contexts) -> &mut BitContext) -> Result<bool> {
+        let c = pick(&mut self.ctx);
+        self.dec
+            .bit(c)
+            .ok_or_else(|| Error::malformed(0, self.at, "a CAME unit ends inside a syntax element"))
+    }
+
+    fn uint(
+        &mut self,
+        pick: impl FnOnce(&mut Contexts) -> &mut UintContext,
+        max: u64,
+        what: &str,
+    ) -> Result<u64> {
+        let c = pick(&mut self.ctx);
+        let v = self.dec.uint(c).ok_or_else(|| {
+            Error::malformed(0, self.at, "a CAME unit ends inside a syntax element")
+        })?;
+        if v > max {
+            return Err(Error::malformed(
+                0,
+                self.at,
+                format!("{what} {v} exceeds {max}"),
+            ));
+        }
+        Ok(v)
+    }
+
+    /// The start of a relative path `up` levels above `s`: the junction's other child.
+    fn other_child(&self, sid: NodeId, up: u64) -> Result<NodeId> {
+        if up == 0 || up > sid.len() as u64 {
+            return Err(Error::malformed(
+                0,
+                self.at,
+                "a relative path goes above the root",
+            ));
+        }
+        let junction = sid.ancestor(sid.len() - up as u8);
+        let side = sid.bit(junction.len());
+        junction
+            .child(!side)
+            .ok_or_else(|| Error::malformed(0, self.at, "a path is longer than 52 bits"))
+    }
+
+    fn child(&self, x: NodeId, bit: bool) -> Result<NodeId> {
+        x.child(bit)
+            .ok_or_else(|| Error::malformed(0, self.at, "a path is longer than 52 bits"))
+    }
+
+    fn children_positions(&self, i: u32) -> ([u32; 2], [[f64; 3]; 2]) {
+        let [a, b] = self.tree.nodes[i as usize]
+            .children
+            .expect("inner nodes have children");
+        (
+            [a, b],
+            [
+                self.tree.nodes[a as usize].position,
+                self.tree.nodes[b as usize].position,
+            ],
+        )
+    }
+
+    fn leaf_path(&mut self, start: NodeId, target: [f64; 3], kind: Kind) -> Result<NodeId> {
+        let mut x = start;
+        loop {
+            let (status, node) = self.tree.status(x, self.unit);
+            let depth = x.len() as usize;
+            match status {
+                Status::Leaf => return Ok(x),
+                Status::Unknown => {
+                    if self.bit(|c| &mut c.leaf_on_path[depth.min(DEPTHS - 1)])? {
+                        return Ok(x);
+                    }
+                }
+                _ => {}
+            }
+            let bit = if status == Status::Inner {
+                let (_, positions) = self.children_positions(node.expect("decoded"));
+                let near = nearer(positions, target);
+                let towards = self.bit(|c| &mut c.towards[kind as usize])?;
+                towards == near
+            } else {
+                self.bit(|c| &mut c.blind[kind as usize])?
+            };
+            x = self.child(x, bit)?;
+        }
+    }
+
+    fn dependency_path(&mut self, start: NodeId) -> Result<NodeId> {
+        let start_position = self
+            .tree
+            .status(start, self.unit)
+            .1
+            .map(|i| self.tree.nodes[i as usize].position);
+        let mut x = start;
+        let mut steps = 0usize;
+        loop {
+            let (status, node) = self.tree.status(x, self.unit);
+            if status == Status::Leaf {
+                return Err(Error::malformed(
+                    0,
+                    self.at,
+                    "a dependency path enters a leaf",
+                ));
+            }
+            if self.bit(|c| &mut c.stop[steps.min(15)])? {
+                return Ok(x);
+            }
+            let bit = if status == Status::Inner {
+                let (children, positions) = self.children_positions(node.expect("decoded"));
+                let leaves = children.map(|c| {
+                    let n = &self.tree.nodes[c as usize];
+                    n.leaf
+                });
+                match leaves {
+                    [true, true] => {
+                        return Err(Error::malformed(
+                            0,
+                            self.at,
+                            "a dependency path enters a leaf",
+                        ))
+                    }
+                    [true, false] => true,
+                    [false, true] => false,
+                    [false, false] => {
+                        let near = nearer(
+                            positions,
+                            start_position.expect("an inner node's child is decoded"),
+                        );
+                        let towards = self.bit(|c| &mut c.towards[Kind::Dependency as usize])?;
+                        towards == near
+                    }
+                }
+            } else {
+                self.bit(|c| &mut c.blind[Kind::Dependency as usize])?
+            };
+            x = self.child(x, bit)?;
+            steps += 1;
+        }
+    }
+}
+
+impl UnitDecoder for ModelledUnits {
+    fn decode_unit(
+        &self,
+        tree: &mut DecodedTree,
+        header: &Header,
+        params: &Params,
+        root: u32,
+        bytes: &[u8],
+        at: usize,
+    ) -> Result<Vec<u32>> {
+        let dec = ArithDecoder::new(bytes)
+            .ok_or_else(|| Error::malformed(0, at, "a came unit is not a whole number of words"))?;
+        let first = tree.nodes.is_empty();
+        let unit = if first {
+            NodeId::ROOT
+        } else {
+            tree.nodes[root as usize].id
+        };
+        let mut r = UnitReader {
+            tree,
+            dec,
+            ctx: Contexts::new(),
+            unit,
+            at,
+        };
+        let whole = r.bit(|c| &mut c.whole)?;
+        if first {
+            let mut p = [0.0; 3];
+            for x in &mut p {
+                *x = r.dec.raw(header.grid.bits as u32).ok_or_else(|| r.cut())? as f64;
+            }
+            let radius = r
+                .dec
+                .uint(&mut UintContext::default())
+                .filter(|&v| v <= 1 << 40)
+                .ok_or_else(|| Error::malformed(0, at, "the root's radius is cut or too large"))?
+                as f64;
+            r.tree.add_root(p, radius);
+        }
+        let top = r.tree.nodes[root as usize].id.len();
+        let mut queue = vec![root];
+        let mut children_units = Vec::new();
+        let mut at_node = 0;
+        // Pass 1.
+        while at_node < queue.len() {
+            let s = queue[at_node];
+            at_node += 1;
+            let node = &r.tree.nodes[s as usize];
+            let (sid, ps, rs) = (node.id, node.position, node.radius);
+            let depth = sid.len() as usize + 1;
+            let mut leaf = [false; 2];
+            for (side, l) in leaf.iter_mut().enumerate() {
+                *l = r.bit(|c| &mut c.leaf_child[depth.min(DEPTHS - 1)][side])?;
+            }
+            let class = scale(rs);
+            let mut pu = ps;
+            for (axis, p) in pu.iter_mut().enumerate() {
+                let d = r
+                    .dec
+                    .int(&mut r.ctx.coordinate[class][axis])
+                    .ok_or_else(|| r.cut())?;
+                if d.unsigned_abs() > 1 << 31 {
+                    return Err(Error::malformed(
+                        0,
+                        at,
+                        "a difference vector leaves the grid",
+                    ));
+                }
+                *p += d as f64;
+            }
+            let positions = [ps, pu];
+            let mut radii = [0.0; 2];
+            for side in 0..2 {
+                if leaf[side] {
+                    continue;
+                }
+                let base = ratio_base(rs, ps, positions[side]);
+                let code = get_symbol(&mut r.dec, &mut r.ctx.ratio[side], RADIUS_BITS)
+                    .ok_or_else(|| r.cut())?;
+                radii[side] = decoded_radius(code, base, RADIUS_BITS);
+            }
+            let children = r.tree.split(s, leaf, positions, radii, unit, at)?;
+            for side in 0..2 {
+                if leaf[side] {
+                    continue;
+                }
+                let c = children[side];
+                if whole || (depth as u8) < top + params.meta_levels {
+                    queue.push(c);
+                } else {
+                    children_units.push(c);
+                }
+            }
+        }
+        // Pass 2.
+        let max_triangles = header.triangles;
+        for &s in &queue {
+            let node = &r.tree.nodes[s as usize];
+            let sid = node.id;
+            let (children, positions) = r.children_positions(s);
+            let ps = node.position;
+            let shape = r.tree.nodes[children[0] as usize].leaf as usize * 2
+                + r.tree.nodes[children[1] as usize].leaf as usize;
+            let count = r.uint(
+                |c| &mut c.triangles[shape],
+                max_triangles,
+                "triangles at a split",
+            )?;
+            let mut previous = 0;
+            let mut thirds = Vec::with_capacity(count as usize);
+            for _ in 0..count {
+                let n1 = r.leaf_path(r.child(sid, false)?, positions[1], Kind::N1)?;
+                let n2 = r.leaf_path(r.child(sid, true)?, positions[0], Kind::N2)?;
+                let up = r.uint(|c| &mut c.up, 52, "n3.up")? + 1;
+                let start = r.other_child(sid, up)?;
+                let n3 = r.leaf_path(start, ps, Kind::N3)?;
+                thirds.push((n3, start.len()));
+                let flipped = r.bit(|c| &mut c.orientation[previous])?;
+                previous = 1 + flipped as usize;
+                let corners = if flipped { [n2, n1, n3] } else { [n1, n2, n3] };
+                r.tree.add_triangle(
+                    Triangle {
+                        corners,
+                        birth_depth: sid.len(),
+                    },
+                    at,
+                )?;
+            }
+            let count = r.uint(|c| &mut c.dependencies, 64, "dependencies of a split")?;
+            let mut deps = Vec::with_capacity(count as usize);
+            for _ in 0..count {
+                let which = r.uint(
+                    |c| &mut c.dependency_on,
+                    thirds.len() as u64,
+                    "a dependency's triangle",
+                )?;
+                if let Some(&(leaf, below)) = thirds.get(which as usize) {
+                    // An inner node of the n3 path, from the junction's child down.
+                    let rise = r.uint(|c| &mut c.dependency_rise, 52, "a dependency's rise")?;
+                    let len = (leaf.len() as u64)
+                        .checked_sub(rise + 1)
+                        .filter(|&l| l >= below as u64);
+                    let Some(len) = len else {
+                        return Err(Error::malformed(0, at, "a dependency above its path"));
+                    };
+                    deps.push(leaf.ancestor(len as u8));
+                    continue;
+                }
+                let up = r.uint(|c| &mut c.dependency_up, 52, "a dependency's up")? + 1;
+                let start = r.other_child(sid, up)?;
+                deps.push(r.dependency_path(start)?);
+            }
+            r.tree.dependencies.push((sid, deps));
+        }
+        Ok(children_units)
+    }
+}
