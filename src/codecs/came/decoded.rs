@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::came::NodeId;
 use crate::mesh::TriMesh;
 use glam::DVec3;
-use std::collections::{HashMap, VecDeque};
+use std::collections::HashMap;
 
 /// A decoded node.
 #[derive(Clone, Debug)]
@@ -202,15 +202,24 @@ pub trait UnitDecoder {
     ) -> Result<Vec<u32>>;
 }
 
-/// The level decoder of both CAME codecs.
+/// The level decoder of both CAME codecs. Units decode in stream order for levels, or any unit
+/// once its ancestors are ([`CameDecoder::decode_unit`]): a unit's root is the k-th child root
+/// of its parent unit when it is the parent's k-th child in the index.
 pub struct CameDecoder<'a, U: UnitDecoder> {
     stream: StreamReader<'a>,
     params: Params,
     units: U,
     tree: DecodedTree,
-    /// Units to decode, in stream order: root node, parent unit.
-    pending: VecDeque<(u32, Option<usize>)>,
-    units_decoded: usize,
+    /// Per unit: the roots of its child units, once it is decoded.
+    child_roots: Vec<Option<Vec<u32>>>,
+    /// Per unit: its rank among its parent's children in the index.
+    rank: Vec<usize>,
+    /// Per unit: how many children the index gives it.
+    child_count: Vec<usize>,
+    /// Per unit: the triangles it decoded (a range of `tree.triangles`).
+    unit_triangles: Vec<Option<std::ops::Range<usize>>>,
+    /// Units decoded in stream order for levels.
+    units_in_order: usize,
     levels_decoded: usize,
 }
 
@@ -225,28 +234,39 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                 "a CAME stream codes a mesh of at least one triangle",
             ));
         }
-        if stream
-            .index()
-            .units
-            .first()
-            .is_some_and(|u| u.parent.is_some())
-        {
+        let index = stream.index();
+        if index.units.first().is_some_and(|u| u.parent.is_some()) {
             return Err(Error::malformed(
                 0,
                 0,
                 "the first unit cannot have a parent",
             ));
         }
+        let mut children = vec![0usize; index.len()];
+        let mut rank = vec![0usize; index.len()];
+        for (i, unit) in index.units.iter().enumerate() {
+            match unit.parent {
+                Some(p) => {
+                    rank[i] = children[p];
+                    children[p] += 1;
+                }
+                None if i > 0 => {
+                    return Err(Error::malformed(0, 0, "only the first unit has no parent"))
+                }
+                None => {}
+            }
+        }
         let tree = DecodedTree::new(header.vertices, header.triangles);
-        let mut pending = VecDeque::new();
-        pending.push_back((0, None));
         Ok(CameDecoder {
+            child_roots: vec![None; index.len()],
+            unit_triangles: vec![None; index.len()],
+            rank,
+            child_count: children,
             stream,
             params,
             units,
             tree,
-            pending,
-            units_decoded: 0,
+            units_in_order: 0,
             levels_decoded: 0,
         })
     }
@@ -256,38 +276,50 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         &self.tree
     }
 
-    /// Decodes the next unit; `Ok(false)` if the prefix ends before it.
-    fn decode_next_unit(&mut self) -> Result<bool> {
-        let i = self.units_decoded;
+    /// The triangles unit `i` decoded, if it is decoded.
+    pub fn unit_triangles(&self, i: usize) -> Option<&[Triangle]> {
+        let range = self.unit_triangles.get(i)?.clone()?;
+        Some(&self.tree.triangles[range])
+    }
+
+    /// The root of unit `i`, if its parent is decoded (the first unit's root is the tree's).
+    fn unit_root(&self, i: usize) -> Result<Option<u32>> {
+        let Some(parent) = self.stream.index().units[i].parent else {
+            return Ok(Some(0));
+        };
+        let Some(roots) = &self.child_roots[parent] else {
+            return Ok(None);
+        };
+        roots.get(self.rank[i]).copied().map(Some).ok_or_else(|| {
+            Error::malformed(
+                i + 1,
+                self.stream.payload_start(),
+                format!("unit {i} has no meta-node under its parent unit {parent}"),
+            )
+        })
+    }
+
+    /// Decodes unit `i`, its ancestors decoded; `Ok(false)` if its bytes are not in the prefix.
+    /// Errors if it is decoded already or a parent is missing.
+    pub fn decode_unit(&mut self, i: usize) -> Result<bool> {
         let index_len = self.stream.index().len();
         if i >= index_len {
-            return Err(Error::malformed(
-                0,
-                self.stream.payload_start(),
-                format!("the hierarchy needs more units than the index's {index_len}"),
-            ));
+            return Err(Error::Unsupported(format!(
+                "no unit {i}: the stream has {index_len}"
+            )));
         }
-        let entry = self.stream.index().units[i].clone();
+        if self.child_roots[i].is_some() {
+            return Err(Error::Unsupported(format!("unit {i} is decoded already")));
+        }
+        let Some(root) = self.unit_root(i)? else {
+            return Err(Error::Unsupported(format!(
+                "unit {i} needs its parent unit decoded first"
+            )));
+        };
         let Some(unit) = self.stream.unit(i) else {
             return Ok(false);
         };
-        let (root, parent) = self.pending.pop_front().expect("a unit is pending");
-        if entry.parent != parent {
-            return Err(Error::malformed(
-                i + 1,
-                unit.start,
-                format!("unit {i} does not depend on the unit its meta-node lies under"),
-            ));
-        }
-        if i == 0 {
-            // The root unit decodes the root itself.
-        } else if self.tree.nodes[root as usize].children.is_some() {
-            return Err(Error::malformed(
-                i + 1,
-                unit.start,
-                "a meta-node decoded twice",
-            ));
-        }
+        let first = self.tree.triangles.len();
         let header = self.stream.header();
         let children = self.units.decode_unit(
             &mut self.tree,
@@ -297,35 +329,47 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
             unit.bytes,
             unit.start,
         )?;
-        self.pending
-            .extend(children.into_iter().map(|c| (c, Some(i))));
-        self.units_decoded += 1;
+        let expected = self.child_count[i];
+        if children.len() != expected {
+            return Err(Error::malformed(
+                i + 1,
+                unit.start,
+                format!(
+                    "unit {i} opens {} meta-nodes, the index lists {expected} under it",
+                    children.len()
+                ),
+            ));
+        }
+        self.child_roots[i] = Some(children);
+        self.unit_triangles[i] = Some(first..self.tree.triangles.len());
         Ok(true)
     }
 
-    /// Depth of the next pending unit's root.
-    fn next_unit_depth(&self) -> Option<u8> {
-        self.pending.front().map(|&(root, _)| {
-            if self.units_decoded == 0 {
-                0
-            } else {
-                self.tree.nodes[root as usize].id.len()
-            }
-        })
+    /// Depth of the next unit in stream order, once its parent is decoded.
+    fn next_unit_depth(&self) -> Result<Option<u8>> {
+        let i = self.units_in_order;
+        if i >= self.stream.index().len() {
+            return Ok(None);
+        }
+        match self.unit_root(i)? {
+            Some(_) if i == 0 => Ok(Some(0)),
+            Some(root) => Ok(Some(self.tree.nodes[root as usize].id.len())),
+            None => Err(Error::malformed(
+                i + 1,
+                self.stream.payload_start(),
+                format!("unit {i} depends on a unit after it"),
+            )),
+        }
     }
 
     fn check_complete(&self) -> Result<()> {
         let at = self.stream.payload_start();
         let header = self.stream.header();
-        if self.units_decoded != self.stream.index().len() {
+        if self.child_roots.iter().any(Option::is_none) {
             return Err(Error::malformed(
                 0,
                 at,
-                format!(
-                    "the hierarchy ends after {} of the index's {} units",
-                    self.units_decoded,
-                    self.stream.index().len()
-                ),
+                "the hierarchy is complete before the index's last unit",
             ));
         }
         let leaves = self.tree.nodes.iter().filter(|n| n.leaf).count() as u64;
@@ -396,13 +440,14 @@ impl<U: UnitDecoder> LevelDecoder for CameDecoder<'_, U> {
         }
         // The front at depth k needs every split above depth k.
         let k = self.levels_decoded + 1;
-        while let Some(top) = self.next_unit_depth() {
+        while let Some(top) = self.next_unit_depth()? {
             if top as usize >= k {
                 break;
             }
-            if !self.decode_next_unit()? {
+            if !self.decode_unit(self.units_in_order)? {
                 return Ok(false);
             }
+            self.units_in_order += 1;
         }
         self.levels_decoded = k;
         if k == depth {

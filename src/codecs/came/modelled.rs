@@ -860,3 +860,102 @@ impl UnitDecoder for ModelledUnits {
         Ok(children_units)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::codecs::{canonical_for, decode, Stop};
+    use crate::mesh::generate;
+
+    fn stream(mesh: &crate::mesh::TriMesh) -> (CanonicalMesh, Vec<u8>) {
+        let canonical = canonical_for(mesh, &Came.default_options()).unwrap();
+        let bytes = Came.encode(&canonical).unwrap().bytes;
+        (canonical, bytes)
+    }
+
+    fn decoder(bytes: &[u8]) -> CameDecoder<'_, ModelledUnits> {
+        let reader = StreamReader::open(bytes).unwrap();
+        let params = Params::from_bytes(&reader.header().params, 0..=0).unwrap();
+        CameDecoder::new(reader, params, ModelledUnits).unwrap()
+    }
+
+    #[test]
+    fn every_sphere_holds_every_vertex_of_its_subtree() {
+        let mut mesh = generate::icosphere(4);
+        let far = generate::torus(1.0, 0.3, 30, 12);
+        let offset = mesh.positions.len() as u32;
+        mesh.positions.extend(
+            far.positions
+                .iter()
+                .map(|p| *p + glam::DVec3::new(3.0, 0.5, 0.0)),
+        );
+        mesh.faces
+            .extend(far.faces.iter().map(|f| f.map(|v| v + offset)));
+        let (_, bytes) = stream(&mesh);
+        let mut d = decoder(&bytes);
+        while d.advance().unwrap() {}
+        let tree = d.tree();
+        let mut checked = 0;
+        for leaf in tree.nodes.iter().filter(|n| n.leaf) {
+            let p = glam::DVec3::from_array(leaf.position);
+            for len in 0..leaf.id.len() {
+                let a = &tree.nodes[tree.get(leaf.id.ancestor(len)).unwrap() as usize];
+                let distance = p.distance(glam::DVec3::from_array(a.position));
+                assert!(
+                    distance <= a.radius,
+                    "{:?}: {distance} > {}",
+                    a.id,
+                    a.radius
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 10 * tree.nodes.len() / 2);
+    }
+
+    #[test]
+    fn a_meta_node_decodes_alone_once_its_ancestors_are() {
+        let (_, bytes) = stream(&generate::icosphere(5));
+        let mut full = decoder(&bytes);
+        while full.advance().unwrap() {}
+        let reader = StreamReader::open(&bytes).unwrap();
+        let units = reader.index().units.clone();
+        assert!(units.len() > 8, "{} units", units.len());
+        let last = units.len() - 1;
+        let mut chain = vec![last];
+        while let Some(p) = units[*chain.last().unwrap()].parent {
+            chain.push(p);
+        }
+        chain.reverse();
+        let mut alone = decoder(&bytes);
+        let e = alone.decode_unit(last).unwrap_err();
+        assert!(e.to_string().contains("parent unit decoded first"), "{e}");
+        for &i in &chain {
+            assert!(alone.decode_unit(i).unwrap());
+        }
+        let corners = |d: &CameDecoder<'_, ModelledUnits>| -> Vec<[NodeId; 3]> {
+            d.unit_triangles(last)
+                .unwrap()
+                .iter()
+                .map(|t| t.corners)
+                .collect()
+        };
+        assert!(!corners(&alone).is_empty());
+        assert_eq!(corners(&alone), corners(&full));
+        assert!(alone.decode_unit(last).is_err());
+    }
+
+    #[test]
+    fn prefixes_decode_the_levels_they_hold_and_the_whole_stream_is_exact() {
+        let (canonical, bytes) = stream(&generate::icosphere(4));
+        let (whole, levels) = decode(&bytes, Stop::All).unwrap();
+        canonical.check_lossless(&whole.mesh).unwrap();
+        let mut previous = 0;
+        for cut in [bytes.len() / 4, bytes.len() / 2, bytes.len() - 1] {
+            let (mesh, got) = decode(&bytes[..cut], Stop::All).unwrap();
+            assert!(got >= previous && got < levels, "{got} of {levels}");
+            assert!(mesh.mesh.face_count() <= canonical.face_count());
+            previous = got;
+        }
+    }
+}
