@@ -15,7 +15,7 @@ use meshcodec::mesh::{generate, io, TriMesh};
 use std::sync::OnceLock;
 
 /// The codecs, in the order of their `decode_*` targets.
-pub const CODECS: [&str; 5] = ["raw", "emc", "emc-paper", "pm", "pm-reordered"];
+pub const CODECS: [&str; 6] = ["raw", "emc", "emc-paper", "pm", "pm-reordered", "came"];
 
 /// Decodes `body` as everything after the first six bytes (magic, version, codec id) of a stream
 /// of codec `name`, so the fuzzer spends its effort on that codec's syntax.
@@ -27,6 +27,40 @@ pub fn decode_as(name: &str, body: &[u8]) {
     bytes.push(id);
     bytes.extend_from_slice(body);
     decode_every_way(&bytes);
+}
+
+/// Decodes `body` (after a `came` stream's first six bytes) one meta-node alone: the index's
+/// last unit after its ancestors only, as a view-dependent client fetches it.
+pub fn decode_came_unit_alone(body: &[u8]) {
+    use meshcodec::codecs::came::{decoded::CameDecoder, modelled::ModelledUnits, Params};
+    let mut bytes = Vec::with_capacity(body.len() + 6);
+    bytes.extend_from_slice(&MAGIC);
+    bytes.push(FORMAT_VERSION);
+    bytes.push(codecs::names::CAME.id);
+    bytes.extend_from_slice(body);
+    let Ok(reader) = meshcodec::container::StreamReader::open(&bytes) else {
+        return;
+    };
+    let units = reader.index().units.clone();
+    let Ok(params) = Params::from_bytes(&reader.header().params, 0..=0) else {
+        return;
+    };
+    let Ok(mut decoder) = CameDecoder::new(reader, params, ModelledUnits) else {
+        return;
+    };
+    let Some(mut at) = units.len().checked_sub(1) else {
+        return;
+    };
+    let mut chain = vec![at];
+    while let Some(p) = units[at].parent {
+        chain.push(p);
+        at = p;
+    }
+    for &i in chain.iter().rev() {
+        if !matches!(decoder.decode_unit(i), Ok(true)) {
+            return;
+        }
+    }
 }
 
 /// Decodes `bytes` level by level, checking every intermediate mesh and what a cut inside the

@@ -27,16 +27,13 @@ pub const PM_REORDERED: Naming = Naming {
 /// Embedded mesh coding, context-modelled.
 pub const EMC: Naming = Naming { name: "emc", id: 4 };
 
-/// Grabner's compressed adaptive multiresolution encoding as published.
-pub const CAME_PAPER: Naming = Naming {
-    name: "came-paper",
-    id: 5,
-};
 /// Compressed adaptive multiresolution encoding, context-modelled and lossless.
 pub const CAME: Naming = Naming {
     name: "came",
     id: 6,
 };
+
+// Id 5 is kept for Grabner's CAME as published (`came-paper`).
 
 /// Every codec of this build.
 pub const ALL: [Naming; 6] = [RAW, EMC_PAPER, PM, PM_REORDERED, EMC, CAME];

@@ -628,14 +628,13 @@ impl UnitReader<'_> {
         loop {
             let (status, node) = self.tree.status(x, self.unit);
             let depth = x.len() as usize;
-            match status {
-                Status::Leaf => return Ok(x),
-                Status::Unknown => {
-                    if self.bit(|c| &mut c.leaf_on_path[depth.min(DEPTHS - 1)])? {
-                        return Ok(x);
-                    }
-                }
-                _ => {}
+            let ends_here = match status {
+                Status::Leaf => true,
+                Status::Unknown => self.bit(|c| &mut c.leaf_on_path[depth.min(DEPTHS - 1)])?,
+                Status::Inner | Status::Open => false,
+            };
+            if ends_here {
+                return Ok(x);
             }
             let bit = if status == Status::Inner {
                 let (_, positions) = self.children_positions(node.expect("decoded"));
