@@ -27,7 +27,9 @@ fn replay(target: &str, bytes: &[u8]) {
             }
         }
         _ => {
-            if let Some(codec) = target.strip_prefix("decode_") {
+            if target == "decode_came_unit" {
+                exercise::decode_came_unit_alone(bytes);
+            } else if let Some(codec) = target.strip_prefix("decode_") {
                 exercise::decode_as(&codec.replace('_', "-"), bytes);
             } else if let Some(format) = target.strip_prefix("read_") {
                 exercise::read_as(format, bytes);
