@@ -77,15 +77,24 @@ impl Index {
     /// The index of units laid out back to back in order, each depending on the one before —
     /// the levels of a layered codec.
     pub fn layered(lengths: &[u64]) -> Index {
+        Index::back_to_back(
+            lengths
+                .iter()
+                .enumerate()
+                .map(|(i, &length)| (length, i.checked_sub(1))),
+        )
+    }
+
+    /// The index of units of these lengths and parents, laid out back to back in order.
+    pub fn back_to_back(units: impl IntoIterator<Item = (u64, Option<usize>)>) -> Index {
         let mut offset = 0;
-        let units = lengths
-            .iter()
-            .enumerate()
-            .map(|(i, &length)| {
+        let units = units
+            .into_iter()
+            .map(|(length, parent)| {
                 let unit = UnitEntry {
                     offset,
                     length,
-                    parent: i.checked_sub(1),
+                    parent,
                 };
                 offset += length;
                 unit
@@ -400,25 +409,7 @@ impl StreamWriter {
     pub fn finish(self) -> (Vec<u8>, Vec<LevelRecord>) {
         let mut bytes = Vec::with_capacity(self.payload.len() + 64 + 12 * self.units.len());
         self.header.write(&mut bytes);
-        let mut offset = 0;
-        let units = self
-            .units
-            .iter()
-            .map(|&(length, parent)| {
-                let unit = UnitEntry {
-                    offset,
-                    length,
-                    parent,
-                };
-                offset += length;
-                unit
-            })
-            .collect();
-        Index {
-            units,
-            payload_bytes: offset,
-        }
-        .write(&mut bytes);
+        Index::back_to_back(self.units.iter().copied()).write(&mut bytes);
         let start = bytes.len();
         bytes.extend_from_slice(&self.payload);
         let (mut connectivity, mut geometry) = (0, 0);

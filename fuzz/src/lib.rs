@@ -20,24 +20,26 @@ pub const CODECS: [&str; 6] = ["raw", "emc", "emc-paper", "pm", "pm-reordered", 
 /// Decodes `body` as everything after the first six bytes (magic, version, codec id) of a stream
 /// of codec `name`, so the fuzzer spends its effort on that codec's syntax.
 pub fn decode_as(name: &str, body: &[u8]) {
+    decode_every_way(&stream_of(name, body));
+}
+
+/// A stream of codec `name` whose bytes after the first six (magic, version, codec id) are
+/// `body`.
+fn stream_of(name: &str, body: &[u8]) -> Vec<u8> {
     let id = codecs::by_name(name).expect("a registered codec").id();
     let mut bytes = Vec::with_capacity(body.len() + 6);
     bytes.extend_from_slice(&MAGIC);
     bytes.push(FORMAT_VERSION);
     bytes.push(id);
     bytes.extend_from_slice(body);
-    decode_every_way(&bytes);
+    bytes
 }
 
 /// Decodes `body` (after a `came` stream's first six bytes) one meta-node alone: the index's
 /// last unit after its ancestors only, as a view-dependent client fetches it.
 pub fn decode_came_unit_alone(body: &[u8]) {
     use meshcodec::codecs::came::{decoded::CameDecoder, modelled::ModelledUnits, Params};
-    let mut bytes = Vec::with_capacity(body.len() + 6);
-    bytes.extend_from_slice(&MAGIC);
-    bytes.push(FORMAT_VERSION);
-    bytes.push(codecs::names::CAME.id);
-    bytes.extend_from_slice(body);
+    let bytes = stream_of("came", body);
     let Ok(reader) = meshcodec::container::StreamReader::open(&bytes) else {
         return;
     };

@@ -154,13 +154,6 @@ pub fn terrain(points: usize, seed: u64) -> TriMesh {
 pub fn messy(seed: u64) -> TriMesh {
     let mut rng = Pcg64::seed_from_u64(seed);
     let mut mesh = TriMesh::default();
-    let append = |mesh: &mut TriMesh, part: TriMesh, offset: DVec3, scale: f64| {
-        let base = mesh.positions.len() as VertexId;
-        mesh.positions
-            .extend(part.positions.iter().map(|&p| p * scale + offset));
-        mesh.faces
-            .extend(part.faces.iter().map(|f| f.map(|v| v + base)));
-    };
     let spread = |rng: &mut Pcg64| {
         DVec3::new(
             rng.gen_range(-3.0..3.0),
@@ -172,12 +165,12 @@ pub fn messy(seed: u64) -> TriMesh {
     for _ in 0..rng.gen_range(1..=2) {
         let sphere = icosphere(rng.gen_range(0..=1));
         let (offset, scale) = (spread(&mut rng), rng.gen_range(0.3..1.5));
-        append(&mut mesh, sphere, offset, scale);
+        mesh.append(&sphere, offset, scale);
     }
     // An open patch with a boundary.
     let patch = terrain(rng.gen_range(3..25), rng.gen());
     let (offset, scale) = (spread(&mut rng), rng.gen_range(0.5..2.0));
-    append(&mut mesh, patch, offset, scale);
+    mesh.append(&patch, offset, scale);
     let pick_face =
         |mesh: &TriMesh, rng: &mut Pcg64| mesh.faces[rng.gen_range(0..mesh.faces.len())];
     // Fins: a third (and fourth) face on an existing edge.

@@ -69,6 +69,15 @@ impl TriMesh {
         TriMesh { positions, faces }
     }
 
+    /// Adds `part` as a component of its own, scaled by `scale` and moved by `offset`.
+    pub fn append(&mut self, part: &TriMesh, offset: DVec3, scale: f64) {
+        let base = self.positions.len() as VertexId;
+        self.positions
+            .extend(part.positions.iter().map(|&p| p * scale + offset));
+        self.faces
+            .extend(part.faces.iter().map(|f| f.map(|v| v + base)));
+    }
+
     /// Number of vertices stored (referenced or not).
     pub fn vertex_count(&self) -> usize {
         self.positions.len()

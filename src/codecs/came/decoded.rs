@@ -188,9 +188,9 @@ impl DecodedTree {
 
 /// Decodes one unit into the tree: what differs between `came-paper` and `came`.
 pub trait UnitDecoder {
-    /// Decodes the unit rooted at node `root` (`first`: whether it is the stream's first) from
-    /// `bytes` (starting at stream offset `at`); returns the roots of its child units, in
-    /// order.
+    /// Decodes the unit rooted at node `root` from `bytes` (starting at stream offset `at`);
+    /// the stream's first unit, found on an empty tree, decodes the root itself. Returns the
+    /// roots of its child units, in order.
     fn decode_unit(
         &self,
         tree: &mut DecodedTree,

@@ -28,9 +28,10 @@ pub mod knowledge;
 pub mod modelled;
 pub mod partition;
 
+use crate::codecs::{CameField, Stat, Stats};
 use crate::container::{Header, LevelCost, StreamWriter};
 use crate::error::{Error, Result};
-use crate::hierarchy::came::VertexTree;
+use crate::hierarchy::came::{build, BuildOptions, VertexTree};
 use crate::mesh::CanonicalMesh;
 use partition::Partition;
 
@@ -171,4 +172,47 @@ pub fn write_stream(
         });
     }
     writer.finish()
+}
+
+/// The stream's header for `mesh` and `params`.
+pub fn header(id: u8, mesh: &CanonicalMesh, params: Params) -> Header {
+    Header {
+        codec_id: id,
+        params: params.to_bytes(),
+        grid: mesh.grid,
+        vertices: mesh.vertex_count() as u64,
+        triangles: mesh.face_count() as u64,
+    }
+}
+
+/// The hierarchy CAME codes, or a refusal for meshes it cannot take.
+pub fn hierarchy(mesh: &CanonicalMesh) -> Result<VertexTree> {
+    if mesh.vertex_count() < 3 || mesh.faces.is_empty() {
+        return Err(Error::Unsupported(
+            "CAME codes meshes of at least one triangle".into(),
+        ));
+    }
+    build(&mesh.cells, &mesh.faces, &BuildOptions::default())
+}
+
+/// Records what every CAME encoder reports.
+pub fn hierarchy_stats(
+    tree: &VertexTree,
+    partition: &Partition,
+    seconds: f64,
+    field_bits: &std::collections::BTreeMap<&'static str, f64>,
+    stats: &mut Stats,
+) {
+    stats.set(Stat::HierarchySeconds, seconds);
+    for field in CameField::ALL {
+        let bits = field_bits.get(field.name()).copied().unwrap_or(0.0);
+        stats.set(Stat::CameBits(field), bits);
+    }
+    stats.set(Stat::HierarchyDepth, tree.depth() as f64);
+    stats.set(Stat::MetaNodes, partition.units.len() as f64);
+    stats.set(Stat::DependenciesPerNode, tree.dependencies_per_node());
+    stats.set(
+        Stat::RawDependenciesPerNode,
+        tree.raw_dependencies as f64 / tree.children.len().max(1) as f64,
+    );
 }

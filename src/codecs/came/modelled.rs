@@ -11,14 +11,17 @@
 use super::decoded::{CameDecoder, DecodedTree, Triangle, UnitDecoder};
 use super::knowledge::Status;
 use super::partition::{partition, Partition};
-use super::{born_triangles, write_stream, BornTriangle, Params, META_LEVELS};
+use super::{
+    born_triangles, header, hierarchy, hierarchy_stats, write_stream, BornTriangle, Params,
+    META_LEVELS,
+};
 use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
 use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext, IntContext, UintContext};
 use crate::coding::SyntaxClass;
 use crate::container::{Header, LevelCost, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
-use crate::hierarchy::came::{build, BuildOptions, NodeId, VertexTree};
+use crate::hierarchy::came::{NodeId, VertexTree};
 use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
 
@@ -101,50 +104,6 @@ fn nearer(children: [[f64; 3]; 2], target: [f64; 3]) -> bool {
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// The stream's header for `mesh` and `params`.
-pub(super) fn header(id: u8, mesh: &CanonicalMesh, params: Params) -> Header {
-    Header {
-        codec_id: id,
-        params: params.to_bytes(),
-        grid: mesh.grid,
-        vertices: mesh.vertex_count() as u64,
-        triangles: mesh.face_count() as u64,
-    }
-}
-
-/// The hierarchy CAME codes, or a refusal for meshes it cannot take.
-pub(super) fn hierarchy(mesh: &CanonicalMesh) -> Result<VertexTree> {
-    if mesh.vertex_count() < 3 || mesh.faces.is_empty() {
-        return Err(Error::Unsupported(
-            "CAME codes meshes of at least one triangle".into(),
-        ));
-    }
-    build(&mesh.cells, &mesh.faces, &BuildOptions::default())
-}
-
-/// Records what every CAME encoder reports.
-pub(super) fn hierarchy_stats(
-    tree: &VertexTree,
-    partition: &Partition,
-    seconds: f64,
-    field_bits: &std::collections::BTreeMap<&'static str, f64>,
-    stats: &mut Stats,
-) {
-    use crate::codecs::{CameField, Stat};
-    stats.set(Stat::HierarchySeconds, seconds);
-    for field in CameField::ALL {
-        let bits = field_bits.get(field.name()).copied().unwrap_or(0.0);
-        stats.set(Stat::CameBits(field), bits);
-    }
-    stats.set(Stat::HierarchyDepth, tree.depth() as f64);
-    stats.set(Stat::MetaNodes, partition.units.len() as f64);
-    stats.set(Stat::DependenciesPerNode, tree.dependencies_per_node());
-    stats.set(
-        Stat::RawDependenciesPerNode,
-        tree.raw_dependencies as f64 / tree.children.len().max(1) as f64,
-    );
 }
 
 impl Codec for Came {
@@ -232,9 +191,9 @@ struct Encoder<'a> {
     grid_bits: u8,
     /// Position of each node: its representative vertex.
     positions: Vec<[f64; 3]>,
-    /// Exact sphere radii and the decoder's (rounded-up) ones.
-    exact: Vec<f64>,
+    /// The decoder's (rounded-up) sphere radii, and each inner non-root node's ratio code.
     radii: Vec<f64>,
+    ratio_codes: Vec<u32>,
     born: Vec<Vec<BornTriangle>>,
 }
 
@@ -247,6 +206,7 @@ impl<'a> Encoder<'a> {
             .collect();
         let exact = exact_radii(&leaf, &tree.children, &positions);
         let mut radii = vec![0.0; tree.node_count()];
+        let mut ratio_codes = vec![0; tree.node_count()];
         radii[tree.root as usize] = exact[tree.root as usize].ceil();
         for s in tree.breadth_first() {
             let [t, u] = tree.children_of(s).expect("inner");
@@ -259,6 +219,7 @@ impl<'a> Encoder<'a> {
                     );
                     let code = ratio_code(exact[c as usize], base, RADIUS_BITS);
                     radii[c as usize] = decoded_radius(code, base, RADIUS_BITS);
+                    ratio_codes[c as usize] = code;
                 }
             }
         }
@@ -267,8 +228,8 @@ impl<'a> Encoder<'a> {
             part,
             grid_bits: mesh.grid.bits,
             positions,
-            exact,
             radii,
+            ratio_codes,
             born: born_triangles(tree, mesh),
         }
     }
@@ -318,16 +279,10 @@ impl<'a> Encoder<'a> {
                 if tree.is_leaf(c) {
                     continue;
                 }
-                let base = ratio_base(
-                    self.radii[s as usize],
-                    self.positions[s as usize],
-                    self.positions[c as usize],
-                );
-                let code = ratio_code(self.exact[c as usize], base, RADIUS_BITS);
                 put_symbol(
                     &mut enc,
                     &mut ctx.ratio[side],
-                    code,
+                    self.ratio_codes[c as usize],
                     RADIUS_BITS,
                     G,
                     "spheres",
@@ -557,16 +512,19 @@ struct UnitReader<'t> {
     at: usize,
 }
 
+/// The error of a unit whose bytes end inside a syntax element (`at`: the unit's offset).
+fn cut_at(at: usize) -> Error {
+    Error::malformed(0, at, "a CAME unit ends inside a syntax element")
+}
+
 impl UnitReader<'_> {
     fn cut(&self) -> Error {
-        Error::malformed(0, self.at, "a CAME unit ends inside a syntax element")
+        cut_at(self.at)
     }
 
     fn bit(&mut self, pick: impl FnOnce(&mut Contexts) -> &mut BitContext) -> Result<bool> {
         let c = pick(&mut self.ctx);
-        self.dec
-            .bit(c)
-            .ok_or_else(|| Error::malformed(0, self.at, "a CAME unit ends inside a syntax element"))
+        self.dec.bit(c).ok_or_else(|| cut_at(self.at))
     }
 
     fn uint(
@@ -576,9 +534,7 @@ impl UnitReader<'_> {
         what: &str,
     ) -> Result<u64> {
         let c = pick(&mut self.ctx);
-        let v = self.dec.uint(c).ok_or_else(|| {
-            Error::malformed(0, self.at, "a CAME unit ends inside a syntax element")
-        })?;
+        let v = self.dec.uint(c).ok_or_else(|| cut_at(self.at))?;
         if v > max {
             return Err(Error::malformed(
                 0,
@@ -882,14 +838,7 @@ mod tests {
     fn every_sphere_holds_every_vertex_of_its_subtree() {
         let mut mesh = generate::icosphere(4);
         let far = generate::torus(1.0, 0.3, 30, 12);
-        let offset = mesh.positions.len() as u32;
-        mesh.positions.extend(
-            far.positions
-                .iter()
-                .map(|p| *p + glam::DVec3::new(3.0, 0.5, 0.0)),
-        );
-        mesh.faces
-            .extend(far.faces.iter().map(|f| f.map(|v| v + offset)));
+        mesh.append(&far, glam::DVec3::new(3.0, 0.5, 0.0), 1.0);
         let (_, bytes) = stream(&mesh);
         let mut d = decoder(&bytes);
         while d.advance().unwrap() {}

@@ -519,15 +519,7 @@ mod tests {
     #[test]
     fn disjoint_components_and_soup_merge_into_one_hierarchy() {
         let mut mesh = generate::icosphere(1);
-        let far = generate::icosphere(1);
-        let offset = mesh.positions.len() as u32;
-        mesh.positions.extend(
-            far.positions
-                .iter()
-                .map(|p| *p + glam::DVec3::new(9.0, 0.0, 0.0)),
-        );
-        mesh.faces
-            .extend(far.faces.iter().map(|f| f.map(|v| v + offset)));
+        mesh.append(&generate::icosphere(1), DVec3::new(9.0, 0.0, 0.0), 1.0);
         // A loose triangle of its own vertices, and one sharing an edge non-manifoldly.
         let base = mesh.positions.len() as u32;
         mesh.positions.extend([
