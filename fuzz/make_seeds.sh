@@ -74,7 +74,7 @@ with open('read_m/torus.m', 'w') as f:
     for k, t in enumerate(tris): f.write('Face %d %d %d %d\n' % ((k + 1,) + tuple(x + 1 for x in t)))
 EOF
 stream=$(mktemp)
-for codec in raw emc emc-paper pm pm-reordered came; do
+for codec in raw emc emc-paper pm pm-reordered came came-paper; do
   dir=$seeds/decode_${codec//-/_}
   mkdir -p "$dir"
   for mesh in $seeds/read_obj/torus.obj $seeds/read_off/colour.off; do
@@ -83,7 +83,9 @@ for codec in raw emc emc-paper pm pm-reordered came; do
     tail -c +7 "$stream" > "$dir/$name.body"
   done
 done
-# One meta-node alone takes came streams too.
-mkdir -p $seeds/decode_came_unit
-cp $seeds/decode_came/*.body $seeds/decode_came_unit/
+# One meta-node alone takes the CAME codecs' streams too.
+for codec in came came_paper; do
+  mkdir -p $seeds/decode_${codec}_unit
+  cp $seeds/decode_$codec/*.body $seeds/decode_${codec}_unit/
+done
 rm -f "$stream"

@@ -27,8 +27,9 @@ fn replay(target: &str, bytes: &[u8]) {
             }
         }
         _ => {
-            if target == "decode_came_unit" {
-                exercise::decode_came_unit_alone(bytes);
+            let codec = target.strip_prefix("decode_").map(|c| c.replace('_', "-"));
+            if let Some(came) = codec.as_deref().and_then(|c| c.strip_suffix("-unit")) {
+                exercise::decode_unit_alone(came, bytes);
             } else if let Some(codec) = target.strip_prefix("decode_") {
                 exercise::decode_as(&codec.replace('_', "-"), bytes);
             } else if let Some(format) = target.strip_prefix("read_") {

@@ -88,6 +88,11 @@ pub trait Codec: Send + Sync {
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded>;
     /// A decoder positioned before the first level of `stream` (whose header names this codec).
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>>;
+    /// Whether the full decode is the canonical mesh (docs/CONTRACT.md §3). A lossy codec's full
+    /// level is reported with its error, never called lossless.
+    fn lossless(&self) -> bool {
+        true
+    }
     /// Codec-specific measurements of an encoded stream (PM: iteration rates), stored with the
     /// run's results; codecs with none return an empty set.
     fn measure(&self, stream: &[u8]) -> Result<Stats>;
@@ -144,6 +149,9 @@ pub fn registry() -> Vec<&'static dyn Codec> {
         },
         &pm::Pm {
             ordering: pm::Ordering::Reordered,
+        },
+        &came::paper::CamePaper {
+            component_bits: came::paper::DEFAULT_COMPONENT_BITS,
         },
         &came::modelled::Came,
     ]

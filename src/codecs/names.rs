@@ -33,10 +33,14 @@ pub const CAME: Naming = Naming {
     id: 6,
 };
 
-// Id 5 is kept for Grabner's CAME as published (`came-paper`).
+/// Compressed adaptive multiresolution encoding as published (lossy).
+pub const CAME_PAPER: Naming = Naming {
+    name: "came-paper",
+    id: 5,
+};
 
 /// Every codec of this build.
-pub const ALL: [Naming; 6] = [RAW, EMC_PAPER, PM, PM_REORDERED, EMC, CAME];
+pub const ALL: [Naming; 7] = [RAW, EMC_PAPER, PM, PM_REORDERED, EMC, CAME_PAPER, CAME];
 
 #[cfg(test)]
 mod tests {

@@ -235,7 +235,7 @@ mod tests {
                 DoubleSidedFaces,
                 OrientationExceptions,
             ],
-            "came" => {
+            "came" | "came-paper" => {
                 let mut stats = vec![
                     HierarchyDepth,
                     MetaNodes,
@@ -269,7 +269,7 @@ mod tests {
     #[test]
     fn every_stat_is_recorded_by_its_codecs() {
         let mesh = generate::torus(1.0, 0.4, 40, 20);
-        for name in ["emc-paper", "pm", "pm-reordered", "came"] {
+        for name in ["emc-paper", "pm", "pm-reordered", "came", "came-paper"] {
             let codec = by_name(name).unwrap();
             let canonical = canonical_for(&mesh, &codec.default_options()).unwrap();
             let encoded = codec.encode(&canonical).unwrap();

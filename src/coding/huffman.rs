@@ -5,6 +5,8 @@ use super::{BitSink, BitSource, SyntaxClass};
 
 /// Longest codeword allowed.
 pub const MAX_CODE_LENGTH: u8 = 24;
+/// Bits of one code length in a written table.
+pub const LENGTH_FIELD_BITS: u32 = 5;
 
 /// A canonical prefix code over symbols `0..lengths.len()`; a length of 0 means "no codeword".
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -74,6 +76,36 @@ impl Huffman {
                 .iter_mut()
                 .for_each(|w| *w = (*w).max(floor) + floor);
         }
+    }
+
+    /// Writes the table: each symbol's code length in [`LENGTH_FIELD_BITS`] bits.
+    pub fn write_lengths(&self, sink: &mut BitSink, class: SyntaxClass) {
+        for &l in &self.lengths {
+            sink.put(class, LENGTH_FIELD_BITS, l as u32);
+        }
+    }
+
+    /// Reads a table of `symbols` code lengths as [`Huffman::write_lengths`] writes it; `None`
+    /// when the bits run out, a length is too long, or the lengths form no prefix code (no
+    /// codeword, or a Kraft sum above 1).
+    pub fn read_lengths(source: &mut BitSource, symbols: usize) -> Option<Huffman> {
+        let mut lengths = Vec::with_capacity(symbols);
+        for _ in 0..symbols {
+            let l = source.get(LENGTH_FIELD_BITS)? as u8;
+            if l > MAX_CODE_LENGTH {
+                return None;
+            }
+            lengths.push(l);
+        }
+        let kraft: u64 = lengths
+            .iter()
+            .filter(|&&l| l > 0)
+            .map(|&l| 1u64 << (MAX_CODE_LENGTH - l))
+            .sum();
+        if kraft == 0 || kraft > 1 << MAX_CODE_LENGTH {
+            return None;
+        }
+        Some(Huffman::from_lengths(&lengths))
     }
 
     /// Length of the codeword of `symbol` (0 if it has none).
@@ -193,5 +225,26 @@ mod tests {
         assert!(Huffman::lengths_for(&counts)
             .iter()
             .all(|&l| (1..=MAX_CODE_LENGTH).contains(&l)));
+    }
+
+    #[test]
+    fn tables_round_trip_and_broken_ones_are_refused() {
+        let code = Huffman::from_lengths(&Huffman::lengths_for(&[9, 1, 4, 0, 30]));
+        let mut sink = BitSink::default();
+        code.write_lengths(&mut sink, SyntaxClass::Connectivity);
+        let (bytes, _) = sink.finish();
+        assert_eq!(
+            Huffman::read_lengths(&mut BitSource::new(&bytes), 5),
+            Some(code)
+        );
+        // Three codewords of one bit break the Kraft inequality; none at all is no code.
+        let mut sink = BitSink::default();
+        for l in [1, 1, 1, 0, 0] {
+            sink.put(SyntaxClass::Connectivity, LENGTH_FIELD_BITS, l);
+        }
+        let (bytes, _) = sink.finish();
+        assert_eq!(Huffman::read_lengths(&mut BitSource::new(&bytes), 5), None);
+        assert_eq!(Huffman::read_lengths(&mut BitSource::new(&[0; 4]), 5), None);
+        assert_eq!(Huffman::read_lengths(&mut BitSource::new(&[8]), 5), None);
     }
 }

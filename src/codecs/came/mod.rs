@@ -16,6 +16,9 @@
 //! - q_ij = r_j / r_i: an error-sphere radius ratio, rounded up.
 //!
 //! The codecs share the hierarchy, the meta-node partition and the decoder:
+//! - `came-paper` ([`paper`]): as published — Huffman-coded path lengths before raw path bits,
+//!   difference vectors d_t and d_u per split in the meta-node's PCA frame ([`frame`]) at B bits
+//!   per component, 2-bit radius ratios; inner nodes at the quadric optimum; lossy.
 //! - `came` ([`modelled`]): every element arithmetic-coded with contexts from what the decoder
 //!   of the unit already has; inner nodes at a representative vertex, so one integer difference
 //!   vector a split and the full decode exactly the canonical mesh.
@@ -24,8 +27,10 @@
 //! every leaf above it, once every meta-node rooted above depth k is decoded.
 
 pub mod decoded;
+pub mod frame;
 pub mod knowledge;
 pub mod modelled;
+pub mod paper;
 pub mod partition;
 
 use crate::codecs::{CameField, Stat, Stats};
@@ -172,6 +177,11 @@ pub fn write_stream(
         });
     }
     writer.finish()
+}
+
+/// The error of a unit whose bytes end inside a syntax element (`at`: the unit's offset).
+pub fn cut_at(at: usize) -> Error {
+    Error::malformed(0, at, "a CAME unit ends inside a syntax element")
 }
 
 /// The stream's header for `mesh` and `params`.

@@ -10,9 +10,9 @@
 
 use super::decoded::{CameDecoder, DecodedTree, Triangle, UnitDecoder};
 use super::knowledge::Status;
-use super::partition::{partition, Partition};
+use super::partition::{partition, Partition, Tails};
 use super::{
-    born_triangles, header, hierarchy, hierarchy_stats, write_stream, BornTriangle, Params,
+    born_triangles, cut_at, header, hierarchy, hierarchy_stats, write_stream, BornTriangle, Params,
     META_LEVELS,
 };
 use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
@@ -138,7 +138,7 @@ impl Codec for Came {
         let started = std::time::Instant::now();
         let tree = hierarchy(mesh)?;
         let seconds = started.elapsed().as_secs_f64();
-        let part = partition(&tree, META_LEVELS);
+        let part = partition(&tree, META_LEVELS, Tails::Whole);
         let params = Params {
             meta_levels: META_LEVELS,
             depth: tree.depth(),
@@ -510,11 +510,6 @@ struct UnitReader<'t> {
     ctx: Contexts,
     unit: NodeId,
     at: usize,
-}
-
-/// The error of a unit whose bytes end inside a syntax element (`at`: the unit's offset).
-fn cut_at(at: usize) -> Error {
-    Error::malformed(0, at, "a CAME unit ends inside a syntax element")
 }
 
 impl UnitReader<'_> {

@@ -1,8 +1,10 @@
 //! Meta-nodes (Grabner §3.1.3, after El-Sana & Chiang): L levels of the hierarchy form one unit
 //! of the stream, decodable once its ancestors are. A meta-node rooted at depth D0 holds the
 //! splits of its root's subtree at depths D0..D0+L; the inner nodes at depth D0+L root its child
-//! meta-nodes. A meta-node whose subtree ends within L + L/2 levels holds all of it, so that
-//! the last levels do not scatter into units of a few splits each (docs/FORMAT.md §8.1).
+//! meta-nodes. With [`Tails::Whole`] (`came`), a meta-node whose subtree ends within L + L/2
+//! levels holds all of it, so that the last levels do not scatter into units of a few splits each
+//! (docs/FORMAT.md §8.1); with [`Tails::Split`] (`came-paper`) every meta-node holds L levels,
+//! as published.
 //!
 //! Units follow in breadth-first order of the meta-node tree (so by D0), each after its parent.
 
@@ -31,13 +33,22 @@ pub struct Partition {
     pub knowledge: Knowledge,
 }
 
+/// Whether a meta-node near the leaves holds the rest of its subtree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tails {
+    /// A subtree ending within L + L/2 levels is one meta-node.
+    Whole,
+    /// Every meta-node holds L levels (the paper).
+    Split,
+}
+
 /// Whether a meta-node rooted at a subtree of `height` levels holds all of it.
 pub fn holds_whole(height: u8, levels: u8) -> bool {
     height <= levels + levels / 2
 }
 
 /// Partitions `tree` into meta-nodes of `levels` levels.
-pub fn partition(tree: &VertexTree, levels: u8) -> Partition {
+pub fn partition(tree: &VertexTree, levels: u8, tails: Tails) -> Partition {
     let n = tree.leaves;
     let total = tree.node_count();
     // Subtree heights; nodes are numbered bottom-up.
@@ -54,7 +65,7 @@ pub fn partition(tree: &VertexTree, levels: u8) -> Partition {
     }
     while let Some((root, parent)) = roots.pop_front() {
         let index = units.len();
-        let whole = holds_whole(height[root as usize], levels);
+        let whole = tails == Tails::Whole && holds_whole(height[root as usize], levels);
         let top = tree.ids[root as usize].len();
         let unit_id = tree.ids[root as usize];
         let mut nodes = vec![root];
