@@ -46,7 +46,7 @@ pub struct DecodedTree {
     /// Nodes in decoding order; the root first.
     pub nodes: Vec<Node>,
     /// Node by packed path.
-    pub lookup: HashMap<u64, u32>,
+    pub lookup: HashMap<u64, u32, foldhash::fast::FixedState>,
     /// Triangles in decoding order.
     pub triangles: Vec<Triangle>,
     /// Per split decoded: the node and the splits it depends on.
@@ -56,11 +56,15 @@ pub struct DecodedTree {
 }
 
 impl DecodedTree {
-    /// A tree of `vertices` leaves to be, holding at most `triangles` triangles.
-    pub fn new(vertices: u64, triangles: u64) -> DecodedTree {
+    /// A tree of `vertices` leaves to be, holding at most `triangles` triangles, decoded from
+    /// `stream_bytes` bytes.
+    pub fn new(vertices: u64, triangles: u64, stream_bytes: usize) -> DecodedTree {
+        // Room for the nodes the header declares, as far as the stream's size can hold them
+        // (a split costs more than a byte in any stream an encoder writes).
+        let expected = (2 * vertices).min(2 * stream_bytes as u64) as usize;
         DecodedTree {
-            nodes: Vec::new(),
-            lookup: HashMap::new(),
+            nodes: Vec::with_capacity(expected),
+            lookup: HashMap::with_capacity_and_hasher(expected, Default::default()),
             triangles: Vec::new(),
             dependencies: Vec::new(),
             max_nodes: (2 * vertices).saturating_sub(1) as usize,
@@ -96,6 +100,12 @@ impl DecodedTree {
                 (status(n.leaf, n.split_unit, n.created_unit, unit), Some(i))
             }
         }
+    }
+
+    /// The status of decoded node `i` from the unit rooted at `unit`.
+    pub fn status_of(&self, i: u32, unit: NodeId) -> Status {
+        let n = &self.nodes[i as usize];
+        status(n.leaf, n.split_unit, n.created_unit, unit)
     }
 
     /// Splits node `s` into children with the given leaf flags, positions and radii, decoded by
@@ -256,7 +266,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                 None => {}
             }
         }
-        let tree = DecodedTree::new(header.vertices, header.triangles);
+        let tree = DecodedTree::new(header.vertices, header.triangles, stream.bytes().len());
         Ok(CameDecoder {
             child_roots: vec![None; index.len()],
             unit_triangles: vec![None; index.len()],

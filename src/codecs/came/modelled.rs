@@ -574,10 +574,20 @@ impl UnitReader<'_> {
         )
     }
 
-    fn leaf_path(&mut self, start: NodeId, target: [f64; 3], kind: Kind) -> Result<NodeId> {
+    /// A leaf's path from `start` (its node, when the caller knows it decoded).
+    fn leaf_path(
+        &mut self,
+        start: NodeId,
+        known: Option<u32>,
+        target: [f64; 3],
+        kind: Kind,
+    ) -> Result<NodeId> {
         let mut x = start;
+        let (mut status, mut node) = match known {
+            Some(i) => (self.tree.status_of(i, self.unit), Some(i)),
+            None => self.tree.status(x, self.unit),
+        };
         loop {
-            let (status, node) = self.tree.status(x, self.unit);
             let depth = x.len() as usize;
             let ends_here = match status {
                 Status::Leaf => true,
@@ -588,11 +598,19 @@ impl UnitReader<'_> {
                 return Ok(x);
             }
             let bit = if status == Status::Inner {
-                let (_, positions) = self.children_positions(node.expect("decoded"));
+                let (children, positions) = self.children_positions(node.expect("decoded"));
                 let near = nearer(positions, target);
                 let towards = self.bit(|c| &mut c.towards[kind as usize])?;
-                towards == near
+                let bit = towards == near;
+                // Below a known split the walk follows the decoded children, no lookup.
+                let child = children[bit as usize];
+                status = self.tree.status_of(child, self.unit);
+                node = Some(child);
+                bit
             } else {
+                // Below a node whose split this unit does not know, nothing is known.
+                status = Status::Unknown;
+                node = None;
                 self.bit(|c| &mut c.blind[kind as usize])?
             };
             x = self.child(x, bit)?;
@@ -600,15 +618,11 @@ impl UnitReader<'_> {
     }
 
     fn dependency_path(&mut self, start: NodeId) -> Result<NodeId> {
-        let start_position = self
-            .tree
-            .status(start, self.unit)
-            .1
-            .map(|i| self.tree.nodes[i as usize].position);
+        let (mut status, mut node) = self.tree.status(start, self.unit);
+        let start_position = node.map(|i| self.tree.nodes[i as usize].position);
         let mut x = start;
         let mut steps = 0usize;
         loop {
-            let (status, node) = self.tree.status(x, self.unit);
             if status == Status::Leaf {
                 return Err(Error::malformed(
                     0,
@@ -621,11 +635,8 @@ impl UnitReader<'_> {
             }
             let bit = if status == Status::Inner {
                 let (children, positions) = self.children_positions(node.expect("decoded"));
-                let leaves = children.map(|c| {
-                    let n = &self.tree.nodes[c as usize];
-                    n.leaf
-                });
-                match leaves {
+                let leaves = children.map(|c| self.tree.nodes[c as usize].leaf);
+                let bit = match leaves {
                     [true, true] => {
                         return Err(Error::malformed(
                             0,
@@ -643,8 +654,14 @@ impl UnitReader<'_> {
                         let towards = self.bit(|c| &mut c.towards[Kind::Dependency as usize])?;
                         towards == near
                     }
-                }
+                };
+                let child = children[bit as usize];
+                status = self.tree.status_of(child, self.unit);
+                node = Some(child);
+                bit
             } else {
+                status = Status::Unknown;
+                node = None;
                 self.bit(|c| &mut c.blind[Kind::Dependency as usize])?
             };
             x = self.child(x, bit)?;
@@ -764,11 +781,12 @@ impl UnitDecoder for ModelledUnits {
             let mut previous = 0;
             let mut thirds = Vec::with_capacity(count as usize);
             for _ in 0..count {
-                let n1 = r.leaf_path(r.child(sid, false)?, positions[1], Kind::N1)?;
-                let n2 = r.leaf_path(r.child(sid, true)?, positions[0], Kind::N2)?;
+                let [t, u] = children;
+                let n1 = r.leaf_path(r.child(sid, false)?, Some(t), positions[1], Kind::N1)?;
+                let n2 = r.leaf_path(r.child(sid, true)?, Some(u), positions[0], Kind::N2)?;
                 let up = r.uint(|c| &mut c.up, 52, "n3.up")? + 1;
                 let start = r.other_child(sid, up)?;
-                let n3 = r.leaf_path(start, ps, Kind::N3)?;
+                let n3 = r.leaf_path(start, None, ps, Kind::N3)?;
                 thirds.push((n3, start.len()));
                 let flipped = r.bit(|c| &mut c.orientation[previous])?;
                 previous = 1 + flipped as usize;

@@ -9,13 +9,14 @@
 //! and the split that undoes that contraction creates it. Faces never need neighbours, so
 //! nothing here cares whether the mesh is a manifold.
 
+use super::grid::CellGrid;
 use super::{NodeId, VertexTree, MAX_DEPTH};
 use crate::error::{Error, Result};
 use crate::hierarchy::simplify::engine::topology;
 use crate::hierarchy::simplify::quadric::{initial_quadrics, Quadric};
 use glam::DVec3;
-use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap};
+use orx_priority_queue::{DaryHeapOfIndices, PriorityQueue, PriorityQueueDecKey};
+use rayon::prelude::*;
 
 /// How the hierarchy is built.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,95 +51,174 @@ pub fn build(cells: &[[u32; 3]], faces: &[[u32; 3]], options: &BuildOptions) -> 
     if n == 0 {
         return Err(Error::mesh("no vertices to build a hierarchy of"));
     }
-    let mut c = Contraction::new(cells, faces, options);
+    // Work in a spatial order (vertices by Morton code, faces by their first corner), so that
+    // what one contraction touches lies close in memory.
+    let vertex_of_slot = morton_order(cells);
+    let mut slot_of_vertex = vec![0u32; n];
+    for (slot, &v) in vertex_of_slot.iter().enumerate() {
+        slot_of_vertex[v as usize] = slot as u32;
+    }
+    let slot_cells: Vec<[u32; 3]> = vertex_of_slot.iter().map(|&v| cells[v as usize]).collect();
+    let slot_faces: Vec<[u32; 3]> = faces
+        .iter()
+        .map(|f| f.map(|v| slot_of_vertex[v as usize]))
+        .collect();
+    let mut face_order: Vec<u32> = (0..faces.len() as u32).collect();
+    face_order.sort_unstable_by_key(|&f| (slot_faces[f as usize].iter().min().copied(), f));
+    let ordered_faces: Vec<[u32; 3]> = face_order.iter().map(|&f| slot_faces[f as usize]).collect();
+    let mut c = Contraction::new(&slot_cells, &ordered_faces, &vertex_of_slot, options);
     c.run();
-    c.finish()
+    c.finish(&face_order)
 }
 
+/// Vertices sorted by the Morton code of their cells (ties by index).
+fn morton_order(cells: &[[u32; 3]]) -> Vec<u32> {
+    fn spread(x: u32) -> u64 {
+        // 21 bits of x, two zero bits after each.
+        let mut v = (x as u64) & 0x1f_ffff;
+        v = (v | v << 32) & 0x1f_0000_0000_ffff;
+        v = (v | v << 16) & 0x1f_0000_ff00_00ff;
+        v = (v | v << 8) & 0x100f_00f0_0f00_f00f;
+        v = (v | v << 4) & 0x10c3_0c30_c30c_30c3;
+        v = (v | v << 2) & 0x1249_2492_4924_9249;
+        v
+    }
+    // Grids finer than 21 bits an axis are ordered by their top 21 bits.
+    let shift = cells
+        .iter()
+        .flat_map(|c| c.iter())
+        .max()
+        .map_or(0, |&m| (32 - m.leading_zeros()).saturating_sub(21));
+    let mut keyed: Vec<(u64, u32)> = cells
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let [x, y, z] = c.map(|a| spread(a >> shift));
+            (x | y << 1 | z << 2, i as u32)
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    keyed.into_iter().map(|(_, i)| i).collect()
+}
+
+/// The greedy contraction. Every live node sits in a *slot*: the slot of one of its leaves,
+/// which it keeps when it merges with another node (that node's slot dies), so that a node's
+/// faces and pairs stay where they were and only the vanishing node's move.
 struct Contraction {
     balance: f64,
     leaves: usize,
-    positions: Vec<DVec3>,
+    /// Per slot: the node in it, its position, quadric, subtree height and representative leaf.
+    node: Vec<u32>,
+    slot_position: Vec<DVec3>,
     quadrics: Vec<Quadric>,
     height: Vec<u8>,
     rep_leaf: Vec<u32>,
     alive: Vec<bool>,
-    children: Vec<[u32; 2]>,
+    /// Faces and pairs around each live slot (dead ones dropped lazily).
+    slot_faces: Vec<Vec<u32>>,
+    slot_pairs: Vec<Vec<u32>>,
+    /// A tag per slot, for "already seen in this contraction".
+    mark: Vec<u32>,
+    /// Per node: position, parent; per inner node: children.
+    positions: Vec<DVec3>,
     parent: Vec<u32>,
-    /// Current corners of each face.
+    children: Vec<[u32; 2]>,
+    /// Per face: its corners' slots, whether it vanished, and the node whose split creates it.
     corners: Vec<[u32; 3]>,
     face_dead: Vec<bool>,
     births: Vec<u32>,
-    /// Faces around each live node (dead ones dropped lazily).
-    node_faces: Vec<Vec<u32>>,
+    /// Pairs of slots.
     pairs: Vec<[u32; 2]>,
-    pair_version: Vec<u32>,
     pair_dead: Vec<bool>,
-    node_pairs: Vec<Vec<u32>>,
-    heap: BinaryHeap<Reverse<(u64, u32, u32)>>,
-    dependency_faces: Vec<Vec<u32>>,
-    mark: Vec<u32>,
+    /// Live pairs by cost (f32 bits, then pair id): keys updated in place, so the heap never
+    /// holds more than the live pairs.
+    heap: DaryHeapOfIndices<usize, u64, 8>,
+    /// Per inner node i: the faces (fn0..fn3) its split needs,
+    /// `dependency_faces[dependency_start[i]..dependency_start[i + 1]]`.
+    dependency_faces: Vec<u32>,
+    dependency_start: Vec<u32>,
+    /// Third corners of the faces vanishing in one contraction.
+    vanishing: Vec<u32>,
 }
 
 fn to_f(c: [u32; 3]) -> DVec3 {
     DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
 }
 
+/// A heap key: the cost as f32 bits above the pair's id, so ties go to the lower id.
+fn heap_key(cost: f64, pair: u32) -> u64 {
+    ((cost as f32).to_bits() as u64) << 32 | pair as u64
+}
+
 impl Contraction {
-    fn new(cells: &[[u32; 3]], faces: &[[u32; 3]], options: &BuildOptions) -> Contraction {
+    fn new(
+        cells: &[[u32; 3]],
+        faces: &[[u32; 3]],
+        vertex_of_slot: &[u32],
+        options: &BuildOptions,
+    ) -> Contraction {
         let n = cells.len();
         let total = 2 * n - 1;
         let signed: Vec<[i32; 3]> = cells.iter().map(|c| c.map(|x| x as i32)).collect();
         let t = topology(n, faces, &vec![true; faces.len()]);
-        let mut quadrics = initial_quadrics(&signed, faces, &t);
-        quadrics.resize(total, Quadric::default());
-        let mut positions: Vec<DVec3> = cells.iter().map(|&c| to_f(c)).collect();
-        positions.resize(total, DVec3::ZERO);
-        let mut node_faces = vec![Vec::new(); total];
+        let quadrics = initial_quadrics(&signed, faces, &t);
+        let slot_position: Vec<DVec3> = cells.iter().map(|&c| to_f(c)).collect();
+        let mut positions = vec![DVec3::ZERO; total];
+        for (slot, &v) in vertex_of_slot.iter().enumerate() {
+            positions[v as usize] = slot_position[slot];
+        }
+        let mut slot_faces = vec![Vec::new(); n];
         for (f, face) in faces.iter().enumerate() {
             for &v in face {
-                node_faces[v as usize].push(f as u32);
+                slot_faces[v as usize].push(f as u32);
             }
         }
         let pairs = initial_pairs(cells, faces, options.pair_distance);
-        let mut node_pairs = vec![Vec::new(); total];
+        let mut slot_pairs = vec![Vec::new(); n];
         for (p, &[a, b]) in pairs.iter().enumerate() {
-            node_pairs[a as usize].push(p as u32);
-            node_pairs[b as usize].push(p as u32);
+            slot_pairs[a as usize].push(p as u32);
+            slot_pairs[b as usize].push(p as u32);
         }
         let mut c = Contraction {
             balance: options.balance,
             leaves: n,
-            positions,
+            node: vertex_of_slot.to_vec(),
+            slot_position,
             quadrics,
-            height: vec![0; total],
-            rep_leaf: (0..total as u32).collect(),
-            alive: (0..total).map(|i| i < n).collect(),
-            children: Vec::with_capacity(n.saturating_sub(1)),
+            height: vec![0; n],
+            rep_leaf: vertex_of_slot.to_vec(),
+            alive: vec![true; n],
+            slot_faces,
+            slot_pairs,
+            mark: vec![u32::MAX; n],
+            positions,
             parent: vec![u32::MAX; total],
+            children: Vec::with_capacity(n.saturating_sub(1)),
             corners: faces.to_vec(),
             face_dead: vec![false; faces.len()],
             births: vec![u32::MAX; faces.len()],
-            node_faces,
-            pair_version: vec![0; pairs.len()],
             pair_dead: vec![false; pairs.len()],
             pairs,
-            node_pairs,
-            heap: BinaryHeap::new(),
-            dependency_faces: Vec::with_capacity(n.saturating_sub(1)),
-            mark: vec![u32::MAX; total],
+            heap: DaryHeapOfIndices::with_index_bound(0),
+            dependency_faces: Vec::with_capacity(2 * n),
+            dependency_start: vec![0],
+            vanishing: Vec::new(),
         };
-        let keys: Vec<_> = (0..c.pairs.len() as u32)
-            .map(|p| Reverse((c.cost(p).to_bits(), p, 0)))
+        let keys: Vec<(usize, u64)> = (0..c.pairs.len() as u32)
+            .into_par_iter()
+            .map(|p| (p as usize, heap_key(c.cost(p), p)))
             .collect();
-        c.heap = BinaryHeap::from(keys);
+        c.heap = DaryHeapOfIndices::from_iter_with_index_bound(c.pairs.len(), keys);
         c
     }
 
-    /// The merged quadric's optimum for a pair, or the best of its ends and midpoint.
+    /// The merged quadric's optimum for a pair of slots, or the best of its ends and midpoint.
     fn place(&self, a: u32, b: u32) -> (DVec3, Quadric) {
         let q = Quadric::sum(&self.quadrics[a as usize], &self.quadrics[b as usize]);
-        let (pa, pb) = (self.positions[a as usize], self.positions[b as usize]);
+        let (pa, pb) = (
+            self.slot_position[a as usize],
+            self.slot_position[b as usize],
+        );
         let fallback = || {
             [pa, pb, (pa + pb) * 0.5]
                 .into_iter()
@@ -157,7 +237,8 @@ impl Contraction {
     fn cost(&self, p: u32) -> f64 {
         let [a, b] = self.pairs[p as usize];
         let (pos, q) = self.place(a, b);
-        let length2 = self.positions[a as usize].distance_squared(self.positions[b as usize]);
+        let length2 =
+            self.slot_position[a as usize].distance_squared(self.slot_position[b as usize]);
         let eq = q.error(pos).max(0.0) + LENGTH_TIE_BREAK * length2 * length2;
         let d = self.height[a as usize].max(self.height[b as usize]) as f64 + 1.0;
         eq * (self.balance * d).exp2()
@@ -166,11 +247,8 @@ impl Contraction {
     fn run(&mut self) {
         let mut left = self.leaves;
         while left > 1 {
-            while let Some(Reverse((_, p, version))) = self.heap.pop() {
-                if self.pair_dead[p as usize] || self.pair_version[p as usize] != version {
-                    continue;
-                }
-                self.contract(p);
+            while let Some((p, _)) = self.heap.pop() {
+                self.contract(p as u32);
                 left -= 1;
             }
             if left > 1 {
@@ -179,108 +257,126 @@ impl Contraction {
         }
     }
 
+    /// Contracts pair `p` of slots (a, b) into a new node k in slot a.
     fn contract(&mut self, p: u32) {
         let [a, b] = self.pairs[p as usize];
         self.pair_dead[p as usize] = true;
         let k = (self.leaves + self.children.len()) as u32;
         let (pos, q) = self.place(a, b);
-        let (ra, rb) = (self.rep_leaf[a as usize], self.rep_leaf[b as usize]);
-        let ea = q.error(self.positions[ra as usize]);
-        let eb = q.error(self.positions[rb as usize]);
-        let [t, u] = if eb < ea { [b, a] } else { [a, b] };
-        let ku = k as usize;
+        let (au, bu) = (a as usize, b as usize);
+        let ea = q.error(self.positions[self.rep_leaf[au] as usize]);
+        let eb = q.error(self.positions[self.rep_leaf[bu] as usize]);
+        let (na, nb) = (self.node[au], self.node[bu]);
+        let [t, u] = if eb < ea { [nb, na] } else { [na, nb] };
+        let representative = if eb < ea {
+            self.rep_leaf[bu]
+        } else {
+            self.rep_leaf[au]
+        };
         self.children.push([t, u]);
-        self.parent[a as usize] = k;
-        self.parent[b as usize] = k;
-        self.positions[ku] = pos;
-        self.quadrics[ku] = q;
-        self.height[ku] = self.height[a as usize].max(self.height[b as usize]) + 1;
-        self.rep_leaf[ku] = self.rep_leaf[t as usize];
-        self.alive[a as usize] = false;
-        self.alive[b as usize] = false;
-        self.alive[ku] = true;
+        self.parent[na as usize] = k;
+        self.parent[nb as usize] = k;
+        self.positions[k as usize] = pos;
+        self.node[au] = k;
+        self.slot_position[au] = pos;
+        self.quadrics[au] = q;
+        self.height[au] = self.height[au].max(self.height[bu]) + 1;
+        self.rep_leaf[au] = representative;
+        self.alive[bu] = false;
 
-        // Faces: move both lists to k; faces holding both ends vanish here.
-        let mut faces = std::mem::take(&mut self.node_faces[a as usize]);
-        faces.append(&mut std::mem::take(&mut self.node_faces[b as usize]));
-        let mut vanishing: Vec<(u32, u32)> = Vec::new();
-        faces.retain(|&f| {
+        // Faces: b's move to a; those holding both vanish here.
+        let moving = std::mem::take(&mut self.slot_faces[bu]);
+        let mut vanishing = std::mem::take(&mut self.vanishing);
+        vanishing.clear();
+        let list_a = &mut self.slot_faces[au];
+        for f in moving {
             let fu = f as usize;
             if self.face_dead[fu] {
-                return false;
+                continue;
             }
             let c = &mut self.corners[fu];
-            let mut hits = 0;
+            if c.contains(&a) {
+                self.face_dead[fu] = true;
+                self.births[fu] = k;
+                let w = *c
+                    .iter()
+                    .find(|&&x| x != a && x != b)
+                    .expect("a face has three corners");
+                vanishing.push(w);
+                continue;
+            }
             for x in c.iter_mut() {
-                if *x == a || *x == b {
-                    *x = k;
-                    hits += 1;
+                if *x == b {
+                    *x = a;
                 }
             }
-            if hits >= 2 {
-                // Both lists hold it: vanish once.
-                if !self.face_dead[fu] {
-                    self.face_dead[fu] = true;
-                    self.births[fu] = k;
-                    let w = *c
-                        .iter()
-                        .find(|&&x| x != k)
-                        .expect("a face has three corners");
-                    vanishing.push((f, w));
-                }
-                return false;
-            }
-            true
-        });
+            list_a.push(f);
+        }
         // Hoppe 1997's fn0..fn3: the faces across the vanishing faces' other edges (k, w).
-        let mut depends = Vec::new();
-        for &(_, w) in &vanishing {
-            let list = &mut self.node_faces[w as usize];
+        let first = self.dependency_faces.len();
+        for &w in &vanishing {
+            let list = &mut self.slot_faces[w as usize];
             let (dead, corners) = (&self.face_dead, &self.corners);
             list.retain(|&g| !dead[g as usize]);
             for &g in list.iter() {
-                if corners[g as usize].contains(&k) && !depends.contains(&g) {
-                    depends.push(g);
+                if corners[g as usize].contains(&a) && !self.dependency_faces[first..].contains(&g)
+                {
+                    self.dependency_faces.push(g);
                 }
             }
         }
-        self.dependency_faces.push(depends);
-        self.node_faces[ku] = faces;
+        self.dependency_start
+            .push(self.dependency_faces.len() as u32);
+        let vanished = !vanishing.is_empty();
+        self.vanishing = vanishing;
+        if vanished {
+            let (dead, list) = (&self.face_dead, &mut self.slot_faces[au]);
+            list.retain(|&g| !dead[g as usize]);
+        }
 
-        // Pairs: move both lists to k, one pair per other end.
-        let mut pairs = std::mem::take(&mut self.node_pairs[a as usize]);
-        pairs.append(&mut std::mem::take(&mut self.node_pairs[b as usize]));
-        let mut kept = Vec::with_capacity(pairs.len());
-        for pid in pairs {
+        // Pairs: a's stay, b's move to a; one pair per other end.
+        let mut pairs = std::mem::take(&mut self.slot_pairs[au]);
+        let moving = std::mem::take(&mut self.slot_pairs[bu]);
+        pairs.retain(|&pid| !self.pair_dead[pid as usize]);
+        for &pid in &pairs {
+            let [x, y] = self.pairs[pid as usize];
+            let other = if x == a { y } else { x };
+            self.mark[other as usize] = k;
+        }
+        for pid in moving {
             let pu = pid as usize;
             if self.pair_dead[pu] {
                 continue;
             }
             let [x, y] = self.pairs[pu];
-            let other = if x == a || x == b { y } else { x };
-            if self.mark[other as usize] == k {
+            let other = if x == b { y } else { x };
+            if other == a || self.mark[other as usize] == k {
                 self.pair_dead[pu] = true;
+                if self.heap.contains(&pu) {
+                    self.heap.remove(&pu);
+                }
                 continue;
             }
             self.mark[other as usize] = k;
-            self.pairs[pu] = [k, other];
-            kept.push(pid);
+            self.pairs[pu] = [a, other];
+            pairs.push(pid);
         }
-        for &pid in &kept {
-            let pu = pid as usize;
-            self.pair_version[pu] += 1;
-            let key = self.cost(pid).to_bits();
-            self.heap.push(Reverse((key, pid, self.pair_version[pu])));
+        for &pid in &pairs {
+            let key = heap_key(self.cost(pid), pid);
+            self.heap.update_key_or_push(&(pid as usize), key);
         }
-        self.node_pairs[ku] = kept;
+        self.slot_pairs[au] = pairs;
     }
 
-    /// Pairs every live node with its nearest live neighbour.
+    /// Pairs every live slot with its nearest live neighbour.
     fn pair_nearest(&mut self) {
         let live: Vec<u32> = (0..self.alive.len() as u32)
             .filter(|&v| self.alive[v as usize])
             .collect();
-        let points: Vec<DVec3> = live.iter().map(|&v| self.positions[v as usize]).collect();
+        let points: Vec<DVec3> = live
+            .iter()
+            .map(|&v| self.slot_position[v as usize])
+            .collect();
         let mut found: Vec<[u32; 2]> = nearest_neighbours(&points)
             .into_iter()
             .enumerate()
@@ -291,19 +387,22 @@ impl Contraction {
             .collect();
         found.sort_unstable();
         found.dedup();
+        let mut keys = Vec::with_capacity(found.len());
         for pair in found {
             let pid = self.pairs.len() as u32;
             self.pairs.push(pair);
-            self.pair_version.push(0);
             self.pair_dead.push(false);
-            self.node_pairs[pair[0] as usize].push(pid);
-            self.node_pairs[pair[1] as usize].push(pid);
-            let key = self.cost(pid).to_bits();
-            self.heap.push(Reverse((key, pid, 0)));
+            self.slot_pairs[pair[0] as usize].push(pid);
+            self.slot_pairs[pair[1] as usize].push(pid);
+            keys.push((pid as usize, heap_key(self.cost(pid), pid)));
         }
+        // The heap is empty here: a new one covers the new pairs.
+        self.heap = DaryHeapOfIndices::from_iter_with_index_bound(self.pairs.len(), keys);
     }
 
-    fn finish(self) -> Result<VertexTree> {
+    /// The tree, faces back in the caller's order (`face_order[i]`: the caller's index of
+    /// internal face i).
+    fn finish(self, face_order: &[u32]) -> Result<VertexTree> {
         let total = self.parent.len();
         let root = (total - 1) as u32;
         let leaves = self.leaves;
@@ -319,18 +418,17 @@ impl Contraction {
                 })?;
             }
         }
-        let births = self.births;
-        let mut raw = 0;
-        let dependencies = self
-            .dependency_faces
-            .iter()
-            .enumerate()
-            .map(|(i, faces)| {
-                raw += faces.len();
+        let raw = self.dependency_faces.len();
+        let dependencies = (0..self.children.len())
+            .into_par_iter()
+            .map(|i| {
+                let range =
+                    self.dependency_start[i] as usize..self.dependency_start[i + 1] as usize;
+                let faces = &self.dependency_faces[range];
                 let own = ids[leaves + i];
                 let mut nodes: Vec<u32> = Vec::with_capacity(faces.len());
                 for &f in faces {
-                    let d = births[f as usize];
+                    let d = self.births[f as usize];
                     if !ids[d as usize].is_ancestor_of(own) && !nodes.contains(&d) {
                         nodes.push(d);
                     }
@@ -338,6 +436,10 @@ impl Contraction {
                 nodes
             })
             .collect();
+        let mut births = vec![0u32; self.births.len()];
+        for (internal, &f) in face_order.iter().enumerate() {
+            births[f as usize] = self.births[internal];
+        }
         Ok(VertexTree {
             leaves,
             children: self.children,
@@ -366,39 +468,51 @@ fn initial_pairs(cells: &[[u32; 3]], faces: &[[u32; 3]], fraction: f64) -> Vec<[
     }
     let threshold = fraction * length_sum / (3 * faces.len()).max(1) as f64;
     if threshold > 0.0 {
-        let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-        let key = |p: DVec3| (p / threshold).floor().to_array().map(|x| x as i64);
-        for (v, &c) in cells.iter().enumerate() {
-            grid.entry(key(to_f(c))).or_default().push(v as u32);
-        }
-        let mut near: Vec<(f64, u32)> = Vec::new();
-        for (v, &c) in cells.iter().enumerate() {
-            let p = to_f(c);
-            let [x, y, z] = key(p);
-            near.clear();
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for dz in -1..=1 {
-                        let Some(list) = grid.get(&[x + dx, y + dy, z + dz]) else {
-                            continue;
-                        };
-                        for &w in list {
-                            let d = p.distance(to_f(cells[w as usize]));
-                            if w != v as u32 && d < threshold {
-                                near.push((d, w));
-                            }
+        let points: Vec<DVec3> = cells.iter().map(|&c| to_f(c)).collect();
+        // Cells of twice the threshold: a point's ball of that radius meets at most the two
+        // cells nearest it along each axis, so eight cells hold every point it can pair with.
+        let size = 2.0 * threshold;
+        let grid = CellGrid::new(&points, DVec3::ZERO, size);
+        let close: Vec<Vec<[u32; 2]>> = points
+            .par_iter()
+            .enumerate()
+            .map(|(v, &p)| {
+                let cell = grid.key(p);
+                let side = |axis: usize| {
+                    let inside = p[axis] / size - cell[axis] as f64;
+                    if inside < 0.5 {
+                        -1
+                    } else {
+                        1
+                    }
+                };
+                let step = [side(0), side(1), side(2)];
+                let mut near: Vec<(f64, u32)> = Vec::new();
+                for corner in 0..8 {
+                    let mut key = cell;
+                    for (axis, k) in key.iter_mut().enumerate() {
+                        if corner >> axis & 1 == 1 {
+                            *k += step[axis];
+                        }
+                    }
+                    for &w in grid.cell(key) {
+                        let d = p.distance(points[w as usize]);
+                        if w != v as u32 && d < threshold {
+                            near.push((d, w));
                         }
                     }
                 }
-            }
-            near.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            for &(_, w) in near.iter().take(CLOSE_PAIRS_PER_VERTEX) {
+                near.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
                 let v = v as u32;
-                pairs.push([v.min(w), v.max(w)]);
-            }
-        }
+                near.iter()
+                    .take(CLOSE_PAIRS_PER_VERTEX)
+                    .map(|&(_, w)| [v.min(w), v.max(w)])
+                    .collect()
+            })
+            .collect();
+        pairs.extend(close.into_iter().flatten());
     }
-    pairs.sort_unstable();
+    pairs.par_sort_unstable();
     pairs.dedup();
     pairs
 }
@@ -412,17 +526,13 @@ fn nearest_neighbours(points: &[DVec3]) -> Vec<u32> {
     let cell = (extent.x * extent.y * extent.z * 2.0 / points.len() as f64)
         .cbrt()
         .max(extent.max_element() / 1024.0);
-    let key = |p: DVec3| ((p - lo) / cell).floor().to_array().map(|x| x as i64);
-    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-    for (i, &p) in points.iter().enumerate() {
-        grid.entry(key(p)).or_default().push(i as u32);
-    }
+    let grid = CellGrid::new(points, lo, cell);
     let reach = ((extent / cell).ceil().max_element() as i64) + 1;
     points
         .iter()
         .enumerate()
         .map(|(i, &p)| {
-            let [x, y, z] = key(p);
+            let [x, y, z] = grid.key(p);
             let mut best = (f64::MAX, u32::MAX);
             for r in 0..=reach {
                 // Every point within r − 1 cells is seen; stop once none closer can remain.
@@ -435,10 +545,7 @@ fn nearest_neighbours(points: &[DVec3]) -> Vec<u32> {
                             if dx.abs().max(dy.abs()).max(dz.abs()) != r {
                                 continue;
                             }
-                            let Some(list) = grid.get(&[x + dx, y + dy, z + dz]) else {
-                                continue;
-                            };
-                            for &j in list {
+                            for &j in grid.cell([x + dx, y + dy, z + dz]) {
                                 if j as usize == i {
                                     continue;
                                 }

@@ -21,6 +21,7 @@
 //! there; `came-paper` at the quadric optimum).
 
 mod build;
+mod grid;
 pub mod node_id;
 pub mod spheres;
 
