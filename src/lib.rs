@@ -36,6 +36,8 @@ pub mod limits;
 pub mod mesh;
 
 #[cfg(feature = "lab")]
+pub mod came_extras;
+#[cfg(feature = "lab")]
 pub mod cli;
 #[cfg(feature = "lab")]
 pub mod harness;

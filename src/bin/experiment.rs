@@ -63,6 +63,14 @@ enum Command {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// What the CAME tables need beyond `run experiments/came.toml`: both CAME codecs on a
+    /// mesh of over a million triangles, VRML sizes, came-paper bunny streams at 3 and 5 bits
+    /// per component; writes results/came/extras.json.
+    CameExtras {
+        /// Folder for results.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
     /// Regenerate the papers' tables and figures in paper-tables/ from results/.
     Tables {
         /// Folder of result files.
@@ -101,6 +109,7 @@ fn main() -> ExitCode {
         Some(Command::Run { file, settings }) => run_set(file, settings),
         Some(Command::Tables { results, out }) => tables(results, out),
         Some(Command::Decimation { out }) => decimation(out),
+        Some(Command::CameExtras { out }) => came_extras(out),
         None => match (&cli.codec, &cli.mesh) {
             (Some(codec), Some(mesh)) => run_one(codec, mesh, &cli.settings).map(|_| ()),
             _ => Err(anyhow::anyhow!(
@@ -308,6 +317,12 @@ fn tables(results: &Path, out: &Path) -> Result<()> {
     if written.is_empty() {
         anyhow::bail!("no table could be made from {}", results.display());
     }
+    Ok(())
+}
+
+fn came_extras(out: &Path) -> Result<()> {
+    let path = meshcodec::came_extras::run(out, &mut |line| eprintln!("{line}"))?;
+    meshcodec::outln!("wrote {}", path.display());
     Ok(())
 }
 

@@ -203,26 +203,29 @@ fn info(input: &Path, json: bool) -> Result<()> {
     let reader = StreamReader::open(&stream).with_context(context)?;
     let header = reader.header().clone();
     let codec = codecs::by_id(header.codec_id).with_context(context)?;
-    // Level sizes from the index, mesh sizes from decoding.
-    let declared = reader.index().len();
-    let sizes: Vec<(usize, usize)> = (0..declared)
-        .map_while(|i| reader.unit(i))
-        .map(|unit| (unit.start, unit.bytes.len()))
-        .collect();
+    // Level sizes from the index where each unit is a level, mesh sizes from decoding. In a
+    // stream of meta-nodes (CAME) a level takes every unit rooted above it, so only the units'
+    // count is listed.
+    let layered = reader.index().is_layered();
+    let units = reader.index().len();
+    let present = (0..units).map_while(|i| reader.unit(i)).count();
     let mut decoder = codecs::open(&stream).with_context(context)?;
+    let declared = decoder.levels();
     let mut levels = Vec::new();
-    for &(start, len) in &sizes {
-        decoder.advance().with_context(context)?;
+    while decoder.advance().with_context(context)? {
         let LevelMesh { mesh, loose_edges } = decoder.mesh()?;
+        let level = decoder.levels_decoded();
+        let unit = layered.then(|| reader.unit(level - 1)).flatten();
         levels.push(serde_json::json!({
-            "level": decoder.levels_decoded(),
-            "end_byte": start + len,
-            "payload_bytes": len,
+            "level": level,
+            "end_byte": unit.as_ref().map(|u| u.start + u.bytes.len()),
+            "payload_bytes": unit.as_ref().map(|u| u.bytes.len()),
             "vertices": mesh.vertex_count(),
             "triangles": mesh.face_count(),
             "loose_edges": loose_edges.len(),
         }));
     }
+    let sizes = &levels;
     let report = serde_json::json!({
         "file": input.display().to_string(),
         "bytes": stream.len(),
@@ -236,6 +239,8 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "levels_declared": declared,
         "payload_start": reader.payload_start(),
         "levels_present": sizes.len(),
+        "units": units,
+        "units_present": present,
         "truncated": reader.truncated(),
         "levels": levels,
     });
@@ -259,11 +264,16 @@ fn info(input: &Path, json: bool) -> Result<()> {
     );
     let _ = writeln!(
         text,
-        "full mesh: {} vertices, {} triangles; {} of {} levels present{}",
+        "full mesh: {} vertices, {} triangles; {} of {} levels present{}{}",
         header.vertices,
         header.triangles,
         sizes.len(),
         declared,
+        if layered {
+            String::new()
+        } else {
+            format!(" ({present} of {units} meta-node units)")
+        },
         if reader.truncated() {
             " (truncated)"
         } else {
@@ -276,7 +286,10 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "level", "end byte", "bytes", "vertices", "triangles"
     );
     for l in &levels {
-        let cell = |key: &str| l[key].to_string();
+        let cell = |key: &str| match &l[key] {
+            serde_json::Value::Null => "—".to_string(),
+            v => v.to_string(),
+        };
         let _ = writeln!(
             text,
             "{:>5} {:>10} {:>10} {:>10} {:>10}",

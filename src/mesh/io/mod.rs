@@ -10,6 +10,7 @@ mod off;
 mod ply;
 mod stl;
 mod text;
+pub mod vrml;
 
 use super::TriMesh;
 use crate::error::{Error, Result};
@@ -54,16 +55,17 @@ pub fn read_mesh_bytes(bytes: &[u8], format: &str) -> Result<TriMesh> {
     Ok(mesh)
 }
 
-/// Writes `mesh` as binary PLY (double positions) or OBJ, by the extension of `path`. The file
+/// Writes `mesh` as binary PLY (double positions), OBJ or VRML, by the extension of `path`. The file
 /// appears only when it is complete: it is written beside and renamed into place.
 pub fn write_mesh(mesh: &TriMesh, path: &Path) -> Result<()> {
     let mut bytes = Vec::new();
     match extension(path).as_str() {
         "ply" => write_ply(mesh, &mut bytes)?,
         "obj" => write_obj(mesh, &mut bytes)?,
+        "wrl" => vrml::write_vrml(mesh, &mut bytes)?,
         other => {
             return Err(Error::Unsupported(format!(
-                "output format '.{other}' (writers: ply, obj)"
+                "output format '.{other}' (writers: ply, obj, wrl)"
             )))
         }
     }

@@ -1,6 +1,6 @@
 //! The papers' tables and figures, regenerated from the result files in results/ beside the
-//! papers' own figures. Nothing here encodes: tables read `RunResult`s, and the rendered figure
-//! decodes the streams that the experiments kept.
+//! papers' own figures. Nothing here encodes: tables read `RunResult`s, and the rendered figures
+//! decode the streams that the experiments kept. Grabner's CAME tables are in `came.rs`.
 
 use crate::codecs::stats::{PmField, Stat};
 use crate::codecs::EncodeOptions;
@@ -14,6 +14,8 @@ use crate::results::{self, read_result, RunResult};
 use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+mod came;
 
 /// One row of EMC's Table 1 as printed in the paper.
 struct PaperRow {
@@ -314,6 +316,18 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
     match emc_rate_distortion(results, out) {
         Ok(p) => written.extend(p),
         Err(e) => missing.push(format!("emc-rate-distortion: {e}")),
+    }
+    match came::tables(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("came: {e}")),
+    }
+    match came::fig4(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("came-fig4: {e}")),
+    }
+    match came::rate_distortion(results, out) {
+        Ok(p) => written.extend(p),
+        Err(e) => missing.push(format!("came-rate-distortion: {e}")),
     }
     (written, missing)
 }
@@ -705,7 +719,13 @@ mod tests {
         let out = tempfile::tempdir().unwrap();
         let (written, skipped) = regenerate(&results, out.path());
         assert!(skipped.is_empty(), "skipped: {skipped:?}");
-        for name in ["emc-table1.md", "emc-vs-anchors.md", "hoppe-pm.md"] {
+        for name in [
+            "emc-table1.md",
+            "emc-vs-anchors.md",
+            "hoppe-pm.md",
+            "came.md",
+            "came-fig4.png",
+        ] {
             assert!(
                 written.iter().any(|p| p.ends_with(name)),
                 "{name} not written"
