@@ -302,7 +302,7 @@ pub fn tables(results: &Path, out: &Path) -> Result<PathBuf> {
 
     let _ = writeln!(md, "\n## Fig. 4 and the rate–distortion curve\n");
     let _ = writeln!(md, "[came-fig4.png](came-fig4.png): the bunny from `came-paper` at 5 and 3 bits per component ({} and {} bytes, Hausdorff {:.1e} and {:.1e} of the diagonal) beside the original, with error screens, as the paper's Fig. 4 shows its dino: at 3 bits the shape holds and the surface turns grainy. Fewer bits a component save little: the components are about a quarter of the stream.\n", fig4_bytes(&extras, 5), fig4_bytes(&extras, 3), fig4_error(&extras, 5), fig4_error(&extras, 3));
-    let _ = writeln!(md, "[came-rate-distortion.png](came-rate-distortion.png): every level (front depth) of both CAME codecs on the bunny beside `emc` and `pm`. The curves are staircases: a level needs every meta-node rooted above it, and meta-nodes are 8 levels deep (`came`'s below depth 8 hold their whole subtrees), so the levels arrive in {} (`came`) and {} (`came-paper`) steps of bytes. CAME is made to be fetched by meta-nodes where a view needs them (part 2), not level by level; as a progressive stream, `emc` and `pm` reach each error at a fraction of the bits.", distinct_steps(results, "came")?, distinct_steps(results, "came-paper")?);
+    let _ = writeln!(md, "[came-rate-distortion.png](came-rate-distortion.png) and [came-rate-resolution.png](came-rate-resolution.png): every level (front depth) of both CAME codecs on the bunny beside `emc` and `pm`. The curves are staircases: a level needs every meta-node rooted above it, and meta-nodes are 8 levels deep (`came`'s below depth 8 hold their whole subtrees), so the levels arrive in {} (`came`) and {} (`came-paper`) steps of bytes. CAME is made to be fetched by meta-nodes where a view needs them (part 2), not level by level; as a progressive stream, `emc` and `pm` reach each error at a fraction of the bits.", distinct_steps(results, "came")?, distinct_steps(results, "came-paper")?);
 
     let path = out.join("came.md");
     std::fs::write(&path, md)?;
@@ -422,8 +422,9 @@ pub fn fig4(results: &Path, out: &Path) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// Writes paper-tables/came-rate-distortion.{png,svg}: bits against Hausdorff error on the
-/// bunny for every level of `came-paper` and `came` beside `emc` and `pm`, all at 12 bits.
+/// Writes paper-tables/came-rate-distortion.{png,svg} (bits against Hausdorff error) and
+/// came-rate-resolution.{png,svg} (level against bits per vertex) on the bunny for every level
+/// of `came-paper` and `came` beside `emc` and `pm`, all at 12 bits.
 pub fn rate_distortion(results: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     let mut runs = Vec::new();
     for codec in ["came-paper", "came"] {
@@ -436,5 +437,11 @@ pub fn rate_distortion(results: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     chart.title =
         "Rate vs distortion — bunny.ply at 12 bits: CAME's levels (front depths) beside EMC and PM"
             .into();
-    chart.draw(&out.join("came-rate-distortion"))
+    let mut written = chart.draw(&out.join("came-rate-distortion"))?;
+    let mut chart = plot::rate_resolution(&runs, "bunny.ply, 12 bits");
+    chart.title =
+        "Rate vs resolution — bunny.ply at 12 bits: CAME's front depths beside EMC's and PM's levels"
+            .into();
+    written.extend(chart.draw(&out.join("came-rate-resolution"))?);
+    Ok(written)
 }

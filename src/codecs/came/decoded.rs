@@ -49,8 +49,11 @@ pub struct DecodedTree {
     pub lookup: HashMap<u64, u32, foldhash::fast::FixedState>,
     /// Triangles in decoding order.
     pub triangles: Vec<Triangle>,
-    /// Per split decoded: the node and the splits it depends on.
-    pub dependencies: Vec<(NodeId, Vec<NodeId>)>,
+    /// Per split decoded: the node and the range of `dependency_nodes` holding the splits it
+    /// depends on (one array for all, so a split costs no allocation of its own).
+    pub dependencies: Vec<(NodeId, std::ops::Range<u32>)>,
+    /// The dependencies of every split, in decoding order.
+    pub dependency_nodes: Vec<NodeId>,
     max_nodes: usize,
     max_triangles: usize,
 }
@@ -65,8 +68,9 @@ impl DecodedTree {
         DecodedTree {
             nodes: Vec::with_capacity(expected),
             lookup: HashMap::with_capacity_and_hasher(expected, Default::default()),
-            triangles: Vec::new(),
+            triangles: Vec::with_capacity(triangles.min(2 * stream_bytes as u64) as usize),
             dependencies: Vec::new(),
+            dependency_nodes: Vec::new(),
             max_nodes: (2 * vertices).saturating_sub(1) as usize,
             max_triangles: triangles as usize,
         }
@@ -150,6 +154,22 @@ impl DecodedTree {
             });
         }
         Ok([first, first + 1])
+    }
+
+    /// Records the dependencies of split `s` (those pushed onto `dependency_nodes` since
+    /// `first`).
+    pub fn close_dependencies(&mut self, s: NodeId, first: usize) {
+        let range = first as u32..self.dependency_nodes.len() as u32;
+        self.dependencies.push((s, range));
+    }
+
+    /// The splits split `i` (in decoding order) depends on.
+    pub fn dependencies_of(&self, i: usize) -> (NodeId, &[NodeId]) {
+        let (s, range) = &self.dependencies[i];
+        (
+            *s,
+            &self.dependency_nodes[range.start as usize..range.end as usize],
+        )
     }
 
     /// Adds a triangle, within the header's count.

@@ -800,7 +800,7 @@ impl UnitDecoder for ModelledUnits {
                 )?;
             }
             let count = r.uint(|c| &mut c.dependencies, 64, "dependencies of a split")?;
-            let mut deps = Vec::with_capacity(count as usize);
+            let first = r.tree.dependency_nodes.len();
             for _ in 0..count {
                 let which = r.uint(
                     |c| &mut c.dependency_on,
@@ -816,14 +816,15 @@ impl UnitDecoder for ModelledUnits {
                     let Some(len) = len else {
                         return Err(Error::malformed(0, at, "a dependency above its path"));
                     };
-                    deps.push(leaf.ancestor(len as u8));
+                    r.tree.dependency_nodes.push(leaf.ancestor(len as u8));
                     continue;
                 }
                 let up = r.uint(|c| &mut c.dependency_up, 52, "a dependency's up")? + 1;
                 let start = r.other_child(sid, up)?;
-                deps.push(r.dependency_path(start)?);
+                let dependency = r.dependency_path(start)?;
+                r.tree.dependency_nodes.push(dependency);
             }
-            r.tree.dependencies.push((sid, deps));
+            r.tree.close_dependencies(sid, first);
         }
         Ok(children_units)
     }

@@ -643,13 +643,14 @@ impl UnitDecoder for PaperUnits {
                 MAX_DEPENDENCIES,
                 "dependencies of a split",
             )?;
-            let mut deps = Vec::with_capacity(count as usize);
+            let first = tree.dependency_nodes.len();
             for _ in 0..count {
                 let up = r.symbol(Table::DependencyUp)? + 1;
                 let start = r.other_child(sid, up)?;
-                deps.push(r.path(Table::DependencyLength, start)?);
+                let dependency = r.path(Table::DependencyLength, start)?;
+                tree.dependency_nodes.push(dependency);
             }
-            tree.dependencies.push((sid, deps));
+            tree.close_dependencies(sid, first);
         }
         Ok(children_units)
     }
@@ -734,6 +735,19 @@ mod tests {
         }
         assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
         assert!(errors[2] < 0.01, "{errors:?}");
+    }
+
+    #[test]
+    fn prefixes_decode_the_levels_they_hold() {
+        let (canonical, bytes) = stream(&generate::icosphere(4), 5);
+        let (_, levels) = decode(&bytes, Stop::All).unwrap();
+        let mut previous = 0;
+        for cut in [bytes.len() / 4, bytes.len() / 2, bytes.len() - 1] {
+            let (mesh, got) = decode(&bytes[..cut], Stop::All).unwrap();
+            assert!(got >= previous && got < levels, "{got} of {levels}");
+            assert!(mesh.mesh.face_count() <= canonical.face_count());
+            previous = got;
+        }
     }
 
     #[test]
