@@ -72,21 +72,10 @@ fn with_header(bytes: &[u8], body: usize, header: &Header) -> Vec<u8> {
     out
 }
 
-/// Every codec of the build.
-const CODECS: [&str; 7] = [
-    "raw",
-    "emc",
-    "emc-paper",
-    "pm",
-    "pm-reordered",
-    "came",
-    "came-paper",
-];
-
 #[test]
 fn headers_claiming_too_much_are_refused_as_limits() {
     let _one = ONE_AT_A_TIME.lock().unwrap();
-    for codec in CODECS {
+    for codec in meshcodec::codecs::names::ALL.map(|n| n.name) {
         let (bytes, header, body) = stream(codec);
         for (what, claim) in [
             (
@@ -139,7 +128,7 @@ fn claims_within_the_limits_cost_only_what_the_stream_holds() {
     let _one = ONE_AT_A_TIME.lock().unwrap();
     // The most a header may claim, over levels of a few hundred bytes: every decoder must
     // stop at what its levels hold, not at what the header promised.
-    for codec in CODECS {
+    for codec in meshcodec::codecs::names::ALL.map(|n| n.name) {
         let (bytes, header, body) = stream(codec);
         let claim = Header {
             vertices: meshcodec::limits::MAX_VERTICES,
@@ -205,7 +194,7 @@ fn decoding_takes_memory_in_proportion_to_the_mesh() {
     let _one = ONE_AT_A_TIME.lock().unwrap();
     // Bytes of the decoded mesh: positions (3 doubles) and faces (3 indices).
     let mesh = io::read_mesh(&io::resolve("bunny-3k-closed").unwrap()).unwrap();
-    for codec in CODECS {
+    for codec in meshcodec::codecs::names::ALL.map(|n| n.name) {
         let codec = codecs::by_name(codec).unwrap();
         let options = codec.default_options();
         let canonical = codecs::canonical_for(&mesh, &options).unwrap();

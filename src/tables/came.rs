@@ -3,7 +3,7 @@
 //! bunny's rate–distortion curve beside `emc` and `pm`. Everything is read from results/:
 //! the harness's runs (`experiments/came.toml`) and results/came/extras.json.
 
-use super::{load_at, view_of};
+use super::{draw_panel, load_at, view_of};
 use crate::came_extras::{self, Extras, COMMAND};
 use crate::codecs::stats::{CameField, Stat};
 use crate::codecs::{self, Stats, Stop};
@@ -395,20 +395,9 @@ pub fn fig4(results: &Path, out: &Path) -> Result<PathBuf> {
     .map_err(|e| fail(&e))?;
     for (col, (caption, pixels, error)) in panels.iter().enumerate() {
         let x0 = col as u32 * PANEL;
-        let draw = |pixels: &[[u8; 3]], y0: u32| -> Result<()> {
-            for (i, px) in pixels.iter().enumerate() {
-                if *px == [255, 255, 255] {
-                    continue;
-                }
-                let (x, y) = (x0 + i as u32 % PANEL, y0 + i as u32 / PANEL);
-                root.draw_pixel((x as i32, y as i32), &RGBColor(px[0], px[1], px[2]))
-                    .map_err(|e| fail(&e))?;
-            }
-            Ok(())
-        };
-        draw(pixels, TITLE)?;
+        draw_panel(&root, pixels, PANEL, (x0, TITLE))?;
         if let Some(error) = error {
-            draw(error, TITLE + PANEL + CAPTION)?;
+            draw_panel(&root, error, PANEL, (x0, TITLE + PANEL + CAPTION))?;
         }
         root.draw_text(
             caption,

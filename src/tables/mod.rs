@@ -264,14 +264,7 @@ pub fn emc_fig5(results: &Path, out: &Path) -> Result<PathBuf> {
             let (decoded, _) = codecs::decode(&stream, Stop::Levels(level))?;
             let picture = render(&decoded.mesh, &frame, view, PANEL, PANEL);
             let (x0, y0) = (col as u32 * PANEL, TITLE + row as u32 * (PANEL + CAPTION));
-            for (i, px) in picture.pixels.iter().enumerate() {
-                if *px == [255, 255, 255] {
-                    continue;
-                }
-                let (x, y) = (x0 + i as u32 % PANEL, y0 + i as u32 / PANEL);
-                root.draw_pixel((x as i32, y as i32), &RGBColor(px[0], px[1], px[2]))
-                    .map_err(|e| fail(&e))?;
-            }
+            draw_panel(&root, &picture.pixels, PANEL, (x0, y0))?;
             let bytes = result.levels[level - 1].bits / 8;
             let caption = format!("EMC level {level}: {bytes} bytes");
             root.draw_text(
@@ -285,6 +278,24 @@ pub fn emc_fig5(results: &Path, out: &Path) -> Result<PathBuf> {
     root.present().map_err(|e| fail(&e))?;
     drop(root);
     Ok(path)
+}
+
+/// Draws a rendered panel of `width`-pixel rows at `origin`, its white background left out.
+fn draw_panel<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    pixels: &[[u8; 3]],
+    width: u32,
+    (x0, y0): (u32, u32),
+) -> Result<()> {
+    for (i, px) in pixels.iter().enumerate() {
+        if *px == [255, 255, 255] {
+            continue;
+        }
+        let (x, y) = (x0 + i as u32 % width, y0 + i as u32 / width);
+        root.draw_pixel((x as i32, y as i32), &RGBColor(px[0], px[1], px[2]))
+            .map_err(|e| Error::Io(std::io::Error::other(format!("plot: {e}"))))?;
+    }
+    Ok(())
 }
 
 /// Regenerates every paper table and figure whose results are present; returns what it wrote

@@ -133,7 +133,7 @@ pub fn born_triangles(tree: &VertexTree, mesh: &CanonicalMesh) -> Vec<Vec<BornTr
 
 /// Writes the units of `partition` (payloads and costs in unit order) as a stream whose levels
 /// are the depths of the front.
-pub fn write_stream(
+fn write_stream(
     header: &Header,
     tree: &VertexTree,
     partition: &Partition,
@@ -179,13 +179,78 @@ pub fn write_stream(
     writer.finish()
 }
 
+/// What a CAME coder makes of one unit: its bytes, their bits per syntax class, and per field
+/// (named as [`CameField::name`]).
+pub type CodedUnit = (
+    Vec<u8>,
+    crate::coding::BitLedger,
+    std::collections::BTreeMap<&'static str, f64>,
+);
+
+/// What differs between the CAME codecs' streams: the codec, how meta-nodes end near the
+/// leaves, and the bits of components and radius ratios (the header's parameters).
+#[derive(Clone, Copy, Debug)]
+pub struct Layout {
+    /// Codec id.
+    pub id: u8,
+    /// Meta-nodes near the leaves.
+    pub tails: partition::Tails,
+    /// Bits per PCA component (0: none).
+    pub component_bits: u8,
+    /// Bits per radius ratio.
+    pub radius_bits: u8,
+}
+
+/// Encodes `mesh` as a CAME stream: builds the hierarchy, partitions it into meta-nodes, has
+/// `code_units` code every unit in stream order, and writes the stream with its levels and
+/// statistics.
+pub fn encode_stream(
+    mesh: &CanonicalMesh,
+    layout: Layout,
+    code_units: impl FnOnce(&VertexTree, &Partition) -> Vec<CodedUnit>,
+) -> Result<crate::codecs::Encoded> {
+    let started = std::time::Instant::now();
+    let tree = hierarchy(mesh)?;
+    let seconds = started.elapsed().as_secs_f64();
+    let part = partition::partition(&tree, META_LEVELS, layout.tails);
+    let params = Params {
+        meta_levels: META_LEVELS,
+        depth: tree.depth(),
+        component_bits: layout.component_bits,
+        radius_bits: layout.radius_bits,
+    };
+    let mut fields = std::collections::BTreeMap::<&'static str, f64>::new();
+    let units: Vec<(Vec<u8>, LevelCost)> = code_units(&tree, &part)
+        .into_iter()
+        .map(|(bytes, ledger, unit_fields)| {
+            for (k, v) in unit_fields {
+                *fields.entry(k).or_default() += v;
+            }
+            let cost = LevelCost {
+                connectivity_bits: ledger.connectivity,
+                geometry_bits: ledger.geometry,
+                ..Default::default()
+            };
+            (bytes, cost)
+        })
+        .collect();
+    let (bytes, levels) = write_stream(&header(layout.id, mesh, params), &tree, &part, units);
+    let mut stats = Stats::default();
+    hierarchy_stats(&tree, &part, seconds, &fields, &mut stats);
+    Ok(crate::codecs::Encoded {
+        bytes,
+        levels,
+        stats,
+    })
+}
+
 /// The error of a unit whose bytes end inside a syntax element (`at`: the unit's offset).
 pub fn cut_at(at: usize) -> Error {
     Error::malformed(0, at, "a CAME unit ends inside a syntax element")
 }
 
 /// The stream's header for `mesh` and `params`.
-pub fn header(id: u8, mesh: &CanonicalMesh, params: Params) -> Header {
+fn header(id: u8, mesh: &CanonicalMesh, params: Params) -> Header {
     Header {
         codec_id: id,
         params: params.to_bytes(),
@@ -206,7 +271,7 @@ pub fn hierarchy(mesh: &CanonicalMesh) -> Result<VertexTree> {
 }
 
 /// Records what every CAME encoder reports.
-pub fn hierarchy_stats(
+fn hierarchy_stats(
     tree: &VertexTree,
     partition: &Partition,
     seconds: f64,

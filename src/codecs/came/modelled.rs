@@ -10,15 +10,12 @@
 
 use super::decoded::{CameDecoder, DecodedTree, Triangle, UnitDecoder};
 use super::knowledge::Status;
-use super::partition::{partition, Partition, Tails};
-use super::{
-    born_triangles, cut_at, header, hierarchy, hierarchy_stats, write_stream, BornTriangle, Params,
-    META_LEVELS,
-};
+use super::partition::{Partition, Tails};
+use super::{born_triangles, cut_at, encode_stream, BornTriangle, Layout, Params};
 use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
 use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext, IntContext, UintContext};
 use crate::coding::SyntaxClass;
-use crate::container::{Header, LevelCost, StreamReader};
+use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
 use crate::hierarchy::came::{NodeId, VertexTree};
@@ -135,39 +132,15 @@ impl Codec for Came {
     }
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
-        let started = std::time::Instant::now();
-        let tree = hierarchy(mesh)?;
-        let seconds = started.elapsed().as_secs_f64();
-        let part = partition(&tree, META_LEVELS, Tails::Whole);
-        let params = Params {
-            meta_levels: META_LEVELS,
-            depth: tree.depth(),
+        let layout = Layout {
+            id: self.id(),
+            tails: Tails::Whole,
             component_bits: 0,
             radius_bits: RADIUS_BITS,
         };
-        let encoder = Encoder::new(&tree, mesh, &part);
-        let mut fields = std::collections::BTreeMap::<&'static str, f64>::new();
-        let units: Vec<(Vec<u8>, LevelCost)> = (0..part.units.len())
-            .map(|m| {
-                let (bytes, ledger, unit_fields) = encoder.unit(m);
-                for (k, v) in unit_fields {
-                    *fields.entry(k).or_default() += v;
-                }
-                let cost = LevelCost {
-                    connectivity_bits: ledger.connectivity,
-                    geometry_bits: ledger.geometry,
-                    ..Default::default()
-                };
-                (bytes, cost)
-            })
-            .collect();
-        let (bytes, levels) = write_stream(&header(self.id(), mesh, params), &tree, &part, units);
-        let mut stats = Stats::default();
-        hierarchy_stats(&tree, &part, seconds, &fields, &mut stats);
-        Ok(Encoded {
-            bytes,
-            levels,
-            stats,
+        encode_stream(mesh, layout, |tree, part| {
+            let encoder = Encoder::new(tree, mesh, part);
+            (0..part.units.len()).map(|m| encoder.unit(m)).collect()
         })
     }
 

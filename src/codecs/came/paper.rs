@@ -15,15 +15,12 @@
 
 use super::decoded::{CameDecoder, DecodedTree, Triangle, UnitDecoder};
 use super::frame::Frame;
-use super::partition::{partition, Partition, Tails};
-use super::{
-    born_triangles, cut_at, header, hierarchy, hierarchy_stats, write_stream, BornTriangle, Params,
-    META_LEVELS,
-};
+use super::partition::{Partition, Tails};
+use super::{born_triangles, cut_at, encode_stream, BornTriangle, Layout, Params};
 use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
-use crate::coding::huffman::{get_gamma, Huffman};
+use crate::coding::huffman::{get_gamma, Huffman, LENGTH_FIELD_BITS};
 use crate::coding::{BitSink, BitSource, SyntaxClass};
-use crate::container::{Header, LevelCost, StreamReader};
+use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
 use crate::hierarchy::came::{NodeId, VertexTree, MAX_DEPTH};
@@ -195,64 +192,45 @@ impl Codec for CamePaper {
                 "came-paper codes 1 to 16 bits per component".into(),
             ));
         }
-        let started = std::time::Instant::now();
-        let tree = hierarchy(mesh)?;
-        let seconds = started.elapsed().as_secs_f64();
-        let part = partition(&tree, META_LEVELS, Tails::Split);
-        let params = Params {
-            meta_levels: META_LEVELS,
-            depth: tree.depth(),
+        let layout = Layout {
+            id: self.id(),
+            tails: Tails::Split,
             component_bits: self.component_bits,
             radius_bits: RADIUS_BITS,
         };
-        let encoder = Encoder::new(&tree, mesh, &part, self.component_bits);
-        let mut counter = Counter {
-            counts: [[0; SYMBOLS]; TABLES],
-        };
-        for m in 0..part.units.len() {
-            encoder.unit(m, &mut counter);
-        }
-        let tables: Vec<Huffman> = counter
-            .counts
-            .iter()
-            .map(|c| Huffman::from_lengths(&Huffman::lengths_for(c)))
-            .collect();
-        let mut fields = BTreeMap::<&'static str, f64>::new();
-        let units: Vec<(Vec<u8>, LevelCost)> = (0..part.units.len())
-            .map(|m| {
-                let mut writer = Writer {
-                    sink: BitSink::default(),
-                    tables: &tables,
-                    fields: BTreeMap::new(),
-                };
-                if m == 0 {
-                    for (table, field) in tables.iter().zip(TABLE_FIELDS) {
-                        table.write_lengths(&mut writer.sink, field.class());
-                        let bits =
-                            (SYMBOLS as u32 * crate::coding::huffman::LENGTH_FIELD_BITS) as f64;
-                        *writer.fields.entry(field.name()).or_default() += bits;
+        let bits = self.component_bits;
+        encode_stream(mesh, layout, |tree, part| {
+            let encoder = Encoder::new(tree, mesh, part, bits);
+            let mut counter = Counter {
+                counts: [[0; SYMBOLS]; TABLES],
+            };
+            for m in 0..part.units.len() {
+                encoder.unit(m, &mut counter);
+            }
+            let tables: Vec<Huffman> = counter
+                .counts
+                .iter()
+                .map(|c| Huffman::from_lengths(&Huffman::lengths_for(c)))
+                .collect();
+            (0..part.units.len())
+                .map(|m| {
+                    let mut writer = Writer {
+                        sink: BitSink::default(),
+                        tables: &tables,
+                        fields: BTreeMap::new(),
+                    };
+                    if m == 0 {
+                        let bits = (SYMBOLS as u32 * LENGTH_FIELD_BITS) as f64;
+                        for (table, field) in tables.iter().zip(TABLE_FIELDS) {
+                            table.write_lengths(&mut writer.sink, field.class());
+                            *writer.fields.entry(field.name()).or_default() += bits;
+                        }
                     }
-                }
-                encoder.unit(m, &mut writer);
-                for (k, v) in writer.fields {
-                    *fields.entry(k).or_default() += v;
-                }
-                let (bytes, ledger) = writer.sink.finish();
-                let cost = LevelCost {
-                    connectivity_bits: ledger.connectivity,
-                    geometry_bits: ledger.geometry,
-                    ..Default::default()
-                };
-                (bytes, cost)
-            })
-            .collect();
-        let (bytes, levels) = write_stream(&header(self.id(), mesh, params), &tree, &part, units);
-        let mut stats = Stats::default();
-        hierarchy_stats(&tree, &part, seconds, &fields, &mut stats);
-        Ok(Encoded {
-            bytes,
-            levels,
-            stats,
+                    encoder.unit(m, &mut writer);
+                    let (bytes, ledger) = writer.sink.finish();
+                    (bytes, ledger, writer.fields)
+                })
+                .collect()
         })
     }
 
@@ -413,35 +391,32 @@ impl<'a> Encoder<'a> {
                     let below = sid.len() + 1;
                     path(out, Table::SiblingLength, Field::Connectivity, leaf, below);
                 }
-                let junction = l3.common_len(sid);
-                let up = sid.len() - junction;
-                out.symbol(Table::ThirdUp, Field::Connectivity, up as usize - 1);
-                path(
-                    out,
-                    Table::ThirdLength,
-                    Field::Connectivity,
-                    l3,
-                    junction + 1,
-                );
+                let tables = (Table::ThirdUp, Table::ThirdLength);
+                relative_path(out, tables, Field::Connectivity, l3, sid);
                 out.bits(Field::Connectivity, 1, tri.flipped as u64);
             }
             let deps = &tree.dependencies[s as usize - tree.leaves];
             out.count(Table::Dependencies, Field::Dependencies, deps.len() as u64);
             for &y in deps {
-                let yid = tree.ids[y as usize];
-                let junction = yid.common_len(sid);
-                let up = sid.len() - junction;
-                out.symbol(Table::DependencyUp, Field::Dependencies, up as usize - 1);
-                path(
-                    out,
-                    Table::DependencyLength,
-                    Field::Dependencies,
-                    yid,
-                    junction + 1,
-                );
+                let tables = (Table::DependencyUp, Table::DependencyLength);
+                relative_path(out, tables, Field::Dependencies, tree.ids[y as usize], sid);
             }
         }
     }
+}
+
+/// Writes `id` relative to split `sid`: up − 1 to the junction, then the path below the
+/// junction's other child (its first bit implied).
+fn relative_path(
+    out: &mut impl Out,
+    (up, length): (Table, Table),
+    field: Field,
+    id: NodeId,
+    sid: NodeId,
+) {
+    let junction = id.common_len(sid);
+    out.symbol(up, field, (sid.len() - junction) as usize - 1);
+    path(out, length, field, id, junction + 1);
 }
 
 /// Writes the bits of `id` from depth `from` on, after their count.
