@@ -45,7 +45,9 @@ pub struct Came;
 struct Contexts {
     whole: BitContext,
     leaf_child: Vec<[BitContext; 2]>,
-    coordinate: Vec<[IntContext; 3]>,
+    /// Per class of the parent's radius, made when first used: a unit meets only a few of the
+    /// classes, and each is 3 KB of contexts to set up.
+    coordinate: Vec<Option<Box<[IntContext; 3]>>>,
     ratio: [Vec<BitContext>; 2],
     triangles: [UintContext; 4],
     up: UintContext,
@@ -65,7 +67,7 @@ impl Contexts {
         Contexts {
             whole: BitContext::default(),
             leaf_child: vec![[BitContext::default(); 2]; DEPTHS],
-            coordinate: vec![Default::default(); SCALES],
+            coordinate: vec![None; SCALES],
             ratio: [
                 vec![BitContext::default(); 1 << RADIUS_BITS],
                 vec![BitContext::default(); 1 << RADIUS_BITS],
@@ -82,6 +84,13 @@ impl Contexts {
             dependency_up: UintContext::default(),
             stop: [BitContext::default(); 16],
         }
+    }
+}
+
+impl Contexts {
+    /// The difference vector's contexts for radius class `class`.
+    fn coordinates(&mut self, class: usize) -> &mut [IntContext; 3] {
+        self.coordinate[class].get_or_insert_with(Default::default)
     }
 }
 
@@ -246,7 +255,12 @@ impl<'a> Encoder<'a> {
             let class = scale(self.radii[s as usize]);
             let d = sub(self.positions[u as usize], self.positions[s as usize]);
             for (axis, &x) in d.iter().enumerate() {
-                enc.int(&mut ctx.coordinate[class][axis], x as i64, G, "coordinates");
+                enc.int(
+                    &mut ctx.coordinates(class)[axis],
+                    x as i64,
+                    G,
+                    "coordinates",
+                );
             }
             for (side, c) in [t, u].into_iter().enumerate() {
                 if tree.is_leaf(c) {
@@ -702,7 +716,7 @@ impl UnitDecoder for ModelledUnits {
             for (axis, p) in pu.iter_mut().enumerate() {
                 let d = r
                     .dec
-                    .int(&mut r.ctx.coordinate[class][axis])
+                    .int(&mut r.ctx.coordinates(class)[axis])
                     .ok_or_else(|| r.cut())?;
                 if d.unsigned_abs() > 1 << 31 {
                     return Err(Error::malformed(
