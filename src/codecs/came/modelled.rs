@@ -561,6 +561,17 @@ impl UnitReader<'_> {
         )
     }
 
+    /// The status and node of child `bit` of a walk's node: its decoded child below a split
+    /// this unit knows (no lookup), nothing known below any other.
+    fn descend(&self, status: Status, node: Option<u32>, bit: bool) -> (Status, Option<u32>) {
+        if status != Status::Inner {
+            return (Status::Unknown, None);
+        }
+        let (children, _) = self.children_positions(node.expect("an inner node is decoded"));
+        let child = children[bit as usize];
+        (self.tree.status_of(child, self.unit), Some(child))
+    }
+
     /// A leaf's path from `start` (its node, when the caller knows it decoded).
     fn leaf_path(
         &mut self,
@@ -585,21 +596,14 @@ impl UnitReader<'_> {
                 return Ok(x);
             }
             let bit = if status == Status::Inner {
-                let (children, positions) = self.children_positions(node.expect("decoded"));
+                let (_, positions) = self.children_positions(node.expect("decoded"));
                 let near = nearer(positions, target);
                 let towards = self.bit(|c| &mut c.towards[kind as usize])?;
-                let bit = towards == near;
-                // Below a known split the walk follows the decoded children, no lookup.
-                let child = children[bit as usize];
-                status = self.tree.status_of(child, self.unit);
-                node = Some(child);
-                bit
+                towards == near
             } else {
-                // Below a node whose split this unit does not know, nothing is known.
-                status = Status::Unknown;
-                node = None;
                 self.bit(|c| &mut c.blind[kind as usize])?
             };
+            (status, node) = self.descend(status, node, bit);
             x = self.child(x, bit)?;
         }
     }
@@ -623,7 +627,7 @@ impl UnitReader<'_> {
             let bit = if status == Status::Inner {
                 let (children, positions) = self.children_positions(node.expect("decoded"));
                 let leaves = children.map(|c| self.tree.nodes[c as usize].leaf);
-                let bit = match leaves {
+                match leaves {
                     [true, true] => {
                         return Err(Error::malformed(
                             0,
@@ -641,16 +645,11 @@ impl UnitReader<'_> {
                         let towards = self.bit(|c| &mut c.towards[Kind::Dependency as usize])?;
                         towards == near
                     }
-                };
-                let child = children[bit as usize];
-                status = self.tree.status_of(child, self.unit);
-                node = Some(child);
-                bit
+                }
             } else {
-                status = Status::Unknown;
-                node = None;
                 self.bit(|c| &mut c.blind[Kind::Dependency as usize])?
             };
+            (status, node) = self.descend(status, node, bit);
             x = self.child(x, bit)?;
             steps += 1;
         }
