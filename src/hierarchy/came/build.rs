@@ -10,6 +10,7 @@
 //! nothing here cares whether the mesh is a manifold.
 
 use super::grid::CellGrid;
+use super::regions::{contract_in_regions, REGION_MIN_VERTICES, REGION_SLOTS};
 use super::{NodeId, VertexTree, MAX_DEPTH};
 use crate::error::{Error, Result};
 use crate::hierarchy::simplify::engine::topology;
@@ -47,6 +48,17 @@ const LENGTH_TIE_BREAK: f64 = 1e-6;
 /// Builds the hierarchy of the mesh (`cells`, `faces`); faces may be anything that repeats no
 /// vertex. Errors if the hierarchy would be deeper than [`MAX_DEPTH`].
 pub fn build(cells: &[[u32; 3]], faces: &[[u32; 3]], options: &BuildOptions) -> Result<VertexTree> {
+    let region_slots = (cells.len() >= REGION_MIN_VERTICES).then_some(REGION_SLOTS);
+    build_in_regions(cells, faces, options, region_slots)
+}
+
+/// [`build`], first in regions of `region_slots` slots if given.
+fn build_in_regions(
+    cells: &[[u32; 3]],
+    faces: &[[u32; 3]],
+    options: &BuildOptions,
+    region_slots: Option<usize>,
+) -> Result<VertexTree> {
     let n = cells.len();
     if n == 0 {
         return Err(Error::mesh("no vertices to build a hierarchy of"));
@@ -66,9 +78,14 @@ pub fn build(cells: &[[u32; 3]], faces: &[[u32; 3]], options: &BuildOptions) -> 
     let mut face_order: Vec<u32> = (0..faces.len() as u32).collect();
     face_order.sort_unstable_by_key(|&f| (slot_faces[f as usize].iter().min().copied(), f));
     let ordered_faces: Vec<[u32; 3]> = face_order.iter().map(|&f| slot_faces[f as usize]).collect();
-    let mut c = Contraction::new(&slot_cells, &ordered_faces, &vertex_of_slot, options);
-    c.run();
-    c.finish(&face_order)
+    let start = Start::new(&slot_cells, ordered_faces, &vertex_of_slot, options);
+    let start = match region_slots {
+        Some(slots) => contract_in_regions(start, options.balance, slots),
+        None => start,
+    };
+    let mut c = Contraction::new(start, options.balance);
+    c.run(1, true);
+    c.finish(cells, &face_order)
 }
 
 /// Vertices sorted by the Morton code of their cells (ties by index).
@@ -101,42 +118,111 @@ fn morton_order(cells: &[[u32; 3]]) -> Vec<u32> {
     keyed.into_iter().map(|(_, i)| i).collect()
 }
 
-/// The greedy contraction. Every live node sits in a *slot*: the slot of one of its leaves,
-/// which it keeps when it merges with another node (that node's slot dies), so that a node's
-/// faces and pairs stay where they were and only the vanishing node's move.
+/// What the greedy loop may do with a slot. The whole mesh's loop has only free slots; a
+/// region's loop ([`super::regions`]) pins the slots whose faces or pairs reach another region
+/// and holds the other regions' corners of its faces as ghosts, so that it never changes a face,
+/// pair or slot another region's loop can see.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Role {
+    /// May vanish into another slot.
+    Free,
+    /// May absorb a free slot but not vanish.
+    Pinned,
+    /// Another region's slot, only named as a face's corner; none of its pairs are contracted.
+    Ghost,
+}
+
+/// A state of the contraction: the slots (every live node sits in the slot of one of its
+/// leaves, which it keeps when it absorbs another node, so that its faces and pairs stay where
+/// they were and only the vanishing node's move), the faces' current corners, the pairs, and the
+/// tree made so far.
+pub(super) struct Start {
+    /// The id of the first inner node (the mesh's vertex count); inner node `base + i` is
+    /// `children[i]`.
+    pub base: u32,
+    /// Per slot: the node in it, its position, quadric, subtree height, the position of its
+    /// representative leaf, whether it is live, and its role.
+    pub node: Vec<u32>,
+    pub position: Vec<DVec3>,
+    pub quadric: Vec<Quadric>,
+    pub height: Vec<u8>,
+    pub rep_position: Vec<DVec3>,
+    pub alive: Vec<bool>,
+    pub role: Vec<Role>,
+    /// Per face: its corners' slots, whether it vanished, and the node whose split creates it.
+    pub corners: Vec<[u32; 3]>,
+    pub face_dead: Vec<bool>,
+    pub births: Vec<u32>,
+    /// Pairs of slots, each once.
+    pub pairs: Vec<[u32; 2]>,
+    /// Per inner node: its children, its position, and the faces (fn0..fn3) its split needs,
+    /// `dependency_faces[dependency_start[i]..dependency_start[i + 1]]`.
+    pub children: Vec<[u32; 2]>,
+    pub inner_positions: Vec<DVec3>,
+    pub dependency_faces: Vec<u32>,
+    pub dependency_start: Vec<u32>,
+}
+
+impl Start {
+    /// The mesh before any contraction: one slot per vertex (`cells` and `faces` in slot order,
+    /// `vertex_of_slot` the vertex in each slot).
+    fn new(
+        cells: &[[u32; 3]],
+        faces: Vec<[u32; 3]>,
+        vertex_of_slot: &[u32],
+        options: &BuildOptions,
+    ) -> Start {
+        let n = cells.len();
+        let signed: Vec<[i32; 3]> = cells.iter().map(|c| c.map(|x| x as i32)).collect();
+        let t = topology(n, &faces, &vec![true; faces.len()]);
+        let quadric = initial_quadrics(&signed, &faces, &t);
+        let position: Vec<DVec3> = cells.iter().map(|&c| to_f(c)).collect();
+        let pairs = initial_pairs(cells, &faces, options.pair_distance);
+        Start {
+            base: n as u32,
+            node: vertex_of_slot.to_vec(),
+            rep_position: position.clone(),
+            position,
+            quadric,
+            height: vec![0; n],
+            alive: vec![true; n],
+            role: vec![Role::Free; n],
+            face_dead: vec![false; faces.len()],
+            births: vec![u32::MAX; faces.len()],
+            corners: faces,
+            pairs,
+            children: Vec::with_capacity(n.saturating_sub(1)),
+            inner_positions: Vec::with_capacity(n.saturating_sub(1)),
+            dependency_faces: Vec::with_capacity(2 * n),
+            dependency_start: vec![0],
+        }
+    }
+}
+
+/// Contracts `start` greedily until `stop_at` of its live slots (ghosts aside) are left or no
+/// allowed pair is.
+pub(super) fn contract_greedily(start: Start, balance: f64, stop_at: usize) -> Start {
+    let mut c = Contraction::new(start, balance);
+    c.run(stop_at, false);
+    c.into_start()
+}
+
+/// The greedy contraction over a [`Start`], with each slot's faces and pairs at hand and the
+/// allowed pairs in a heap by cost.
 struct Contraction {
     balance: f64,
-    leaves: usize,
-    /// Per slot: the node in it, its position, quadric, subtree height and representative leaf.
-    node: Vec<u32>,
-    slot_position: Vec<DVec3>,
-    quadrics: Vec<Quadric>,
-    height: Vec<u8>,
-    rep_leaf: Vec<u32>,
-    alive: Vec<bool>,
+    s: Start,
+    /// Live slots that are not ghosts.
+    left: usize,
     /// Faces and pairs around each live slot (dead ones dropped lazily).
     slot_faces: Vec<Vec<u32>>,
     slot_pairs: Vec<Vec<u32>>,
     /// A tag per slot, for "already seen in this contraction".
     mark: Vec<u32>,
-    /// Per node: position, parent; per inner node: children.
-    positions: Vec<DVec3>,
-    parent: Vec<u32>,
-    children: Vec<[u32; 2]>,
-    /// Per face: its corners' slots, whether it vanished, and the node whose split creates it.
-    corners: Vec<[u32; 3]>,
-    face_dead: Vec<bool>,
-    births: Vec<u32>,
-    /// Pairs of slots.
-    pairs: Vec<[u32; 2]>,
     pair_dead: Vec<bool>,
-    /// Live pairs by cost (f32 bits, then pair id): keys updated in place, so the heap never
-    /// holds more than the live pairs.
+    /// Allowed live pairs by cost (f32 bits, then pair id): keys updated in place, so the heap
+    /// never holds more than the live pairs.
     heap: DaryHeapOfIndices<usize, u64, 8>,
-    /// Per inner node i: the faces (fn0..fn3) its split needs,
-    /// `dependency_faces[dependency_start[i]..dependency_start[i + 1]]`.
-    dependency_faces: Vec<u32>,
-    dependency_start: Vec<u32>,
     /// Third corners of the faces vanishing in one contraction.
     vanishing: Vec<u32>,
 }
@@ -151,74 +237,54 @@ fn heap_key(cost: f64, pair: u32) -> u64 {
 }
 
 impl Contraction {
-    fn new(
-        cells: &[[u32; 3]],
-        faces: &[[u32; 3]],
-        vertex_of_slot: &[u32],
-        options: &BuildOptions,
-    ) -> Contraction {
-        let n = cells.len();
-        let total = 2 * n - 1;
-        let signed: Vec<[i32; 3]> = cells.iter().map(|c| c.map(|x| x as i32)).collect();
-        let t = topology(n, faces, &vec![true; faces.len()]);
-        let quadrics = initial_quadrics(&signed, faces, &t);
-        let slot_position: Vec<DVec3> = cells.iter().map(|&c| to_f(c)).collect();
-        let mut positions = vec![DVec3::ZERO; total];
-        for (slot, &v) in vertex_of_slot.iter().enumerate() {
-            positions[v as usize] = slot_position[slot];
-        }
+    fn new(s: Start, balance: f64) -> Contraction {
+        let n = s.node.len();
         let mut slot_faces = vec![Vec::new(); n];
-        for (f, face) in faces.iter().enumerate() {
-            for &v in face {
-                slot_faces[v as usize].push(f as u32);
+        for (f, face) in s.corners.iter().enumerate() {
+            if !s.face_dead[f] {
+                for &v in face {
+                    slot_faces[v as usize].push(f as u32);
+                }
             }
         }
-        let pairs = initial_pairs(cells, faces, options.pair_distance);
         let mut slot_pairs = vec![Vec::new(); n];
-        for (p, &[a, b]) in pairs.iter().enumerate() {
+        for (p, &[a, b]) in s.pairs.iter().enumerate() {
             slot_pairs[a as usize].push(p as u32);
             slot_pairs[b as usize].push(p as u32);
         }
+        let left = (0..n)
+            .filter(|&v| s.alive[v] && s.role[v] != Role::Ghost)
+            .count();
         let mut c = Contraction {
-            balance: options.balance,
-            leaves: n,
-            node: vertex_of_slot.to_vec(),
-            slot_position,
-            quadrics,
-            height: vec![0; n],
-            rep_leaf: vertex_of_slot.to_vec(),
-            alive: vec![true; n],
+            balance,
+            left,
             slot_faces,
             slot_pairs,
             mark: vec![u32::MAX; n],
-            positions,
-            parent: vec![u32::MAX; total],
-            children: Vec::with_capacity(n.saturating_sub(1)),
-            corners: faces.to_vec(),
-            face_dead: vec![false; faces.len()],
-            births: vec![u32::MAX; faces.len()],
-            pair_dead: vec![false; pairs.len()],
-            pairs,
+            pair_dead: vec![false; s.pairs.len()],
             heap: DaryHeapOfIndices::with_index_bound(0),
-            dependency_faces: Vec::with_capacity(2 * n),
-            dependency_start: vec![0],
             vanishing: Vec::new(),
+            s,
         };
-        let keys: Vec<(usize, u64)> = (0..c.pairs.len() as u32)
+        let keys: Vec<(usize, u64)> = (0..c.s.pairs.len() as u32)
             .into_par_iter()
+            .filter(|&p| c.allowed(p))
             .map(|p| (p as usize, heap_key(c.cost(p), p)))
             .collect();
-        c.heap = DaryHeapOfIndices::from_iter_with_index_bound(c.pairs.len(), keys);
+        c.heap = DaryHeapOfIndices::from_iter_with_index_bound(c.s.pairs.len(), keys);
         c
+    }
+
+    /// Whether pair `p` may be contracted: no ghost end, and one end free to vanish.
+    fn allowed(&self, p: u32) -> bool {
+        let [a, b] = self.s.pairs[p as usize].map(|x| self.s.role[x as usize]);
+        a != Role::Ghost && b != Role::Ghost && (a == Role::Free || b == Role::Free)
     }
 
     /// The merged quadric's optimum for a pair of slots, or the best of its ends and midpoint.
     fn place(&self, a: u32, b: u32) -> (DVec3, Quadric) {
-        let q = Quadric::sum(&self.quadrics[a as usize], &self.quadrics[b as usize]);
-        let (pa, pb) = (
-            self.slot_position[a as usize],
-            self.slot_position[b as usize],
-        );
+        let q = Quadric::sum(&self.s.quadric[a as usize], &self.s.quadric[b as usize]);
+        let (pa, pb) = (self.s.position[a as usize], self.s.position[b as usize]);
         let fallback = || {
             [pa, pb, (pa + pb) * 0.5]
                 .into_iter()
@@ -235,54 +301,56 @@ impl Contraction {
 
     /// E(i) = 2^(b·d(i)) · E_q(i) of contracting pair `p`, E_q tie-broken by length.
     fn cost(&self, p: u32) -> f64 {
-        let [a, b] = self.pairs[p as usize];
+        let [a, b] = self.s.pairs[p as usize];
         let (pos, q) = self.place(a, b);
-        let length2 =
-            self.slot_position[a as usize].distance_squared(self.slot_position[b as usize]);
+        let length2 = self.s.position[a as usize].distance_squared(self.s.position[b as usize]);
         let eq = q.error(pos).max(0.0) + LENGTH_TIE_BREAK * length2 * length2;
-        let d = self.height[a as usize].max(self.height[b as usize]) as f64 + 1.0;
+        let d = self.s.height[a as usize].max(self.s.height[b as usize]) as f64 + 1.0;
         eq * (self.balance * d).exp2()
     }
 
-    fn run(&mut self) {
-        let mut left = self.leaves;
-        while left > 1 {
-            while let Some((p, _)) = self.heap.pop() {
-                self.contract(p as u32);
-                left -= 1;
-            }
-            if left > 1 {
-                self.pair_nearest();
+    /// Contracts the cheapest allowed pairs until `stop_at` live slots are left or no pair is;
+    /// with `nearest`, pairs the nearest live slots whenever the pairs run out.
+    fn run(&mut self, stop_at: usize, nearest: bool) {
+        while self.left > stop_at {
+            match self.heap.pop() {
+                Some((p, _)) => self.contract(p as u32),
+                None if nearest && self.left > 1 => self.pair_nearest(),
+                None => break,
             }
         }
     }
 
-    /// Contracts pair `p` of slots (a, b) into a new node k in slot a.
+    /// Contracts pair `p` into a new node k in the slot of its pinned end, or of its first.
     fn contract(&mut self, p: u32) {
-        let [a, b] = self.pairs[p as usize];
+        let [x, y] = self.s.pairs[p as usize];
+        let (a, b) = if self.s.role[y as usize] == Role::Pinned {
+            (y, x)
+        } else {
+            (x, y)
+        };
         self.pair_dead[p as usize] = true;
-        let k = (self.leaves + self.children.len()) as u32;
+        self.left -= 1;
+        let k = self.s.base + self.s.children.len() as u32;
         let (pos, q) = self.place(a, b);
         let (au, bu) = (a as usize, b as usize);
-        let ea = q.error(self.positions[self.rep_leaf[au] as usize]);
-        let eb = q.error(self.positions[self.rep_leaf[bu] as usize]);
-        let (na, nb) = (self.node[au], self.node[bu]);
-        let [t, u] = if eb < ea { [nb, na] } else { [na, nb] };
-        let representative = if eb < ea {
-            self.rep_leaf[bu]
+        let s = &mut self.s;
+        let ea = q.error(s.rep_position[au]);
+        let eb = q.error(s.rep_position[bu]);
+        let (na, nb) = (s.node[au], s.node[bu]);
+        let (children, representative) = if eb < ea {
+            ([nb, na], s.rep_position[bu])
         } else {
-            self.rep_leaf[au]
+            ([na, nb], s.rep_position[au])
         };
-        self.children.push([t, u]);
-        self.parent[na as usize] = k;
-        self.parent[nb as usize] = k;
-        self.positions[k as usize] = pos;
-        self.node[au] = k;
-        self.slot_position[au] = pos;
-        self.quadrics[au] = q;
-        self.height[au] = self.height[au].max(self.height[bu]) + 1;
-        self.rep_leaf[au] = representative;
-        self.alive[bu] = false;
+        s.children.push(children);
+        s.inner_positions.push(pos);
+        s.node[au] = k;
+        s.position[au] = pos;
+        s.quadric[au] = q;
+        s.height[au] = s.height[au].max(s.height[bu]) + 1;
+        s.rep_position[au] = representative;
+        s.alive[bu] = false;
 
         // Faces: b's move to a; those holding both vanish here.
         let moving = std::mem::take(&mut self.slot_faces[bu]);
@@ -291,13 +359,13 @@ impl Contraction {
         let list_a = &mut self.slot_faces[au];
         for f in moving {
             let fu = f as usize;
-            if self.face_dead[fu] {
+            if s.face_dead[fu] {
                 continue;
             }
-            let c = &mut self.corners[fu];
+            let c = &mut s.corners[fu];
             if c.contains(&a) {
-                self.face_dead[fu] = true;
-                self.births[fu] = k;
+                s.face_dead[fu] = true;
+                s.births[fu] = k;
                 let w = *c
                     .iter()
                     .find(|&&x| x != a && x != b)
@@ -313,24 +381,21 @@ impl Contraction {
             list_a.push(f);
         }
         // Hoppe 1997's fn0..fn3: the faces across the vanishing faces' other edges (k, w).
-        let first = self.dependency_faces.len();
+        let first = s.dependency_faces.len();
         for &w in &vanishing {
             let list = &mut self.slot_faces[w as usize];
-            let (dead, corners) = (&self.face_dead, &self.corners);
-            list.retain(|&g| !dead[g as usize]);
+            list.retain(|&g| !s.face_dead[g as usize]);
             for &g in list.iter() {
-                if corners[g as usize].contains(&a) && !self.dependency_faces[first..].contains(&g)
-                {
-                    self.dependency_faces.push(g);
+                if s.corners[g as usize].contains(&a) && !s.dependency_faces[first..].contains(&g) {
+                    s.dependency_faces.push(g);
                 }
             }
         }
-        self.dependency_start
-            .push(self.dependency_faces.len() as u32);
+        s.dependency_start.push(s.dependency_faces.len() as u32);
         let vanished = !vanishing.is_empty();
         self.vanishing = vanishing;
         if vanished {
-            let (dead, list) = (&self.face_dead, &mut self.slot_faces[au]);
+            let (dead, list) = (&s.face_dead, &mut self.slot_faces[au]);
             list.retain(|&g| !dead[g as usize]);
         }
 
@@ -339,7 +404,7 @@ impl Contraction {
         let moving = std::mem::take(&mut self.slot_pairs[bu]);
         pairs.retain(|&pid| !self.pair_dead[pid as usize]);
         for &pid in &pairs {
-            let [x, y] = self.pairs[pid as usize];
+            let [x, y] = s.pairs[pid as usize];
             let other = if x == a { y } else { x };
             self.mark[other as usize] = k;
         }
@@ -348,7 +413,7 @@ impl Contraction {
             if self.pair_dead[pu] {
                 continue;
             }
-            let [x, y] = self.pairs[pu];
+            let [x, y] = s.pairs[pu];
             let other = if x == b { y } else { x };
             if other == a || self.mark[other as usize] == k {
                 self.pair_dead[pu] = true;
@@ -358,25 +423,28 @@ impl Contraction {
                 continue;
             }
             self.mark[other as usize] = k;
-            self.pairs[pu] = [a, other];
+            s.pairs[pu] = [a, other];
             pairs.push(pid);
         }
         for &pid in &pairs {
-            let key = heap_key(self.cost(pid), pid);
-            self.heap.update_key_or_push(&(pid as usize), key);
+            let pu = pid as usize;
+            if self.allowed(pid) {
+                let key = heap_key(self.cost(pid), pid);
+                self.heap.update_key_or_push(&pu, key);
+            } else if self.heap.contains(&pu) {
+                // A pair of b's whose other end is pinned, now that a is too.
+                self.heap.remove(&pu);
+            }
         }
         self.slot_pairs[au] = pairs;
     }
 
     /// Pairs every live slot with its nearest live neighbour.
     fn pair_nearest(&mut self) {
-        let live: Vec<u32> = (0..self.alive.len() as u32)
-            .filter(|&v| self.alive[v as usize])
+        let live: Vec<u32> = (0..self.s.alive.len() as u32)
+            .filter(|&v| self.s.alive[v as usize])
             .collect();
-        let points: Vec<DVec3> = live
-            .iter()
-            .map(|&v| self.slot_position[v as usize])
-            .collect();
+        let points: Vec<DVec3> = live.iter().map(|&v| self.s.position[v as usize]).collect();
         let mut found: Vec<[u32; 2]> = nearest_neighbours(&points)
             .into_iter()
             .enumerate()
@@ -389,28 +457,47 @@ impl Contraction {
         found.dedup();
         let mut keys = Vec::with_capacity(found.len());
         for pair in found {
-            let pid = self.pairs.len() as u32;
-            self.pairs.push(pair);
+            let pid = self.s.pairs.len() as u32;
+            self.s.pairs.push(pair);
             self.pair_dead.push(false);
             self.slot_pairs[pair[0] as usize].push(pid);
             self.slot_pairs[pair[1] as usize].push(pid);
             keys.push((pid as usize, heap_key(self.cost(pid), pid)));
         }
         // The heap is empty here: a new one covers the new pairs.
-        self.heap = DaryHeapOfIndices::from_iter_with_index_bound(self.pairs.len(), keys);
+        self.heap = DaryHeapOfIndices::from_iter_with_index_bound(self.s.pairs.len(), keys);
     }
 
-    /// The tree, faces back in the caller's order (`face_order[i]`: the caller's index of
-    /// internal face i).
-    fn finish(self, face_order: &[u32]) -> Result<VertexTree> {
-        let total = self.parent.len();
+    /// The state reached, with the live pairs only.
+    fn into_start(self) -> Start {
+        let mut s = self.s;
+        let dead = self.pair_dead;
+        let mut i = 0;
+        s.pairs.retain(|_| {
+            i += 1;
+            !dead[i - 1]
+        });
+        s
+    }
+
+    /// The tree of the whole mesh (`cells` by vertex), faces back in the caller's order
+    /// (`face_order[i]`: the caller's index of internal face i).
+    fn finish(self, cells: &[[u32; 3]], face_order: &[u32]) -> Result<VertexTree> {
+        let s = self.s;
+        let leaves = s.base as usize;
+        let total = leaves + s.children.len();
         let root = (total - 1) as u32;
-        let leaves = self.leaves;
+        let mut parent = vec![u32::MAX; total];
+        for (i, pair) in s.children.iter().enumerate() {
+            for &c in pair {
+                parent[c as usize] = (leaves + i) as u32;
+            }
+        }
         let mut ids = vec![NodeId::ROOT; total];
         // Children are created after their parents' ids are needed: walk down from the root.
-        for i in (0..self.children.len()).rev() {
+        for i in (0..s.children.len()).rev() {
             let k = leaves + i;
-            for (bit, &c) in self.children[i].iter().enumerate() {
+            for (bit, &c) in s.children[i].iter().enumerate() {
                 ids[c as usize] = ids[k].child(bit == 1).ok_or_else(|| {
                     Error::Unsupported(format!(
                         "the vertex hierarchy is deeper than {MAX_DEPTH} levels"
@@ -418,17 +505,16 @@ impl Contraction {
                 })?;
             }
         }
-        let raw = self.dependency_faces.len();
-        let dependencies = (0..self.children.len())
+        let raw = s.dependency_faces.len();
+        let dependencies = (0..s.children.len())
             .into_par_iter()
             .map(|i| {
-                let range =
-                    self.dependency_start[i] as usize..self.dependency_start[i + 1] as usize;
-                let faces = &self.dependency_faces[range];
+                let range = s.dependency_start[i] as usize..s.dependency_start[i + 1] as usize;
+                let faces = &s.dependency_faces[range];
                 let own = ids[leaves + i];
                 let mut nodes: Vec<u32> = Vec::with_capacity(faces.len());
                 for &f in faces {
-                    let d = self.births[f as usize];
+                    let d = s.births[f as usize];
                     if !ids[d as usize].is_ancestor_of(own) && !nodes.contains(&d) {
                         nodes.push(d);
                     }
@@ -436,16 +522,22 @@ impl Contraction {
                 nodes
             })
             .collect();
-        let mut births = vec![0u32; self.births.len()];
+        let mut births = vec![0u32; s.births.len()];
         for (internal, &f) in face_order.iter().enumerate() {
-            births[f as usize] = self.births[internal];
+            births[f as usize] = s.births[internal];
         }
+        let positions = cells
+            .iter()
+            .map(|&c| to_f(c))
+            .chain(s.inner_positions.iter().copied())
+            .map(|p| p.to_array())
+            .collect();
         Ok(VertexTree {
             leaves,
-            children: self.children,
-            parent: self.parent,
+            children: s.children,
+            parent,
             root,
-            positions: self.positions.iter().map(|p| p.to_array()).collect(),
+            positions,
             ids,
             births,
             dependencies,
@@ -640,6 +732,25 @@ mod tests {
         let c = canonical(&mesh);
         let tree = build(&c.cells, &c.faces, &BuildOptions::default()).unwrap();
         check_tree(&tree, &c.faces);
+    }
+
+    #[test]
+    fn contracting_in_regions_first_makes_a_valid_hierarchy() {
+        let mut mesh = generate::icosphere(4);
+        mesh.append(&generate::icosphere(2), DVec3::new(3.0, 0.0, 0.0), 1.0);
+        let c = canonical(&mesh);
+        let options = BuildOptions::default();
+        let whole = build_in_regions(&c.cells, &c.faces, &options, None).unwrap();
+        let regions = build_in_regions(&c.cells, &c.faces, &options, Some(200)).unwrap();
+        check_tree(&regions, &c.faces);
+        // The same kind of tree: as deep and as dependent, give or take.
+        assert!(regions.depth().abs_diff(whole.depth()) <= 3);
+        let (r, w) = (
+            regions.dependencies_per_node(),
+            whole.dependencies_per_node(),
+        );
+        assert!((r - w).abs() < 0.25, "{r} vs {w}");
+        assert_ne!(regions.children, whole.children, "the regions did nothing");
     }
 
     #[test]

@@ -23,6 +23,7 @@
 mod build;
 mod grid;
 pub mod node_id;
+mod regions;
 pub mod spheres;
 
 pub use build::{build, BuildOptions};

@@ -1,0 +1,233 @@
+//! The region phase for large meshes. The slots, in Morton order, are cut into runs of about
+//! [`REGION_SLOTS`] on large meshes; each run is contracted greedily on a compact copy of its faces and pairs,
+//! all runs in parallel, until [`1/REGION_KEEP`](REGION_KEEP) of its slots are left. A slot
+//! whose faces or pairs reach another region is pinned there (it may absorb others but not
+//! vanish), so no region changes a face, pair or slot another can see, and the regions' results
+//! merge without conflict. The greedy loop over the whole mesh takes over from the merged state.
+//!
+//! Inside a region the order is the greedy one; across regions it is not, which only matters
+//! where it would have interleaved contractions that do not touch each other anyway, and at
+//! the pinned seams, which the whole mesh's loop contracts afterwards.
+
+use super::build::{contract_greedily, Role, Start};
+use rayon::prelude::*;
+use std::collections::HashMap;
+
+/// Meshes with fewer vertices are contracted by the whole mesh's loop alone.
+pub(super) const REGION_MIN_VERTICES: usize = 1 << 16;
+/// Slots per region: small enough that a region's loop works in cache.
+pub(super) const REGION_SLOTS: usize = 1 << 14;
+/// A region's loop stops when this fraction of its slots is left.
+const REGION_KEEP: usize = 32;
+
+/// A region's contracted copy: its state in local slots (the region's own first, then ghosts),
+/// with each local slot's and face's index in the whole mesh.
+struct RegionRun {
+    state: Start,
+    slot_ids: Vec<u32>,
+    face_ids: Vec<u32>,
+}
+
+/// Items of each slot in one flat array: `items[start[v]..start[v + 1]]`.
+struct PerSlot {
+    start: Vec<u32>,
+    items: Vec<u32>,
+}
+
+impl PerSlot {
+    fn new(slots: usize, entries: impl Iterator<Item = (u32, u32)> + Clone) -> PerSlot {
+        let mut start = vec![0u32; slots + 1];
+        for (v, _) in entries.clone() {
+            start[v as usize + 1] += 1;
+        }
+        for v in 0..slots {
+            start[v + 1] += start[v];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; start[slots] as usize];
+        for (v, item) in entries {
+            items[fill[v as usize] as usize] = item;
+            fill[v as usize] += 1;
+        }
+        PerSlot { start, items }
+    }
+
+    fn of(&self, v: u32) -> &[u32] {
+        &self.items[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
+    }
+}
+
+/// Contracts `start` (the mesh before any contraction) in regions of about `region_slots`
+/// slots and returns the merged state.
+pub(super) fn contract_in_regions(start: Start, balance: f64, region_slots: usize) -> Start {
+    let n = start.node.len();
+    let count = n.div_ceil(region_slots.max(1));
+    let bounds: Vec<u32> = (0..=count).map(|r| (r * n / count) as u32).collect();
+    let faces_of = PerSlot::new(
+        n,
+        start
+            .corners
+            .iter()
+            .enumerate()
+            .flat_map(|(f, c)| c.map(|v| (v, f as u32))),
+    );
+    let pairs_of = PerSlot::new(
+        n,
+        start
+            .pairs
+            .iter()
+            .enumerate()
+            .flat_map(|(p, &[a, b])| [(a, p as u32), (b, p as u32)]),
+    );
+    let runs: Vec<RegionRun> = (0..count)
+        .into_par_iter()
+        .map(|r| {
+            let local = region_copy(&start, &faces_of, &pairs_of, bounds[r], bounds[r + 1]);
+            let keep = (bounds[r + 1] - bounds[r]) as usize / REGION_KEEP;
+            RegionRun {
+                state: contract_greedily(local.state, balance, keep.max(1)),
+                ..local
+            }
+        })
+        .collect();
+    merge(start, &bounds, runs)
+}
+
+/// The copy of region `lo..hi` of `whole`: its slots, the faces touching them (other regions'
+/// corners as ghosts) and the pairs inside it; slots with a face or pair reaching out pinned.
+fn region_copy(
+    whole: &Start,
+    faces_of: &PerSlot,
+    pairs_of: &PerSlot,
+    lo: u32,
+    hi: u32,
+) -> RegionRun {
+    let inside = |v: u32| (lo..hi).contains(&v);
+    let own = (hi - lo) as usize;
+    let mut slot_ids: Vec<u32> = (lo..hi).collect();
+    let mut role = vec![Role::Free; own];
+    let mut ghosts: HashMap<u32, u32, foldhash::fast::FixedState> = HashMap::default();
+    let mut face_ids = Vec::new();
+    let mut corners = Vec::new();
+    let mut pairs = Vec::new();
+    for v in lo..hi {
+        for &f in faces_of.of(v) {
+            let c = whole.corners[f as usize];
+            // Each face once: from its first corner inside the region.
+            if c.iter().filter(|&&x| inside(x)).min() != Some(&v) {
+                continue;
+            }
+            let reaches_out = c.iter().any(|&x| !inside(x));
+            let local = c.map(|x| {
+                if inside(x) {
+                    if reaches_out {
+                        role[(x - lo) as usize] = Role::Pinned;
+                    }
+                    x - lo
+                } else {
+                    *ghosts.entry(x).or_insert_with(|| {
+                        slot_ids.push(x);
+                        (slot_ids.len() - 1) as u32
+                    })
+                }
+            });
+            face_ids.push(f);
+            corners.push(local);
+        }
+        for &p in pairs_of.of(v) {
+            let [a, b] = whole.pairs[p as usize];
+            let other = if a == v { b } else { a };
+            if !inside(other) {
+                role[(v - lo) as usize] = Role::Pinned;
+            } else if v < other {
+                pairs.push([v - lo, other - lo]);
+            }
+        }
+    }
+    role.resize(slot_ids.len(), Role::Ghost);
+    let faces = corners.len();
+    let state = Start {
+        base: whole.base,
+        node: pick(&slot_ids, &whole.node),
+        position: pick(&slot_ids, &whole.position),
+        quadric: pick(&slot_ids, &whole.quadric),
+        height: pick(&slot_ids, &whole.height),
+        rep_position: pick(&slot_ids, &whole.rep_position),
+        alive: pick(&slot_ids, &whole.alive),
+        role,
+        corners,
+        face_dead: vec![false; faces],
+        births: vec![u32::MAX; faces],
+        pairs,
+        children: Vec::new(),
+        inner_positions: Vec::new(),
+        dependency_faces: Vec::new(),
+        dependency_start: vec![0],
+    };
+    RegionRun {
+        state,
+        slot_ids,
+        face_ids,
+    }
+}
+
+/// `values` of the slots `slots`.
+fn pick<T: Copy>(slots: &[u32], values: &[T]) -> Vec<T> {
+    slots.iter().map(|&v| values[v as usize]).collect()
+}
+
+/// `whole` with every region's contractions applied: inner nodes numbered region by region,
+/// the pairs between regions kept as they were.
+fn merge(mut whole: Start, bounds: &[u32], runs: Vec<RegionRun>) -> Start {
+    let region_of = |v: u32| bounds.partition_point(|&b| b <= v);
+    let mut pairs: Vec<[u32; 2]> = whole
+        .pairs
+        .iter()
+        .copied()
+        .filter(|&[a, b]| region_of(a) != region_of(b))
+        .collect();
+    let base = whole.base;
+    for run in runs {
+        let offset = whole.children.len() as u32;
+        let node = |id: u32| if id >= base { id + offset } else { id };
+        let r = run.state;
+        for (local, &v) in run.slot_ids.iter().enumerate() {
+            if r.role[local] == Role::Ghost {
+                continue;
+            }
+            let v = v as usize;
+            whole.node[v] = node(r.node[local]);
+            whole.position[v] = r.position[local];
+            whole.quadric[v] = r.quadric[local];
+            whole.height[v] = r.height[local];
+            whole.rep_position[v] = r.rep_position[local];
+            whole.alive[v] = r.alive[local];
+        }
+        for (local, &f) in run.face_ids.iter().enumerate() {
+            let f = f as usize;
+            whole.corners[f] = r.corners[local].map(|x| run.slot_ids[x as usize]);
+            whole.face_dead[f] = r.face_dead[local];
+            if r.births[local] != u32::MAX {
+                whole.births[f] = node(r.births[local]);
+            }
+        }
+        pairs.extend(r.pairs.iter().map(|p| p.map(|x| run.slot_ids[x as usize])));
+        whole
+            .children
+            .extend(r.children.iter().map(|c| c.map(node)));
+        whole.inner_positions.extend_from_slice(&r.inner_positions);
+        for i in 0..r.children.len() {
+            let range = r.dependency_start[i] as usize..r.dependency_start[i + 1] as usize;
+            whole.dependency_faces.extend(
+                r.dependency_faces[range]
+                    .iter()
+                    .map(|&g| run.face_ids[g as usize]),
+            );
+            whole
+                .dependency_start
+                .push(whole.dependency_faces.len() as u32);
+        }
+    }
+    whole.pairs = pairs;
+    whole
+}
