@@ -76,7 +76,7 @@ fn build_in_regions(
         .map(|f| f.map(|v| slot_of_vertex[v as usize]))
         .collect();
     let mut face_order: Vec<u32> = (0..faces.len() as u32).collect();
-    face_order.sort_unstable_by_key(|&f| (slot_faces[f as usize].iter().min().copied(), f));
+    face_order.par_sort_unstable_by_key(|&f| (slot_faces[f as usize].iter().min().copied(), f));
     let ordered_faces: Vec<[u32; 3]> = face_order.iter().map(|&f| slot_faces[f as usize]).collect();
     let start = Start::new(&slot_cells, ordered_faces, &vertex_of_slot, options);
     let start = match region_slots {
@@ -124,11 +124,11 @@ fn morton_order(cells: &[[u32; 3]]) -> Vec<u32> {
 /// pair or slot another region's loop can see.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Role {
-    /// May vanish into another slot.
+    /// Takes part in contractions.
     Free,
-    /// May absorb a free slot but not vanish.
+    /// Takes part in none (its faces or pairs reach another region).
     Pinned,
-    /// Another region's slot, only named as a face's corner; none of its pairs are contracted.
+    /// Another region's slot, only named as a face's corner.
     Ghost,
 }
 
@@ -177,7 +177,7 @@ impl Start {
         let t = topology(n, &faces, &vec![true; faces.len()]);
         let quadric = initial_quadrics(&signed, &faces, &t);
         let position: Vec<DVec3> = cells.iter().map(|&c| to_f(c)).collect();
-        let pairs = initial_pairs(cells, &faces, options.pair_distance);
+        let pairs = initial_pairs(cells, &faces, &t.edges, options.pair_distance);
         Start {
             base: n as u32,
             node: vertex_of_slot.to_vec(),
@@ -199,11 +199,10 @@ impl Start {
     }
 }
 
-/// Contracts `start` greedily until `stop_at` of its live slots (ghosts aside) are left or no
-/// allowed pair is.
-pub(super) fn contract_greedily(start: Start, balance: f64, stop_at: usize) -> Start {
+/// Contracts `start` greedily until no allowed pair is left.
+pub(super) fn contract_greedily(start: Start, balance: f64) -> Start {
     let mut c = Contraction::new(start, balance);
-    c.run(stop_at, false);
+    c.run(0, false);
     c.into_start()
 }
 
@@ -212,7 +211,7 @@ pub(super) fn contract_greedily(start: Start, balance: f64, stop_at: usize) -> S
 struct Contraction {
     balance: f64,
     s: Start,
-    /// Live slots that are not ghosts.
+    /// Free live slots.
     left: usize,
     /// Faces and pairs around each live slot (dead ones dropped lazily).
     slot_faces: Vec<Vec<u32>>,
@@ -253,7 +252,7 @@ impl Contraction {
             slot_pairs[b as usize].push(p as u32);
         }
         let left = (0..n)
-            .filter(|&v| s.alive[v] && s.role[v] != Role::Ghost)
+            .filter(|&v| s.alive[v] && s.role[v] == Role::Free)
             .count();
         let mut c = Contraction {
             balance,
@@ -275,10 +274,11 @@ impl Contraction {
         c
     }
 
-    /// Whether pair `p` may be contracted: no ghost end, and one end free to vanish.
+    /// Whether pair `p` may be contracted: both its ends are free (roles never change, so a
+    /// pair that is not allowed never enters the heap).
     fn allowed(&self, p: u32) -> bool {
-        let [a, b] = self.s.pairs[p as usize].map(|x| self.s.role[x as usize]);
-        a != Role::Ghost && b != Role::Ghost && (a == Role::Free || b == Role::Free)
+        let [a, b] = self.s.pairs[p as usize];
+        self.s.role[a as usize] == Role::Free && self.s.role[b as usize] == Role::Free
     }
 
     /// The merged quadric's optimum for a pair of slots, or the best of its ends and midpoint.
@@ -309,7 +309,7 @@ impl Contraction {
         eq * (self.balance * d).exp2()
     }
 
-    /// Contracts the cheapest allowed pairs until `stop_at` live slots are left or no pair is;
+    /// Contracts the cheapest allowed pairs until `stop_at` free live slots are left or no pair is;
     /// with `nearest`, pairs the nearest live slots whenever the pairs run out.
     fn run(&mut self, stop_at: usize, nearest: bool) {
         while self.left > stop_at {
@@ -321,14 +321,9 @@ impl Contraction {
         }
     }
 
-    /// Contracts pair `p` into a new node k in the slot of its pinned end, or of its first.
+    /// Contracts pair `p` of slots (a, b) into a new node k in slot a.
     fn contract(&mut self, p: u32) {
-        let [x, y] = self.s.pairs[p as usize];
-        let (a, b) = if self.s.role[y as usize] == Role::Pinned {
-            (y, x)
-        } else {
-            (x, y)
-        };
+        let [a, b] = self.s.pairs[p as usize];
         self.pair_dead[p as usize] = true;
         self.left -= 1;
         let k = self.s.base + self.s.children.len() as u32;
@@ -431,9 +426,6 @@ impl Contraction {
             if self.allowed(pid) {
                 let key = heap_key(self.cost(pid), pid);
                 self.heap.update_key_or_push(&pu, key);
-            } else if self.heap.contains(&pu) {
-                // A pair of b's whose other end is pinned, now that a is too.
-                self.heap.remove(&pu);
             }
         }
         self.slot_pairs[au] = pairs;
@@ -548,16 +540,22 @@ impl Contraction {
 
 /// The mesh's edges and, per vertex, up to [`CLOSE_PAIRS_PER_VERTEX`] nearest vertices closer
 /// than `fraction` of the mean edge length; each pair once, ends in ascending order.
-fn initial_pairs(cells: &[[u32; 3]], faces: &[[u32; 3]], fraction: f64) -> Vec<[u32; 2]> {
-    let mut pairs: Vec<[u32; 2]> = Vec::with_capacity(faces.len() * 3 / 2 + cells.len());
+/// `edges` are the mesh's edges, sorted, each once.
+fn initial_pairs(
+    cells: &[[u32; 3]],
+    faces: &[[u32; 3]],
+    edges: &[[u32; 2]],
+    fraction: f64,
+) -> Vec<[u32; 2]> {
+    // The mean over the faces' edges, shared edges counted once a face.
     let mut length_sum = 0.0;
     for f in faces {
         for k in 0..3 {
             let (x, y) = (f[k], f[(k + 1) % 3]);
-            pairs.push([x.min(y), x.max(y)]);
             length_sum += to_f(cells[x as usize]).distance(to_f(cells[y as usize]));
         }
     }
+    let mut close: Vec<[u32; 2]> = Vec::new();
     let threshold = fraction * length_sum / (3 * faces.len()).max(1) as f64;
     if threshold > 0.0 {
         let points: Vec<DVec3> = cells.iter().map(|&c| to_f(c)).collect();
@@ -565,10 +563,10 @@ fn initial_pairs(cells: &[[u32; 3]], faces: &[[u32; 3]], fraction: f64) -> Vec<[
         // cells nearest it along each axis, so eight cells hold every point it can pair with.
         let size = 2.0 * threshold;
         let grid = CellGrid::new(&points, DVec3::ZERO, size);
-        let close: Vec<Vec<[u32; 2]>> = points
+        close = points
             .par_iter()
             .enumerate()
-            .map(|(v, &p)| {
+            .flat_map_iter(|(v, &p)| {
                 let cell = grid.key(p);
                 let side = |axis: usize| {
                     let inside = p[axis] / size - cell[axis] as f64;
@@ -596,16 +594,39 @@ fn initial_pairs(cells: &[[u32; 3]], faces: &[[u32; 3]], fraction: f64) -> Vec<[
                 }
                 near.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
                 let v = v as u32;
-                near.iter()
-                    .take(CLOSE_PAIRS_PER_VERTEX)
-                    .map(|&(_, w)| [v.min(w), v.max(w)])
-                    .collect()
+                near.truncate(CLOSE_PAIRS_PER_VERTEX);
+                near.into_iter().map(move |(_, w)| [v.min(w), v.max(w)])
             })
             .collect();
-        pairs.extend(close.into_iter().flatten());
+        close.par_sort_unstable();
+        close.dedup();
     }
-    pairs.par_sort_unstable();
-    pairs.dedup();
+    // Both lists sorted: merge them, each pair once.
+    let mut pairs = Vec::with_capacity(edges.len() + close.len());
+    let (mut i, mut j) = (0, 0);
+    while i < edges.len() || j < close.len() {
+        let next = match (edges.get(i), close.get(j)) {
+            (Some(e), Some(c)) if c < e => {
+                j += 1;
+                *c
+            }
+            (Some(e), Some(c)) => {
+                i += 1;
+                j += usize::from(c == e);
+                *e
+            }
+            (Some(e), None) => {
+                i += 1;
+                *e
+            }
+            (None, Some(c)) => {
+                j += 1;
+                *c
+            }
+            (None, None) => unreachable!("one list has more"),
+        };
+        pairs.push(next);
+    }
     pairs
 }
 

@@ -2,6 +2,7 @@
 //! pairs: the points of a cell are one slice of an index array sorted by cell.
 
 use glam::DVec3;
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// A cell's integer coordinates.
@@ -22,11 +23,11 @@ impl CellGrid {
     pub fn new(points: &[DVec3], origin: DVec3, size: f64) -> CellGrid {
         let key = |p: DVec3| ((p - origin) / size).floor().to_array().map(|x| x as i64);
         let mut keyed: Vec<(CellKey, u32)> = points
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(i, &p)| (key(p), i as u32))
             .collect();
-        keyed.sort_unstable();
+        keyed.par_sort_unstable();
         let mut cells = HashMap::with_capacity_and_hasher(keyed.len(), Default::default());
         let mut start = 0;
         while start < keyed.len() {

@@ -1,13 +1,16 @@
 //! The region phase for large meshes. The slots, in Morton order, are cut into runs of about
-//! [`REGION_SLOTS`] on large meshes; each run is contracted greedily on a compact copy of its faces and pairs,
-//! all runs in parallel, until [`1/REGION_KEEP`](REGION_KEEP) of its slots are left. A slot
-//! whose faces or pairs reach another region is pinned there (it may absorb others but not
-//! vanish), so no region changes a face, pair or slot another can see, and the regions' results
-//! merge without conflict. The greedy loop over the whole mesh takes over from the merged state.
+//! [`REGION_SLOTS`]; each run is contracted greedily on a compact copy of its faces and pairs,
+//! all runs in parallel, until none of its pairs is left to contract. A slot whose faces or
+//! pairs reach another region is pinned: it takes part in no contraction of the region phase,
+//! so no region changes a face, pair or slot another region can see, and the regions' results
+//! merge without conflict. The greedy loop over the whole mesh then takes over from the merged
+//! state: the pinned seams and the regions' roots.
 //!
-//! Inside a region the order is the greedy one; across regions it is not, which only matters
-//! where it would have interleaved contractions that do not touch each other anyway, and at
-//! the pinned seams, which the whole mesh's loop contracts afterwards.
+//! Inside a region the order is the greedy one; across regions it need not be, which changes
+//! nothing where contractions do not touch each other. On bunny-closed-35k ×16 (557,301
+//! vertices, 17 regions) the build is 2.5–3× faster and the `came` stream 0.3% larger than by
+//! the whole mesh's loop alone. Letting pinned slots absorb free ones (they only may not vanish)
+//! grew the stream 8%: the seams became long chains of absorptions.
 
 use super::build::{contract_greedily, Role, Start};
 use rayon::prelude::*;
@@ -16,9 +19,7 @@ use std::collections::HashMap;
 /// Meshes with fewer vertices are contracted by the whole mesh's loop alone.
 pub(super) const REGION_MIN_VERTICES: usize = 1 << 16;
 /// Slots per region: small enough that a region's loop works in cache.
-pub(super) const REGION_SLOTS: usize = 1 << 14;
-/// A region's loop stops when this fraction of its slots is left.
-const REGION_KEEP: usize = 32;
+pub(super) const REGION_SLOTS: usize = 1 << 15;
 
 /// A region's contracted copy: its state in local slots (the region's own first, then ghosts),
 /// with each local slot's and face's index in the whole mesh.
@@ -83,9 +84,8 @@ pub(super) fn contract_in_regions(start: Start, balance: f64, region_slots: usiz
         .into_par_iter()
         .map(|r| {
             let local = region_copy(&start, &faces_of, &pairs_of, bounds[r], bounds[r + 1]);
-            let keep = (bounds[r + 1] - bounds[r]) as usize / REGION_KEEP;
             RegionRun {
-                state: contract_greedily(local.state, balance, keep.max(1)),
+                state: contract_greedily(local.state, balance),
                 ..local
             }
         })

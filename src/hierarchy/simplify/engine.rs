@@ -390,7 +390,7 @@ impl State {
 /// faces hold each (1: a boundary edge), and the edges around each vertex.
 pub(in crate::hierarchy) struct Topology {
     pub(super) vfaces: Vec<Incident>,
-    pub(super) edges: Vec<[u32; 2]>,
+    pub(in crate::hierarchy) edges: Vec<[u32; 2]>,
     pub(super) edge_faces: Vec<u32>,
     pub(super) vedges: Vec<Incident>,
 }
