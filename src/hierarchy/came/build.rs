@@ -18,6 +18,7 @@ use crate::hierarchy::simplify::quadric::{initial_quadrics, Quadric};
 use glam::DVec3;
 use orx_priority_queue::{DaryHeapOfIndices, PriorityQueue, PriorityQueueDecKey};
 use rayon::prelude::*;
+use smallvec::SmallVec;
 
 /// How the hierarchy is built.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -214,8 +215,8 @@ struct Contraction {
     /// Free live slots.
     left: usize,
     /// Faces and pairs around each live slot (dead ones dropped lazily).
-    slot_faces: Vec<Vec<u32>>,
-    slot_pairs: Vec<Vec<u32>>,
+    slot_faces: Vec<Around>,
+    slot_pairs: Vec<Around>,
     /// A tag per slot, for "already seen in this contraction".
     mark: Vec<u32>,
     pair_dead: Vec<bool>,
@@ -225,6 +226,9 @@ struct Contraction {
     /// Third corners of the faces vanishing in one contraction.
     vanishing: Vec<u32>,
 }
+
+/// A slot's faces or pairs: most slots have few, kept inline.
+type Around = SmallVec<[u32; 8]>;
 
 fn to_f(c: [u32; 3]) -> DVec3 {
     DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
@@ -238,7 +242,7 @@ fn heap_key(cost: f64, pair: u32) -> u64 {
 impl Contraction {
     fn new(s: Start, balance: f64) -> Contraction {
         let n = s.node.len();
-        let mut slot_faces = vec![Vec::new(); n];
+        let mut slot_faces = vec![Around::new(); n];
         for (f, face) in s.corners.iter().enumerate() {
             if !s.face_dead[f] {
                 for &v in face {
@@ -246,7 +250,7 @@ impl Contraction {
                 }
             }
         }
-        let mut slot_pairs = vec![Vec::new(); n];
+        let mut slot_pairs = vec![Around::new(); n];
         for (p, &[a, b]) in s.pairs.iter().enumerate() {
             slot_pairs[a as usize].push(p as u32);
             slot_pairs[b as usize].push(p as u32);
@@ -379,7 +383,7 @@ impl Contraction {
         let first = s.dependency_faces.len();
         for &w in &vanishing {
             let list = &mut self.slot_faces[w as usize];
-            list.retain(|&g| !s.face_dead[g as usize]);
+            list.retain(|g| !s.face_dead[*g as usize]);
             for &g in list.iter() {
                 if s.corners[g as usize].contains(&a) && !s.dependency_faces[first..].contains(&g) {
                     s.dependency_faces.push(g);
@@ -391,13 +395,13 @@ impl Contraction {
         self.vanishing = vanishing;
         if vanished {
             let (dead, list) = (&s.face_dead, &mut self.slot_faces[au]);
-            list.retain(|&g| !dead[g as usize]);
+            list.retain(|g| !dead[*g as usize]);
         }
 
         // Pairs: a's stay, b's move to a; one pair per other end.
         let mut pairs = std::mem::take(&mut self.slot_pairs[au]);
         let moving = std::mem::take(&mut self.slot_pairs[bu]);
-        pairs.retain(|&pid| !self.pair_dead[pid as usize]);
+        pairs.retain(|pid| !self.pair_dead[*pid as usize]);
         for &pid in &pairs {
             let [x, y] = s.pairs[pid as usize];
             let other = if x == a { y } else { x };

@@ -36,19 +36,24 @@ struct PerSlot {
 }
 
 impl PerSlot {
-    fn new(slots: usize, entries: impl Iterator<Item = (u32, u32)> + Clone) -> PerSlot {
+    /// The rows (faces' corners, pairs' ends) around each of `slots` slots, by row index.
+    fn new<const K: usize>(slots: usize, rows: &[[u32; K]]) -> PerSlot {
         let mut start = vec![0u32; slots + 1];
-        for (v, _) in entries.clone() {
-            start[v as usize + 1] += 1;
+        for row in rows {
+            for &v in row {
+                start[v as usize + 1] += 1;
+            }
         }
         for v in 0..slots {
             start[v + 1] += start[v];
         }
         let mut fill = start.clone();
         let mut items = vec![0u32; start[slots] as usize];
-        for (v, item) in entries {
-            items[fill[v as usize] as usize] = item;
-            fill[v as usize] += 1;
+        for (i, row) in rows.iter().enumerate() {
+            for &v in row {
+                items[fill[v as usize] as usize] = i as u32;
+                fill[v as usize] += 1;
+            }
         }
         PerSlot { start, items }
     }
@@ -64,22 +69,8 @@ pub(super) fn contract_in_regions(start: Start, balance: f64, region_slots: usiz
     let n = start.node.len();
     let count = n.div_ceil(region_slots.max(1));
     let bounds: Vec<u32> = (0..=count).map(|r| (r * n / count) as u32).collect();
-    let faces_of = PerSlot::new(
-        n,
-        start
-            .corners
-            .iter()
-            .enumerate()
-            .flat_map(|(f, c)| c.map(|v| (v, f as u32))),
-    );
-    let pairs_of = PerSlot::new(
-        n,
-        start
-            .pairs
-            .iter()
-            .enumerate()
-            .flat_map(|(p, &[a, b])| [(a, p as u32), (b, p as u32)]),
-    );
+    let faces_of = PerSlot::new(n, &start.corners);
+    let pairs_of = PerSlot::new(n, &start.pairs);
     let runs: Vec<RegionRun> = (0..count)
         .into_par_iter()
         .map(|r| {
