@@ -312,6 +312,26 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         Some(&self.tree.triangles[range])
     }
 
+    /// Decodes every unit not decoded yet, in stream order, and checks that the hierarchy is
+    /// complete.
+    pub fn decode_everything(&mut self) -> Result<()> {
+        for i in 0..self.stream.index().len() {
+            if self.child_roots[i].is_none() && !self.decode_unit(i)? {
+                return Err(Error::malformed(
+                    i + 1,
+                    self.stream.bytes().len(),
+                    format!("the stream ends inside unit {i}"),
+                ));
+            }
+        }
+        self.check_complete()
+    }
+
+    /// The tree decoded so far.
+    pub fn into_tree(self) -> DecodedTree {
+        self.tree
+    }
+
     /// The root of unit `i`, if its parent is decoded (the first unit's root is the tree's).
     fn unit_root(&self, i: usize) -> Result<Option<u32>> {
         let Some(parent) = self.stream.index().units[i].parent else {

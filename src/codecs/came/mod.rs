@@ -32,6 +32,7 @@ pub mod knowledge;
 pub mod modelled;
 pub mod paper;
 pub mod partition;
+pub mod refine;
 
 use crate::codecs::{CameField, Stat, Stats};
 use crate::container::{Header, LevelCost, StreamWriter};
@@ -39,6 +40,33 @@ use crate::error::{Error, Result};
 use crate::hierarchy::came::{build, BuildOptions, VertexTree};
 use crate::mesh::CanonicalMesh;
 use partition::Partition;
+
+/// The whole hierarchy of a stream of either CAME codec, every unit decoded, with its header.
+pub fn decode_tree(bytes: &[u8]) -> Result<(Header, decoded::DecodedTree)> {
+    let reader = crate::container::StreamReader::open(bytes)?;
+    let header = reader.header().clone();
+    let name = crate::codecs::by_id(header.codec_id)?.name();
+    let tree = match name {
+        "came" => {
+            let params = modelled::params(&header)?;
+            let mut d = decoded::CameDecoder::new(reader, params, modelled::ModelledUnits)?;
+            d.decode_everything()?;
+            d.into_tree()
+        }
+        "came-paper" => {
+            let params = Params::from_bytes(&header.params, 1..=16)?;
+            let mut d = decoded::CameDecoder::new(reader, params, paper::PaperUnits::default())?;
+            d.decode_everything()?;
+            d.into_tree()
+        }
+        other => {
+            return Err(Error::Unsupported(format!(
+                "{other} streams hold no vertex hierarchy; view-dependent refinement needs came or came-paper"
+            )))
+        }
+    };
+    Ok((header, tree))
+}
 
 /// Levels of the hierarchy per meta-node (the paper's L).
 pub const META_LEVELS: u8 = 8;

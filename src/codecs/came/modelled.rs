@@ -154,16 +154,22 @@ impl Codec for Came {
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
-        let params = Params::from_bytes(&stream.header().params, 0..=0)?;
-        if params.radius_bits != RADIUS_BITS {
-            return Err(Error::malformed(
-                0,
-                0,
-                "came streams use 4-bit radius ratios",
-            ));
-        }
+        let params = params(stream.header())?;
         Ok(Box::new(CameDecoder::new(stream, params, ModelledUnits)?))
     }
+}
+
+/// A `came` stream's parameters, checked.
+pub fn params(header: &Header) -> Result<Params> {
+    let params = Params::from_bytes(&header.params, 0..=0)?;
+    if params.radius_bits != RADIUS_BITS {
+        return Err(Error::malformed(
+            0,
+            0,
+            "came streams use 4-bit radius ratios",
+        ));
+    }
+    Ok(params)
 }
 
 /// What the encoder derives once for all units.

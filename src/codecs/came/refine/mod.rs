@@ -1,0 +1,26 @@
+//! View-dependent selective refinement over a CAME hierarchy (Hoppe, "View-dependent
+//! refinement of progressive meshes", SIGGRAPH 1997, with Grabner's node-to-node dependencies
+//! and error spheres instead of face neighbourhoods and deviation cones).
+//!
+//! Glossary:
+//! - front: the active nodes, a cut of the hierarchy (every leaf has exactly one active node on
+//!   its path from the root); the nodes above it are *split*, those below it *below*.
+//! - vsplit(v_s): v_s leaves the front, v_t and v_u join it, the triangles born at v_s appear and
+//!   the triangles with a corner at v_s move that corner to v_t or v_u (one path bit appended).
+//!   Legal when every node v_s depends on is split (Hoppe's fn0..fn3 present); otherwise those
+//!   are split first ("forced split").
+//! - ecol(v_s): the inverse (one path bit dropped); legal when v_t and v_u are active and no
+//!   split node depends on v_s.
+//! - r_v: the error sphere's radius at v (every vertex of v's subtree lies within r_v of v).
+//! - τ: the screen-space tolerance in pixels; φ: the vertical field of view; H: the viewport's
+//!   height in pixels; κ = 2·τ·tan(φ/2) / H. A node is refined while r_v ≥ κ·|v − e| (its sphere
+//!   would span τ pixels or more) and its sphere meets the view frustum.
+//!
+//! No normal cones are stored (the streams carry none), so there is no back-face culling: a
+//! node facing away is refined like one facing the eye.
+
+mod front;
+mod view;
+
+pub use front::{Adapted, Budget, Pick, ViewMesh};
+pub use view::{Camera, View};
