@@ -56,6 +56,8 @@ impl Budget {
 pub struct Adapted {
     pub splits: usize,
     pub collapses: usize,
+    /// Passes over the active nodes.
+    pub passes: usize,
     /// Whether the front is settled for this view (a pass found nothing more to do).
     pub settled: bool,
 }
@@ -102,6 +104,8 @@ pub struct ViewMesh {
     cursor: usize,
     /// κ's scale, regulated to a face budget.
     scale: f64,
+    /// The active nodes a pass visits (kept to save allocating one a pass).
+    pass: Vec<u32>,
 }
 
 impl ViewMesh {
@@ -188,6 +192,7 @@ impl ViewMesh {
             faces: 0,
             cursor: 0,
             scale: 1.0,
+            pass: Vec::new(),
         })
     }
 
@@ -260,9 +265,17 @@ impl ViewMesh {
                 }
             }
         }
+        let own = self.ids[su];
         for i in 0..self.born[su].len() {
             let f = self.born[su][i];
-            let corners = self.leaf_corners[f as usize].map(|c| self.active_on(c));
+            // The two corners under v_s are at v_t and v_u now; only the third needs a walk.
+            let corners = self.leaf_corners[f as usize].map(|c| {
+                if own.is_ancestor_of(c) {
+                    self.children[su][c.bit(depth) as usize]
+                } else {
+                    self.active_on(c)
+                }
+            });
             for &c in &corners {
                 self.faces_at[c as usize].push(f);
             }
@@ -318,8 +331,8 @@ impl ViewMesh {
     }
 
     /// Splits active node `s`, and first whatever its dependencies need (Hoppe's forced
-    /// split); returns the splits made.
-    fn force_split(&mut self, s: u32) -> Result<usize> {
+    /// split); returns the splits made, and appends the children it activated to `activated`.
+    fn force_split(&mut self, s: u32, activated: &mut Vec<u32>) -> Result<usize> {
         let mut stack = vec![s];
         let mut splits = 0;
         while let Some(&v) = stack.last() {
@@ -340,6 +353,7 @@ impl ViewMesh {
                         Some(d) => stack.push(d),
                         None => {
                             self.split(v);
+                            activated.extend(self.children[v as usize]);
                             splits += 1;
                             stack.pop();
                         }
@@ -350,56 +364,79 @@ impl ViewMesh {
         Ok(splits)
     }
 
-    /// Adapts the front to `view`: passes over the active nodes splitting those the view wants
-    /// refined (their dependencies first) and collapsing the parents it does not, until a pass
-    /// changes nothing or the budget is spent. Errors only on a stream whose dependencies form
-    /// a cycle.
+    /// Adapts the front to `view`: passes over the active nodes, refining each the view wants
+    /// refined down its subtree (dependencies first) and collapsing the parents of the others
+    /// up the tree while the view does not want them, until a pass changes nothing or the
+    /// budget is spent. Errors only on a stream whose dependencies form a cycle.
     pub fn adapt(&mut self, view: &View, budget: Budget) -> Result<Adapted> {
         let mut done = Adapted::default();
+        let mut pass = std::mem::take(&mut self.pass);
+        let result = self.adapt_passes(view, budget, &mut done, &mut pass);
+        self.pass = pass;
+        self.regulate(budget.faces);
+        result.map(|()| done)
+    }
+
+    fn adapt_passes(
+        &mut self,
+        view: &View,
+        budget: Budget,
+        done: &mut Adapted,
+        pass: &mut Vec<u32>,
+    ) -> Result<()> {
         let limit = budget.faces.unwrap_or(usize::MAX);
+        let wants = |m: &ViewMesh, v: u32| {
+            let vu = v as usize;
+            m.is_inner(v) && view.wants_split(m.center[vu], m.radius[vu], m.scale)
+        };
+        let mut below: Vec<u32> = Vec::new();
         loop {
-            let mut changed = false;
+            let before = *done;
+            done.passes += 1;
             let start = self.cursor.min(self.active.len());
-            let pass: Vec<u32> = self.active[start..]
-                .iter()
-                .chain(&self.active[..start])
-                .copied()
-                .collect();
+            pass.clear();
+            pass.extend_from_slice(&self.active[start..]);
+            pass.extend_from_slice(&self.active[..start]);
             self.cursor = 0;
             for (i, &v) in pass.iter().enumerate() {
                 if done.splits + done.collapses >= budget.operations {
                     self.cursor = (start + i) % pass.len().max(1);
-                    self.regulate(budget.faces);
-                    return Ok(done);
+                    return Ok(());
                 }
-                let vu = v as usize;
-                if self.state[vu] != State::Active {
+                if self.state[v as usize] != State::Active {
                     continue;
                 }
-                let (c, r) = (self.center[vu], self.radius[vu]);
-                if self.is_inner(v) && self.faces < limit && view.wants_split(c, r, self.scale) {
-                    done.splits += self.force_split(v)?;
-                    changed = true;
+                if wants(self, v) {
+                    // Down the subtree at once rather than a level a pass.
+                    below.clear();
+                    below.push(v);
+                    while let Some(x) = below.pop() {
+                        if self.state[x as usize] != State::Active
+                            || self.faces >= limit
+                            || done.splits + done.collapses >= budget.operations
+                            || !wants(self, x)
+                        {
+                            continue;
+                        }
+                        done.splits += self.force_split(x, &mut below)?;
+                    }
                     continue;
                 }
-                let p = self.parent[vu];
-                if p != NONE
+                // Up the tree while the parent may and should go.
+                let mut p = self.parent[v as usize];
+                while p != NONE
+                    && done.splits + done.collapses < budget.operations
                     && self.can_collapse(p)
-                    && !view.wants_split(
-                        self.center[p as usize],
-                        self.radius[p as usize],
-                        self.scale,
-                    )
+                    && !wants(self, p)
                 {
                     self.collapse(p);
                     done.collapses += 1;
-                    changed = true;
+                    p = self.parent[p as usize];
                 }
             }
-            if !changed {
+            if (done.splits, done.collapses) == (before.splits, before.collapses) {
                 done.settled = true;
-                self.regulate(budget.faces);
-                return Ok(done);
+                return Ok(());
             }
         }
     }
