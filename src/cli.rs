@@ -35,6 +35,28 @@ macro_rules! outln {
     };
 }
 
+/// Parses a point or direction `x,y,z`.
+pub fn parse_vector(s: &str) -> Result<glam::DVec3, String> {
+    let parts: Vec<Result<f64, _>> = s.split(',').map(|x| x.trim().parse::<f64>()).collect();
+    match parts.as_slice() {
+        [Ok(x), Ok(y), Ok(z)] if x.is_finite() && y.is_finite() && z.is_finite() => {
+            Ok(glam::DVec3::new(*x, *y, *z))
+        }
+        _ => Err(format!("'{s}' is no x,y,z of three numbers")),
+    }
+}
+
+/// Parses a viewport `WxH` in pixels (each 1..=16384).
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("'{s}' is no WIDTHxHEIGHT in pixels (each 1 to 16384)");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
 /// Parses `--grid`: `cubic` or `per-axis`.
 pub fn parse_grid(s: &str) -> Result<GridShape, String> {
     match s {

@@ -62,12 +62,73 @@ pub fn render(mesh: &TriMesh, frame: &Aabb, view: View, width: u32, height: u32)
         )
     };
     let screen: Vec<DVec3> = mesh.positions.iter().map(|&p| project(p)).collect();
+    rasterize(mesh, &screen, |p| rotation * p, width, height)
+}
+
+/// A pinhole camera for [`render_perspective`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Perspective {
+    pub eye: DVec3,
+    pub target: DVec3,
+    pub up: DVec3,
+    /// Vertical field of view, degrees.
+    pub fov_degrees: f64,
+}
+
+/// Draws `mesh` flat-shaded as `camera` sees it; faces reaching behind the eye are left out.
+pub fn render_perspective(
+    mesh: &TriMesh,
+    camera: &Perspective,
+    width: u32,
+    height: u32,
+) -> Picture {
+    let forward = (camera.target - camera.eye).normalize_or_zero();
+    let right = forward.cross(camera.up).normalize_or_zero();
+    let up = right.cross(forward);
+    let focal = 0.5 * height as f64 / (camera.fov_degrees.to_radians() / 2.0).tan();
+    let to_camera = |p: DVec3| {
+        let d = p - camera.eye;
+        DVec3::new(d.dot(right), d.dot(up), -d.dot(forward))
+    };
+    // Depth as 1/distance (larger is nearer, linear across the screen); behind the eye: NaN,
+    // which the rasterizer skips.
+    let screen: Vec<DVec3> = mesh
+        .positions
+        .iter()
+        .map(|&p| {
+            let q = to_camera(p);
+            let z = -q.z;
+            if z <= 1e-9 {
+                return DVec3::NAN;
+            }
+            DVec3::new(
+                width as f64 * 0.5 + q.x / z * focal,
+                height as f64 * 0.5 - q.y / z * focal,
+                1.0 / z,
+            )
+        })
+        .collect();
+    rasterize(mesh, &screen, to_camera, width, height)
+}
+
+/// Fills the faces of `mesh` at their `screen` corners (x, y in pixels, z larger nearer),
+/// shaded by their normals in the camera's frame (`to_camera`).
+fn rasterize(
+    mesh: &TriMesh,
+    screen: &[DVec3],
+    to_camera: impl Fn(DVec3) -> DVec3,
+    width: u32,
+    height: u32,
+) -> Picture {
     let mut depth = vec![f64::NEG_INFINITY; (width * height) as usize];
     let mut pixels = vec![[255u8; 3]; (width * height) as usize];
     let light = DVec3::new(-0.35, 0.45, 1.0).normalize();
     for f in &mesh.faces {
         let [a, b, c] = f.map(|v| screen[v as usize]);
-        let world = mesh.corners(*f).map(|p| rotation * p);
+        if !(a.is_finite() && b.is_finite() && c.is_finite()) {
+            continue;
+        }
+        let world = mesh.corners(*f).map(&to_camera);
         let normal = (world[1] - world[0]).cross(world[2] - world[0]);
         if normal.length_squared() == 0.0 {
             continue;
@@ -108,5 +169,27 @@ pub fn render(mesh: &TriMesh, frame: &Aabb, view: View, width: u32, height: u32)
         width,
         height,
         pixels,
+    }
+}
+
+impl Picture {
+    /// Writes the picture as a PNG file.
+    pub fn save_png(&self, path: &std::path::Path) -> crate::error::Result<()> {
+        use plotters::prelude::{BitMapBackend, DrawingBackend};
+        let fail = |e: &dyn std::fmt::Display| {
+            crate::error::Error::Io(std::io::Error::other(format!("{}: {e}", path.display())))
+        };
+        let mut backend = BitMapBackend::new(path, (self.width, self.height));
+        for (i, px) in self.pixels.iter().enumerate() {
+            let (x, y) = (i as u32 % self.width, i as u32 / self.width);
+            let colour = plotters::style::RGBColor(px[0], px[1], px[2]);
+            backend
+                .draw_pixel(
+                    (x as i32, y as i32),
+                    plotters::style::Color::to_backend_color(&colour),
+                )
+                .map_err(|e| fail(&e))?;
+        }
+        backend.present().map_err(|e| fail(&e))
     }
 }

@@ -305,3 +305,45 @@ fn a_reader_that_goes_away_is_no_panic() {
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
 }
+
+#[test]
+fn view_adapts_a_came_stream_and_refuses_other_streams_and_cut_ones() {
+    let dir = scratch();
+    let d = dir.path();
+    let ok = |args: &[&str]| {
+        let out = run(MESHCODEC, args, d);
+        assert_eq!(out.code, Some(0), "{:?}: {}", args, out.stderr);
+    };
+    ok(&["encode", "--codec", "came", "bunny", "b.mc"]);
+    ok(&["encode", "--codec", "emc", "bunny", "e.mc"]);
+    let camera = [
+        "--eye",
+        "-0.05,0.15,1.0",
+        "--target",
+        "-0.02,0.1,0",
+        "--size",
+        "320x240",
+    ];
+    let with = |extra: &[&'static str]| -> Vec<&str> {
+        let mut args = vec!["view", "b.mc", "v.ply"];
+        args.extend_from_slice(&camera);
+        args.extend_from_slice(extra);
+        args
+    };
+    ok(&with(&["--png", "v.png"]));
+    let full = meshcodec::mesh::io::read_mesh(&d.join("v.ply")).unwrap();
+    assert!(full.face_count() > 100 && d.join("v.png").is_file());
+    ok(&with(&["--faces", "500"]));
+    let budgeted = meshcodec::mesh::io::read_mesh(&d.join("v.ply")).unwrap();
+    assert!(budgeted.face_count() <= 500 && budgeted.face_count() < full.face_count());
+
+    let mut args = vec!["view", "e.mc", "w.ply"];
+    args.extend_from_slice(&camera);
+    assert_clean_failure(&run(MESHCODEC, &args, d), "e.mc");
+    let stream = std::fs::read(d.join("b.mc")).unwrap();
+    write(d, "cut.mc", &stream[..stream.len() / 2]);
+    let mut args = vec!["view", "cut.mc", "w.ply"];
+    args.extend_from_slice(&camera);
+    assert_clean_failure(&run(MESHCODEC, &args, d), "cut.mc");
+    assert!(!d.join("w.ply").exists());
+}

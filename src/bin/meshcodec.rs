@@ -16,7 +16,7 @@ use std::process::ExitCode;
 #[derive(Parser)]
 #[command(
     version,
-    about = "Progressive mesh compression: encode, decode, info, distance"
+    about = "Progressive mesh compression: encode, decode, info, view, distance"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -65,6 +65,39 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Adapt a CAME stream's hierarchy to a camera (view-dependent refinement) and write the
+    /// adapted mesh, optionally with a render from that camera.
+    View {
+        /// CAME stream (came or came-paper).
+        input: PathBuf,
+        /// Mesh file to write (.ply or .obj).
+        output: PathBuf,
+        /// Eye position, x,y,z (the mesh's units).
+        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
+        eye: glam::DVec3,
+        /// Point looked at, x,y,z.
+        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
+        target: glam::DVec3,
+        /// Up direction, x,y,z.
+        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true, default_value = "0,1,0")]
+        up: glam::DVec3,
+        /// Vertical field of view, degrees.
+        #[arg(long, default_value_t = 50.0)]
+        fov: f64,
+        /// Viewport, WIDTHxHEIGHT pixels.
+        #[arg(long, value_parser = meshcodec::cli::parse_size, default_value = "1280x720")]
+        size: (u32, u32),
+        /// Screen-space tolerance, pixels: nodes are refined while their error sphere spans
+        /// this many pixels or more.
+        #[arg(long, default_value_t = 1.0)]
+        tolerance: f64,
+        /// Face budget: the tolerance is raised until the mesh holds at most this many faces.
+        #[arg(long)]
+        faces: Option<usize>,
+        /// Write a render from the camera.
+        #[arg(long)]
+        png: Option<PathBuf>,
+    },
     /// Distance between two meshes' surfaces: one-sided both ways, Hausdorff, RMS.
     Distance {
         /// Reference mesh.
@@ -103,6 +136,28 @@ fn main() -> ExitCode {
             passes,
         } => decode(&input, &output, level, bytes, passes),
         Command::Info { input, json } => info(&input, json),
+        Command::View {
+            input,
+            output,
+            eye,
+            target,
+            up,
+            fov,
+            size,
+            tolerance,
+            faces,
+            png,
+        } => {
+            let camera = meshcodec::codecs::came::refine::Camera {
+                eye,
+                target,
+                up,
+                fov_degrees: fov,
+                width: size.0,
+                height: size.1,
+            };
+            view(&input, &output, &camera, tolerance, faces, png.as_deref())
+        }
         Command::Distance {
             a,
             b,
@@ -194,6 +249,70 @@ fn decode(
         decoded.mesh.face_count(),
         prefix.len()
     );
+    Ok(())
+}
+
+fn view(
+    input: &Path,
+    output: &Path,
+    camera: &meshcodec::codecs::came::refine::Camera,
+    tolerance: f64,
+    faces: Option<usize>,
+    png: Option<&Path>,
+) -> Result<()> {
+    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
+    let stream = read_stream(input)?;
+    let context = || input.display().to_string();
+    let units = StreamReader::open(&stream)
+        .with_context(context)?
+        .index()
+        .len();
+    let mut front = ViewMesh::from_stream(&stream).with_context(context)?;
+    let view = View::new(camera, tolerance)?;
+    let budget = Budget {
+        operations: usize::MAX,
+        faces,
+    };
+    let started = std::time::Instant::now();
+    let (mut splits, mut collapses) = (0, 0);
+    // The face budget is held by raising the tolerance from one adaptation to the next, until
+    // the front settles with no split held back.
+    for _ in 0..64 {
+        let done = front.adapt(&view, budget)?;
+        splits += done.splits;
+        collapses += done.collapses;
+        if done.settled {
+            break;
+        }
+    }
+    let seconds = started.elapsed().as_secs_f64();
+    let mesh = front.mesh();
+    write_mesh(&mesh, output).with_context(|| output.display().to_string())?;
+    meshcodec::outln!(
+        "{}: {} faces, {} vertices (tolerance {:.3} px{}); {splits} splits, {collapses} collapses in {:.1} ms",
+        output.display(),
+        mesh.face_count(),
+        mesh.vertex_count(),
+        tolerance * front.tolerance_scale(),
+        faces.map_or(String::new(), |f| format!(", budget {f} faces")),
+        seconds * 1e3
+    );
+    meshcodec::outln!(
+        "read {} of {} bytes, {units} of {units} meta-nodes decoded (the whole stream: fetching meta-nodes on demand is not built yet)",
+        stream.len(),
+        stream.len()
+    );
+    if let Some(png) = png {
+        let perspective = meshcodec::render::Perspective {
+            eye: camera.eye,
+            target: camera.target,
+            up: camera.up,
+            fov_degrees: camera.fov_degrees,
+        };
+        meshcodec::render::render_perspective(&mesh, &perspective, camera.width, camera.height)
+            .save_png(png)?;
+        meshcodec::outln!("wrote {}", png.display());
+    }
     Ok(())
 }
 

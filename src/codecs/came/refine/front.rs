@@ -58,7 +58,11 @@ pub struct Adapted {
     pub collapses: usize,
     /// Passes over the active nodes.
     pub passes: usize,
-    /// Whether the front is settled for this view (a pass found nothing more to do).
+    /// Whether the face budget held back a split the view wanted (the tolerance is raised for
+    /// the next call).
+    pub capped: bool,
+    /// Whether the front is settled for this view: a pass found nothing more to do and
+    /// nothing was held back.
     pub settled: bool,
 }
 
@@ -373,7 +377,7 @@ impl ViewMesh {
         let mut pass = std::mem::take(&mut self.pass);
         let result = self.adapt_passes(view, budget, &mut done, &mut pass);
         self.pass = pass;
-        self.regulate(budget.faces);
+        self.regulate(budget.faces, done.capped);
         result.map(|()| done)
     }
 
@@ -412,10 +416,13 @@ impl ViewMesh {
                     below.push(v);
                     while let Some(x) = below.pop() {
                         if self.state[x as usize] != State::Active
-                            || self.faces >= limit
                             || done.splits + done.collapses >= budget.operations
                             || !wants(self, x)
                         {
+                            continue;
+                        }
+                        if self.faces >= limit {
+                            done.capped = true;
                             continue;
                         }
                         done.splits += self.force_split(x, &mut below)?;
@@ -435,20 +442,20 @@ impl ViewMesh {
                 }
             }
             if (done.splits, done.collapses) == (before.splits, before.collapses) {
-                done.settled = true;
+                done.settled = !done.capped;
                 return Ok(());
             }
         }
     }
 
-    /// Scales κ towards holding `faces`: up while there are more, back down (not below 1)
-    /// while there are clearly fewer.
-    fn regulate(&mut self, faces: Option<usize>) {
+    /// Scales κ towards holding `faces`: up while there are more or the budget held splits
+    /// back (`capped`), back down (not below 1) while there are clearly fewer.
+    fn regulate(&mut self, faces: Option<usize>, capped: bool) {
         let Some(target) = faces else {
             self.scale = 1.0;
             return;
         };
-        if self.faces > target {
+        if self.faces > target || capped {
             self.scale *= 1.25;
         } else if (self.faces as f64) < 0.8 * target as f64 {
             self.scale = (self.scale / 1.25).max(1.0);
