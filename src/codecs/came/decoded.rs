@@ -216,6 +216,15 @@ impl DecodedTree {
     }
 }
 
+/// A node's position in grid units (cell centres at whole numbers) in the mesh's units.
+pub fn to_world(grid: &crate::mesh::Grid, p: [f64; 3]) -> DVec3 {
+    DVec3::new(
+        grid.origin[0] + (p[0] + 0.5) * grid.cell[0],
+        grid.origin[1] + (p[1] + 0.5) * grid.cell[1],
+        grid.origin[2] + (p[2] + 0.5) * grid.cell[2],
+    )
+}
+
 /// Decodes one unit into the tree: what differs between `came-paper` and `came`.
 pub trait UnitDecoder {
     /// Decodes the unit rooted at node `root` from `bytes` (starting at stream offset `at`);
@@ -508,14 +517,9 @@ impl<U: UnitDecoder> LevelDecoder for CameDecoder<'_, U> {
 
     fn mesh(&self) -> Result<LevelMesh> {
         let grid = self.stream.header().grid;
-        let to_world = |p: [f64; 3]| {
-            DVec3::new(
-                grid.origin[0] + (p[0] + 0.5) * grid.cell[0],
-                grid.origin[1] + (p[1] + 0.5) * grid.cell[1],
-                grid.origin[2] + (p[2] + 0.5) * grid.cell[2],
-            )
-        };
-        let mesh = self.tree.mesh_at(self.levels_decoded as u8, to_world)?;
+        let mesh = self
+            .tree
+            .mesh_at(self.levels_decoded as u8, |p| to_world(&grid, p))?;
         Ok(LevelMesh {
             mesh,
             loose_edges: Vec::new(),

@@ -14,7 +14,7 @@
 //! Refining everything gives the full decode's triangles on the full decode's vertices.
 
 use super::view::View;
-use crate::codecs::came::decoded::DecodedTree;
+use crate::codecs::came::decoded::{to_world, DecodedTree};
 use crate::container::Header;
 use crate::error::{Error, Result};
 use crate::hierarchy::came::NodeId;
@@ -122,13 +122,6 @@ impl ViewMesh {
         }
         let grid = header.grid;
         let cell = grid.cell.iter().fold(0.0f64, |m, &c| m.max(c.abs()));
-        let to_world = |p: [f64; 3]| {
-            DVec3::new(
-                grid.origin[0] + (p[0] + 0.5) * grid.cell[0],
-                grid.origin[1] + (p[1] + 0.5) * grid.cell[1],
-                grid.origin[2] + (p[2] + 0.5) * grid.cell[2],
-            )
-        };
         let mut parent = vec![NONE; n];
         let mut children = vec![[NONE; 2]; n];
         for (i, node) in tree.nodes.iter().enumerate() {
@@ -181,7 +174,11 @@ impl ViewMesh {
             ids: tree.nodes.iter().map(|n| n.id).collect(),
             parent,
             children,
-            center: tree.nodes.iter().map(|n| to_world(n.position)).collect(),
+            center: tree
+                .nodes
+                .iter()
+                .map(|n| to_world(&grid, n.position))
+                .collect(),
             radius: tree.nodes.iter().map(|n| n.radius * cell).collect(),
             state,
             born,
