@@ -406,3 +406,46 @@ pub fn round_trip(input: &GeneratedMesh) {
         }
     }
 }
+
+/// Adapts the front of a `came` stream (the bytes after its first six, behind up to 16 bytes
+/// that pick four views) to those views, a face budget and the full mesh, checking every
+/// invariant after each adaptation.
+pub fn adapt_came(data: &[u8]) {
+    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    let (views, body) = data.split_at(data.len().min(16));
+    let Ok(mut front) = ViewMesh::from_stream(&stream_of("came", body)) else {
+        return;
+    };
+    for chunk in views.chunks(4) {
+        let byte = |i: usize| chunk.get(i).copied().unwrap_or(0);
+        let axis = |i: usize| (byte(i) as f64 - 128.0) / 16.0;
+        let camera = Camera {
+            eye: glam::DVec3::new(axis(0), axis(1), axis(2)),
+            target: glam::DVec3::ZERO,
+            up: glam::DVec3::Y,
+            fov_degrees: 10.0 + byte(3) as f64 / 2.0,
+            width: 640,
+            height: 480,
+        };
+        let Ok(view) = View::new(&camera, byte(3) as f64 / 32.0) else {
+            continue;
+        };
+        let budget = Budget {
+            operations: 1 + 16 * byte(3) as usize,
+            faces: (byte(3) % 2 == 1).then_some(64 * byte(2) as usize),
+        };
+        if front.adapt(&view, budget).is_err() {
+            return;
+        }
+        assert_eq!(front.check_invariants(), Ok(()));
+    }
+    if front.adapt(&View::everything(), Budget::UNLIMITED).is_ok() {
+        assert_eq!(front.check_invariants(), Ok(()));
+        let mesh = front.mesh();
+        assert!(mesh
+            .faces
+            .iter()
+            .flatten()
+            .all(|&v| (v as usize) < mesh.positions.len()));
+    }
+}
