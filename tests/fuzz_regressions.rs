@@ -19,6 +19,7 @@ fn replay(target: &str, bytes: &[u8]) {
                 exercise::decode_mutated(&input);
             }
         }
+        "adapt_came" => exercise::adapt_came(bytes),
         "roundtrip" => {
             if let Ok(input) =
                 exercise::GeneratedMesh::arbitrary_take_rest(Unstructured::new(bytes))
