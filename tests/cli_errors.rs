@@ -337,6 +337,18 @@ fn view_adapts_a_came_stream_and_refuses_other_streams_and_cut_ones() {
     let budgeted = meshcodec::mesh::io::read_mesh(&d.join("v.ply")).unwrap();
     assert!(budgeted.face_count() <= 500 && budgeted.face_count() < full.face_count());
 
+    // info lists every meta-node's byte range, the last one ending with the file.
+    let info = Command::new(MESHCODEC)
+        .args(["info", "b.mc", "--json"])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    let report: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    let metas = report["meta_nodes"].as_array().unwrap();
+    assert_eq!(metas.len() as u64, report["units"].as_u64().unwrap());
+    assert_eq!(metas.last().unwrap()["end_byte"], report["bytes"]);
+    assert!(metas.windows(2).all(|w| w[0]["end_byte"] == w[1]["first_byte"]));
+
     let mut args = vec!["view", "e.mc", "w.ply"];
     args.extend_from_slice(&camera);
     assert_clean_failure(&run(MESHCODEC, &args, d), "e.mc");

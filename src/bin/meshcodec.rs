@@ -344,6 +344,28 @@ fn info(input: &Path, json: bool) -> Result<()> {
             "loose_edges": loose_edges.len(),
         }));
     }
+    // Meta-nodes (CAME): each unit's parent and byte range in the file, as a client that
+    // fetches them by range needs them.
+    let payload_start = reader.payload_start() as u64;
+    let meta_nodes: Vec<serde_json::Value> = if layered {
+        Vec::new()
+    } else {
+        reader
+            .index()
+            .units
+            .iter()
+            .enumerate()
+            .map(|(i, u)| {
+                serde_json::json!({
+                    "unit": i,
+                    "parent": u.parent,
+                    "first_byte": payload_start + u.offset,
+                    "end_byte": payload_start + u.end(),
+                    "bytes": u.length,
+                })
+            })
+            .collect()
+    };
     let sizes = &levels;
     let report = serde_json::json!({
         "file": input.display().to_string(),
@@ -362,6 +384,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "units_present": present,
         "truncated": reader.truncated(),
         "levels": levels,
+        "meta_nodes": meta_nodes,
     });
     if json {
         meshcodec::outln!("{}", serde_json::to_string_pretty(&report)?);
@@ -418,6 +441,28 @@ fn info(input: &Path, json: bool) -> Result<()> {
             cell("vertices"),
             cell("triangles")
         );
+    }
+    if !meta_nodes.is_empty() {
+        let _ = writeln!(
+            text,
+            "{:>9} {:>8} {:>11} {:>10} {:>8}",
+            "meta-node", "parent", "first byte", "end byte", "bytes"
+        );
+        for m in &meta_nodes {
+            let cell = |key: &str| match &m[key] {
+                serde_json::Value::Null => "—".to_string(),
+                v => v.to_string(),
+            };
+            let _ = writeln!(
+                text,
+                "{:>9} {:>8} {:>11} {:>10} {:>8}",
+                cell("unit"),
+                cell("parent"),
+                cell("first_byte"),
+                cell("end_byte"),
+                cell("bytes")
+            );
+        }
     }
     meshcodec::cli::write_stdout(&text)?;
     Ok(())
