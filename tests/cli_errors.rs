@@ -347,7 +347,9 @@ fn view_adapts_a_came_stream_and_refuses_other_streams_and_cut_ones() {
     let metas = report["meta_nodes"].as_array().unwrap();
     assert_eq!(metas.len() as u64, report["units"].as_u64().unwrap());
     assert_eq!(metas.last().unwrap()["end_byte"], report["bytes"]);
-    assert!(metas.windows(2).all(|w| w[0]["end_byte"] == w[1]["first_byte"]));
+    assert!(metas
+        .windows(2)
+        .all(|w| w[0]["end_byte"] == w[1]["first_byte"]));
 
     let mut args = vec!["view", "e.mc", "w.ply"];
     args.extend_from_slice(&camera);
