@@ -427,11 +427,13 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "{:>5} {:>10} {:>10} {:>10} {:>10}",
         "level", "end byte", "bytes", "vertices", "triangles"
     );
+    // A table cell: a number, or a dash where there is none.
+    let cell = |row: &serde_json::Value, key: &str| match &row[key] {
+        serde_json::Value::Null => "—".to_string(),
+        v => v.to_string(),
+    };
     for l in &levels {
-        let cell = |key: &str| match &l[key] {
-            serde_json::Value::Null => "—".to_string(),
-            v => v.to_string(),
-        };
+        let cell = |key: &str| cell(l, key);
         let _ = writeln!(
             text,
             "{:>5} {:>10} {:>10} {:>10} {:>10}",
@@ -449,10 +451,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
             "meta-node", "parent", "first byte", "end byte", "bytes"
         );
         for m in &meta_nodes {
-            let cell = |key: &str| match &m[key] {
-                serde_json::Value::Null => "—".to_string(),
-                v => v.to_string(),
-            };
+            let cell = |key: &str| cell(m, key);
             let _ = writeln!(
                 text,
                 "{:>9} {:>8} {:>11} {:>10} {:>8}",

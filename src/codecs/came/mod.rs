@@ -54,7 +54,7 @@ pub fn decode_tree(bytes: &[u8]) -> Result<(Header, decoded::DecodedTree)> {
             d.into_tree()
         }
         "came-paper" => {
-            let params = Params::from_bytes(&header.params, 1..=16)?;
+            let params = paper::params(&header)?;
             let mut d = decoded::CameDecoder::new(reader, params, paper::PaperUnits::default())?;
             d.decode_everything()?;
             d.into_tree()
@@ -318,4 +318,23 @@ fn hierarchy_stats(
         Stat::RawDependenciesPerNode,
         tree.raw_dependencies as f64 / tree.children.len().max(1) as f64,
     );
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use crate::codecs::{decode, Stop};
+    use crate::mesh::CanonicalMesh;
+
+    /// Prefixes of a stream of `canonical` (a quarter, a half, all but a byte) decode to more
+    /// and more levels, never all of them, never more faces than the mesh.
+    pub fn check_prefixes(canonical: &CanonicalMesh, bytes: &[u8]) {
+        let (_, levels) = decode(bytes, Stop::All).unwrap();
+        let mut previous = 0;
+        for cut in [bytes.len() / 4, bytes.len() / 2, bytes.len() - 1] {
+            let (mesh, got) = decode(&bytes[..cut], Stop::All).unwrap();
+            assert!(got >= previous && got < levels, "{got} of {levels}");
+            assert!(mesh.mesh.face_count() <= canonical.face_count());
+            previous = got;
+        }
+    }
 }

@@ -235,13 +235,18 @@ impl Codec for CamePaper {
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
-        let params = Params::from_bytes(&stream.header().params, 1..=16)?;
+        let params = params(stream.header())?;
         Ok(Box::new(CameDecoder::new(
             stream,
             params,
             PaperUnits::default(),
         )?))
     }
+}
+
+/// A `came-paper` stream's parameters, checked.
+pub fn params(header: &Header) -> Result<Params> {
+    Params::from_bytes(&header.params, 1..=16)
 }
 
 /// The field each table's symbols are booked in.
@@ -650,7 +655,7 @@ mod tests {
 
     fn decoder(bytes: &[u8]) -> CameDecoder<'_, PaperUnits> {
         let reader = StreamReader::open(bytes).unwrap();
-        let params = Params::from_bytes(&reader.header().params, 1..=16).unwrap();
+        let params = params(reader.header()).unwrap();
         CameDecoder::new(reader, params, PaperUnits::default()).unwrap()
     }
 
@@ -715,14 +720,7 @@ mod tests {
     #[test]
     fn prefixes_decode_the_levels_they_hold() {
         let (canonical, bytes) = stream(&generate::icosphere(4), 5);
-        let (_, levels) = decode(&bytes, Stop::All).unwrap();
-        let mut previous = 0;
-        for cut in [bytes.len() / 4, bytes.len() / 2, bytes.len() - 1] {
-            let (mesh, got) = decode(&bytes[..cut], Stop::All).unwrap();
-            assert!(got >= previous && got < levels, "{got} of {levels}");
-            assert!(mesh.mesh.face_count() <= canonical.face_count());
-            previous = got;
-        }
+        crate::codecs::came::tests::check_prefixes(&canonical, &bytes);
     }
 
     #[test]

@@ -119,20 +119,6 @@ fn morton_order(cells: &[[u32; 3]]) -> Vec<u32> {
     keyed.into_iter().map(|(_, i)| i).collect()
 }
 
-/// What the greedy loop may do with a slot. The whole mesh's loop has only free slots; a
-/// region's loop ([`super::regions`]) pins the slots whose faces or pairs reach another region
-/// and holds the other regions' corners of its faces as ghosts, so that it never changes a face,
-/// pair or slot another region's loop can see.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Role {
-    /// Takes part in contractions.
-    Free,
-    /// Takes part in none (its faces or pairs reach another region).
-    Pinned,
-    /// Another region's slot, only named as a face's corner.
-    Ghost,
-}
-
 /// A state of the contraction: the slots (every live node sits in the slot of one of its
 /// leaves, which it keeps when it absorbs another node, so that its faces and pairs stay where
 /// they were and only the vanishing node's move), the faces' current corners, the pairs, and the
@@ -142,14 +128,16 @@ pub(super) struct Start {
     /// `children[i]`.
     pub base: u32,
     /// Per slot: the node in it, its position, quadric, subtree height, the position of its
-    /// representative leaf, whether it is live, and its role.
+    /// representative leaf, whether it is live, and whether it is pinned: kept out of every
+    /// contraction (a region's loop, [`super::regions`], pins the slots whose faces or pairs
+    /// reach another region, so that it never changes what another region's loop can see).
     pub node: Vec<u32>,
     pub position: Vec<DVec3>,
     pub quadric: Vec<Quadric>,
     pub height: Vec<u8>,
     pub rep_position: Vec<DVec3>,
     pub alive: Vec<bool>,
-    pub role: Vec<Role>,
+    pub pinned: Vec<bool>,
     /// Per face: its corners' slots, whether it vanished, and the node whose split creates it.
     pub corners: Vec<[u32; 3]>,
     pub face_dead: Vec<bool>,
@@ -187,7 +175,7 @@ impl Start {
             quadric,
             height: vec![0; n],
             alive: vec![true; n],
-            role: vec![Role::Free; n],
+            pinned: vec![false; n],
             face_dead: vec![false; faces.len()],
             births: vec![u32::MAX; faces.len()],
             corners: faces,
@@ -255,9 +243,7 @@ impl Contraction {
             slot_pairs[a as usize].push(p as u32);
             slot_pairs[b as usize].push(p as u32);
         }
-        let left = (0..n)
-            .filter(|&v| s.alive[v] && s.role[v] == Role::Free)
-            .count();
+        let left = (0..n).filter(|&v| s.alive[v] && !s.pinned[v]).count();
         let mut c = Contraction {
             balance,
             left,
@@ -278,11 +264,11 @@ impl Contraction {
         c
     }
 
-    /// Whether pair `p` may be contracted: both its ends are free (roles never change, so a
-    /// pair that is not allowed never enters the heap).
+    /// Whether pair `p` may be contracted: neither end is pinned (pins never change, so a pair
+    /// that is not allowed never enters the heap).
     fn allowed(&self, p: u32) -> bool {
         let [a, b] = self.s.pairs[p as usize];
-        self.s.role[a as usize] == Role::Free && self.s.role[b as usize] == Role::Free
+        !self.s.pinned[a as usize] && !self.s.pinned[b as usize]
     }
 
     /// The merged quadric's optimum for a pair of slots, or the best of its ends and midpoint.

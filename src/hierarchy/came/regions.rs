@@ -12,20 +12,19 @@
 //! the whole mesh's loop alone. Letting pinned slots absorb free ones (they only may not vanish)
 //! grew the stream 8%: the seams became long chains of absorptions.
 
-use super::build::{contract_greedily, Role, Start};
+use super::build::{contract_greedily, Start};
 use rayon::prelude::*;
-use std::collections::HashMap;
 
 /// Meshes with fewer vertices are contracted by the whole mesh's loop alone.
 pub(super) const REGION_MIN_VERTICES: usize = 1 << 16;
 /// Slots per region: small enough that a region's loop works in cache.
 pub(super) const REGION_SLOTS: usize = 1 << 15;
 
-/// A region's contracted copy: its state in local slots (the region's own first, then ghosts),
-/// with each local slot's and face's index in the whole mesh.
+/// A region's contracted copy: its state in local slots (slot `lo + i` of the whole mesh is
+/// local slot i), with each local face's index in the whole mesh.
 struct RegionRun {
+    lo: u32,
     state: Start,
-    slot_ids: Vec<u32>,
     face_ids: Vec<u32>,
 }
 
@@ -84,8 +83,10 @@ pub(super) fn contract_in_regions(start: Start, balance: f64, region_slots: usiz
     merge(start, &bounds, runs)
 }
 
-/// The copy of region `lo..hi` of `whole`: its slots, the faces touching them (other regions'
-/// corners as ghosts) and the pairs inside it; slots with a face or pair reaching out pinned.
+/// The copy of region `lo..hi` of `whole`: its slots, the faces and pairs inside it; slots
+/// with a face or pair reaching out pinned. The faces reaching out are left out: all their
+/// corners in the region are pinned, so no contraction there changes them or finds them among
+/// a split's dependencies (those hold the contracted node, which is free).
 fn region_copy(
     whole: &Start,
     faces_of: &PerSlot,
@@ -94,58 +95,42 @@ fn region_copy(
     hi: u32,
 ) -> RegionRun {
     let inside = |v: u32| (lo..hi).contains(&v);
-    let own = (hi - lo) as usize;
-    let mut slot_ids: Vec<u32> = (lo..hi).collect();
-    let mut role = vec![Role::Free; own];
-    let mut ghosts: HashMap<u32, u32, foldhash::fast::FixedState> = HashMap::default();
+    let mut pinned = vec![false; (hi - lo) as usize];
     let mut face_ids = Vec::new();
     let mut corners = Vec::new();
     let mut pairs = Vec::new();
     for v in lo..hi {
         for &f in faces_of.of(v) {
             let c = whole.corners[f as usize];
-            // Each face once: from its first corner inside the region.
-            if c.iter().filter(|&&x| inside(x)).min() != Some(&v) {
-                continue;
+            if !c.iter().all(|&x| inside(x)) {
+                pinned[(v - lo) as usize] = true;
+            } else if c.iter().min() == Some(&v) {
+                // Each face once: from its first corner.
+                face_ids.push(f);
+                corners.push(c.map(|x| x - lo));
             }
-            let reaches_out = c.iter().any(|&x| !inside(x));
-            let local = c.map(|x| {
-                if inside(x) {
-                    if reaches_out {
-                        role[(x - lo) as usize] = Role::Pinned;
-                    }
-                    x - lo
-                } else {
-                    *ghosts.entry(x).or_insert_with(|| {
-                        slot_ids.push(x);
-                        (slot_ids.len() - 1) as u32
-                    })
-                }
-            });
-            face_ids.push(f);
-            corners.push(local);
         }
         for &p in pairs_of.of(v) {
             let [a, b] = whole.pairs[p as usize];
             let other = if a == v { b } else { a };
             if !inside(other) {
-                role[(v - lo) as usize] = Role::Pinned;
+                pinned[(v - lo) as usize] = true;
             } else if v < other {
                 pairs.push([v - lo, other - lo]);
             }
         }
     }
-    role.resize(slot_ids.len(), Role::Ghost);
     let faces = corners.len();
+    let own = lo as usize..hi as usize;
     let state = Start {
         base: whole.base,
-        node: pick(&slot_ids, &whole.node),
-        position: pick(&slot_ids, &whole.position),
-        quadric: pick(&slot_ids, &whole.quadric),
-        height: pick(&slot_ids, &whole.height),
-        rep_position: pick(&slot_ids, &whole.rep_position),
-        alive: pick(&slot_ids, &whole.alive),
-        role,
+        node: whole.node[own.clone()].to_vec(),
+        position: whole.position[own.clone()].to_vec(),
+        quadric: whole.quadric[own.clone()].to_vec(),
+        height: whole.height[own.clone()].to_vec(),
+        rep_position: whole.rep_position[own.clone()].to_vec(),
+        alive: whole.alive[own].to_vec(),
+        pinned,
         corners,
         face_dead: vec![false; faces],
         births: vec![u32::MAX; faces],
@@ -156,15 +141,10 @@ fn region_copy(
         dependency_start: vec![0],
     };
     RegionRun {
+        lo,
         state,
-        slot_ids,
         face_ids,
     }
-}
-
-/// `values` of the slots `slots`.
-fn pick<T: Copy>(slots: &[u32], values: &[T]) -> Vec<T> {
-    slots.iter().map(|&v| values[v as usize]).collect()
 }
 
 /// `whole` with every region's contractions applied: inner nodes numbered region by region,
@@ -182,11 +162,8 @@ fn merge(mut whole: Start, bounds: &[u32], runs: Vec<RegionRun>) -> Start {
         let offset = whole.children.len() as u32;
         let node = |id: u32| if id >= base { id + offset } else { id };
         let r = run.state;
-        for (local, &v) in run.slot_ids.iter().enumerate() {
-            if r.role[local] == Role::Ghost {
-                continue;
-            }
-            let v = v as usize;
+        for local in 0..r.node.len() {
+            let v = run.lo as usize + local;
             whole.node[v] = node(r.node[local]);
             whole.position[v] = r.position[local];
             whole.quadric[v] = r.quadric[local];
@@ -196,13 +173,13 @@ fn merge(mut whole: Start, bounds: &[u32], runs: Vec<RegionRun>) -> Start {
         }
         for (local, &f) in run.face_ids.iter().enumerate() {
             let f = f as usize;
-            whole.corners[f] = r.corners[local].map(|x| run.slot_ids[x as usize]);
+            whole.corners[f] = r.corners[local].map(|x| run.lo + x);
             whole.face_dead[f] = r.face_dead[local];
             if r.births[local] != u32::MAX {
                 whole.births[f] = node(r.births[local]);
             }
         }
-        pairs.extend(r.pairs.iter().map(|p| p.map(|x| run.slot_ids[x as usize])));
+        pairs.extend(r.pairs.iter().map(|p| p.map(|x| run.lo + x)));
         whole
             .children
             .extend(r.children.iter().map(|c| c.map(node)));
