@@ -6,7 +6,9 @@ cd "$(dirname "$0")/.."
 
 bash tests/libusb.sh
 
-cargo build --release --bins
+# Builds the binaries too (the integration tests and the Python checks below run them); a
+# separate `cargo build` first would compile the dependencies twice (the tests' dev-dependencies
+# unify other features).
 cargo test --release
 
 if [ ! -x .venv/bin/python ]; then
