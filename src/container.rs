@@ -477,6 +477,11 @@ impl<'a> StreamReader<'a> {
         })
     }
 
+    /// Its header, index, payload offset and bytes.
+    pub fn into_parts(self) -> (Header, Index, usize, &'a [u8]) {
+        (self.header, self.index, self.payload_start, self.bytes)
+    }
+
     /// Refuses a stream whose units are not levels.
     pub fn require_layered(&self) -> Result<()> {
         self.index.require_layered(self.payload_start)

@@ -38,6 +38,8 @@ pub mod mesh;
 #[cfg(feature = "lab")]
 pub mod came_extras;
 #[cfg(feature = "lab")]
+pub mod came_flythrough;
+#[cfg(feature = "lab")]
 pub mod cli;
 #[cfg(feature = "lab")]
 pub mod harness;

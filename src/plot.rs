@@ -169,6 +169,35 @@ impl Chart {
         Ok(vec![png, svg])
     }
 
+    /// Draws `charts` as panels of one figure, `columns` across, to `<stem>.png` and
+    /// `<stem>.svg` (each panel 800 × 450); returns their paths.
+    pub fn draw_panels(charts: &[Chart], columns: usize, stem: &Path) -> Result<Vec<PathBuf>> {
+        ensure_font()?;
+        let columns = columns.clamp(1, charts.len().max(1));
+        let rows = charts.len().div_ceil(columns).max(1);
+        let size = (800 * columns as u32, 450 * rows as u32);
+        let png = stem.with_extension("png");
+        let svg = stem.with_extension("svg");
+        fn panels<DB: DrawingBackend>(
+            charts: &[Chart],
+            root: DrawingArea<DB, Shift>,
+            rows: usize,
+            columns: usize,
+        ) -> Result<()>
+        where
+            DB::ErrorType: 'static,
+        {
+            root.fill(&WHITE).map_err(plot_error)?;
+            for (chart, area) in charts.iter().zip(root.split_evenly((rows, columns))) {
+                chart.draw_on(&area)?;
+            }
+            root.present().map_err(plot_error)
+        }
+        panels(charts, BitMapBackend::new(&png, size).into_drawing_area(), rows, columns)?;
+        panels(charts, SVGBackend::new(&svg, size).into_drawing_area(), rows, columns)?;
+        Ok(vec![png, svg])
+    }
+
     fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<()>
     where
         DB::ErrorType: 'static,

@@ -6,6 +6,7 @@ use std::process::Command;
 
 struct Outcome {
     code: Option<i32>,
+    stdout: String,
     stderr: String,
 }
 
@@ -21,6 +22,7 @@ fn run(bin: &str, args: &[&str], dir: &Path) -> Outcome {
         .expect("binary runs");
     Outcome {
         code: out.status.code(),
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
     }
 }
@@ -307,7 +309,7 @@ fn a_reader_that_goes_away_is_no_panic() {
 }
 
 #[test]
-fn view_adapts_a_came_stream_and_refuses_other_streams_and_cut_ones() {
+fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
     let dir = scratch();
     let d = dir.path();
     let ok = |args: &[&str]| {
@@ -332,6 +334,25 @@ fn view_adapts_a_came_stream_and_refuses_other_streams_and_cut_ones() {
     };
     ok(&with(&["--png", "v.png"]));
     let full = meshcodec::mesh::io::read_mesh(&d.join("v.ply")).unwrap();
+    // From afar, only some meta-nodes are read.
+    let mut far = vec![
+        "view",
+        "b.mc",
+        "far.ply",
+        "--eye",
+        "-0.05,0.15,5",
+        "--target",
+        "-0.02,0.1,0",
+    ];
+    far.extend_from_slice(&["--size", "320x240"]);
+    let out = run(MESHCODEC, &far, d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let read = out.stdout.lines().find(|l| l.starts_with("read ")).unwrap();
+    let numbers: Vec<u64> = read
+        .split(|c: char| !c.is_ascii_digit())
+        .filter_map(|w| w.parse().ok())
+        .collect();
+    assert!(numbers[0] < numbers[1], "{read}");
     assert!(full.face_count() > 100 && d.join("v.png").is_file());
     ok(&with(&["--faces", "500"]));
     let budgeted = meshcodec::mesh::io::read_mesh(&d.join("v.ply")).unwrap();
@@ -354,10 +375,25 @@ fn view_adapts_a_came_stream_and_refuses_other_streams_and_cut_ones() {
     let mut args = vec!["view", "e.mc", "w.ply"];
     args.extend_from_slice(&camera);
     assert_clean_failure(&run(MESHCODEC, &args, d), "e.mc");
+    // A stream cut after some meta-nodes: those past the cut are refused, each for its own
+    // branch, and the rest adapts.
     let stream = std::fs::read(d.join("b.mc")).unwrap();
     write(d, "cut.mc", &stream[..stream.len() / 2]);
     let mut args = vec!["view", "cut.mc", "w.ply"];
     args.extend_from_slice(&camera);
-    assert_clean_failure(&run(MESHCODEC, &args, d), "cut.mc");
-    assert!(!d.join("w.ply").exists());
+    let out = run(MESHCODEC, &args, d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    assert!(out.stderr.lines().count() > 1, "{}", out.stderr);
+    assert!(out
+        .stderr
+        .lines()
+        .all(|l| l.starts_with("warning: meta-node ") && l.contains("past the stream's end")));
+    let cut = meshcodec::mesh::io::read_mesh(&d.join("w.ply")).unwrap();
+    assert!(cut.face_count() > 100 && cut.face_count() < full.face_count());
+    // Cut inside its index, it cannot be read at all.
+    write(d, "head.mc", &stream[..40]);
+    let mut args = vec!["view", "head.mc", "x.ply"];
+    args.extend_from_slice(&camera);
+    assert_clean_failure(&run(MESHCODEC, &args, d), "head.mc");
+    assert!(!d.join("x.ply").exists());
 }

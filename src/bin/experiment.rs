@@ -71,6 +71,14 @@ enum Command {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// CAME's fly-through: 100 views around and into the million-triangle mesh, its came
+    /// stream's meta-nodes read from a file as the views need them; writes
+    /// results/came/flythrough.{json,csv,png,svg} and renders of the far and near frames.
+    CameFly {
+        /// Folder for results.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
     /// Regenerate the papers' tables and figures in paper-tables/ from results/.
     Tables {
         /// Folder of result files.
@@ -110,6 +118,7 @@ fn main() -> ExitCode {
         Some(Command::Tables { results, out }) => tables(results, out),
         Some(Command::Decimation { out }) => decimation(out),
         Some(Command::CameExtras { out }) => came_extras(out),
+        Some(Command::CameFly { out }) => came_fly(out),
         None => match (&cli.codec, &cli.mesh) {
             (Some(codec), Some(mesh)) => run_one(codec, mesh, &cli.settings).map(|_| ()),
             _ => Err(anyhow::anyhow!(
@@ -322,6 +331,12 @@ fn tables(results: &Path, out: &Path) -> Result<()> {
 
 fn came_extras(out: &Path) -> Result<()> {
     let path = meshcodec::came_extras::run(out, &mut |line| eprintln!("{line}"))?;
+    meshcodec::outln!("wrote {}", path.display());
+    Ok(())
+}
+
+fn came_fly(out: &Path) -> Result<()> {
+    let path = meshcodec::came_flythrough::run(out, &mut |line| eprintln!("{line}"))?;
     meshcodec::outln!("wrote {}", path.display());
     Ok(())
 }

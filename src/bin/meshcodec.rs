@@ -261,47 +261,44 @@ fn view(
     png: Option<&Path>,
 ) -> Result<()> {
     use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
-    let stream = read_stream(input)?;
     let context = || input.display().to_string();
-    let units = StreamReader::open(&stream)
-        .with_context(context)?
-        .index()
-        .len();
-    let mut front = ViewMesh::from_stream(&stream).with_context(context)?;
+    // Only the header, the index and the meta-nodes this view needs are read.
+    let mut front = ViewMesh::open_file(input).with_context(context)?;
     let view = View::new(camera, tolerance)?;
     let budget = Budget {
         operations: usize::MAX,
         faces,
     };
     let started = std::time::Instant::now();
-    let (mut splits, mut collapses) = (0, 0);
     // The face budget is held by raising the tolerance from one adaptation to the next, until
-    // the front settles with no split held back.
-    for _ in 0..64 {
-        let done = front.adapt(&view, budget)?;
-        splits += done.splits;
-        collapses += done.collapses;
-        if done.settled {
-            break;
-        }
-    }
+    // the front settles with no split held back; meta-nodes are waited for as they are asked.
+    let done = front.settle(&view, budget, 64);
     let seconds = started.elapsed().as_secs_f64();
     let mesh = front.mesh();
     write_mesh(&mesh, output).with_context(|| output.display().to_string())?;
     meshcodec::outln!(
-        "{}: {} faces, {} vertices (tolerance {:.3} px{}); {splits} splits, {collapses} collapses in {:.1} ms",
+        "{}: {} faces, {} vertices (tolerance {:.3} px{}); {} splits, {} collapses in {:.1} ms",
         output.display(),
         mesh.face_count(),
         mesh.vertex_count(),
         tolerance * front.tolerance_scale(),
         faces.map_or(String::new(), |f| format!(", budget {f} faces")),
+        done.splits,
+        done.collapses,
         seconds * 1e3
     );
+    let fetched = front.fetched();
     meshcodec::outln!(
-        "read {} of {} bytes, {units} of {units} meta-nodes decoded (the whole stream: fetching meta-nodes on demand is not built yet)",
-        stream.len(),
-        stream.len()
+        "read {} of {} bytes ({:.1}%), {} of {} meta-nodes",
+        fetched.bytes_read,
+        fetched.stream_bytes,
+        100.0 * fetched.bytes_read as f64 / fetched.stream_bytes.max(1) as f64,
+        fetched.units_loaded,
+        fetched.units
     );
+    for (unit, why) in front.refusals() {
+        eprintln!("warning: meta-node {unit} refused, its branch stays coarse: {why}");
+    }
     if let Some(png) = png {
         let perspective = meshcodec::render::Perspective {
             eye: camera.eye,

@@ -5,7 +5,7 @@
 use super::knowledge::{status, Status};
 use super::Params;
 use crate::codecs::{LevelDecoder, LevelMesh};
-use crate::container::{Header, StreamReader};
+use crate::container::{Header, Index, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::NodeId;
 use crate::mesh::TriMesh;
@@ -38,6 +38,15 @@ pub struct Triangle {
     pub corners: [NodeId; 3],
     /// Depth of the node whose split creates it.
     pub birth_depth: u8,
+}
+
+/// The sizes of a [`DecodedTree`] at one moment.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Mark {
+    pub nodes: usize,
+    pub triangles: usize,
+    pub dependencies: usize,
+    pub dependency_nodes: usize,
 }
 
 /// Everything decoded so far.
@@ -74,6 +83,36 @@ impl DecodedTree {
             max_nodes: (2 * vertices).saturating_sub(1) as usize,
             max_triangles: triangles as usize,
         }
+    }
+
+    /// How much is decoded now, to [`DecodedTree::roll_back`] to.
+    pub fn mark(&self) -> Mark {
+        Mark {
+            nodes: self.nodes.len(),
+            triangles: self.triangles.len(),
+            dependencies: self.dependencies.len(),
+            dependency_nodes: self.dependency_nodes.len(),
+        }
+    }
+
+    /// Forgets everything decoded since `mark` (a unit that failed half-way).
+    pub fn roll_back(&mut self, mark: Mark) {
+        for i in mark.nodes.min(self.nodes.len())..self.nodes.len() {
+            let id = self.nodes[i].id;
+            self.lookup.remove(&id.packed());
+            // The parent split by this unit, if it was decoded before it.
+            if let Some(&parent) = id.parent().and_then(|p| self.lookup.get(&p.packed())) {
+                if (parent as usize) < mark.nodes {
+                    let p = &mut self.nodes[parent as usize];
+                    p.children = None;
+                    p.split_unit = None;
+                }
+            }
+        }
+        self.nodes.truncate(mark.nodes);
+        self.triangles.truncate(mark.triangles);
+        self.dependencies.truncate(mark.dependencies);
+        self.dependency_nodes.truncate(mark.dependency_nodes);
     }
 
     /// Adds the root (an inner node: the meshes CAME codes have triangles).
@@ -225,6 +264,18 @@ pub fn to_world(grid: &crate::mesh::Grid, p: [f64; 3]) -> DVec3 {
     )
 }
 
+/// What one unit added to the tree, before it is kept ([`CameDecoder::decode_unit_checked`]).
+pub struct DecodedUnit<'t> {
+    /// The tree, with the unit decoded.
+    pub tree: &'t DecodedTree,
+    /// The unit's root node.
+    pub root: u32,
+    /// The tree before the unit: what lies past this mark is the unit's.
+    pub since: Mark,
+    /// The units under this one in the index, with their root nodes.
+    pub child_units: Vec<(usize, u32)>,
+}
+
 /// Decodes one unit into the tree: what differs between `came-paper` and `came`.
 pub trait UnitDecoder {
     /// Decodes the unit rooted at node `root` from `bytes` (starting at stream offset `at`);
@@ -245,7 +296,13 @@ pub trait UnitDecoder {
 /// once its ancestors are ([`CameDecoder::decode_unit`]): a unit's root is the k-th child root
 /// of its parent unit when it is the parent's k-th child in the index.
 pub struct CameDecoder<'a, U: UnitDecoder> {
-    stream: StreamReader<'a>,
+    header: Header,
+    index: Index,
+    /// Offset of the payload in the stream.
+    payload_start: usize,
+    /// The stream or prefix the units are read from (empty for a detached decoder, which is
+    /// given each unit's bytes).
+    bytes: &'a [u8],
     params: Params,
     units: U,
     tree: DecodedTree,
@@ -253,8 +310,8 @@ pub struct CameDecoder<'a, U: UnitDecoder> {
     child_roots: Vec<Option<Vec<u32>>>,
     /// Per unit: its rank among its parent's children in the index.
     rank: Vec<usize>,
-    /// Per unit: how many children the index gives it.
-    child_count: Vec<usize>,
+    /// Per unit: its children in the index, in order.
+    unit_children: Vec<Vec<usize>>,
     /// Per unit: the triangles it decoded (a range of `tree.triangles`).
     unit_triangles: Vec<Option<std::ops::Range<usize>>>,
     /// Units decoded in stream order for levels.
@@ -265,7 +322,30 @@ pub struct CameDecoder<'a, U: UnitDecoder> {
 impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
     /// A decoder before the first level.
     pub fn new(stream: StreamReader<'a>, params: Params, units: U) -> Result<Self> {
-        let header = stream.header();
+        let (header, index, payload_start, bytes) = stream.into_parts();
+        Self::with_parts(header, index, payload_start, bytes, params, units)
+    }
+
+    /// A decoder given each unit's bytes by [`CameDecoder::decode_unit_bytes`] rather than
+    /// holding the stream: for units fetched on demand, from a file or a network.
+    pub fn detached(
+        header: Header,
+        index: Index,
+        payload_start: usize,
+        params: Params,
+        units: U,
+    ) -> Result<CameDecoder<'static, U>> {
+        CameDecoder::with_parts(header, index, payload_start, &[], params, units)
+    }
+
+    fn with_parts(
+        header: Header,
+        index: Index,
+        payload_start: usize,
+        bytes: &'a [u8],
+        params: Params,
+        units: U,
+    ) -> Result<Self> {
         if header.vertices < 3 || header.triangles == 0 {
             return Err(Error::malformed(
                 0,
@@ -273,7 +353,6 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                 "a CAME stream codes a mesh of at least one triangle",
             ));
         }
-        let index = stream.index();
         if index.units.first().is_some_and(|u| u.parent.is_some()) {
             return Err(Error::malformed(
                 0,
@@ -281,13 +360,13 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                 "the first unit cannot have a parent",
             ));
         }
-        let mut children = vec![0usize; index.len()];
+        let mut children = vec![Vec::new(); index.len()];
         let mut rank = vec![0usize; index.len()];
         for (i, unit) in index.units.iter().enumerate() {
             match unit.parent {
                 Some(p) => {
-                    rank[i] = children[p];
-                    children[p] += 1;
+                    rank[i] = children[p].len();
+                    children[p].push(i);
                 }
                 None if i > 0 => {
                     return Err(Error::malformed(0, 0, "only the first unit has no parent"))
@@ -295,13 +374,19 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                 None => {}
             }
         }
-        let tree = DecodedTree::new(header.vertices, header.triangles, stream.bytes().len());
+        // Room as far as the bytes at hand justify; a detached decoder's tree grows with the
+        // units it is given.
+        let known = bytes.len().max(payload_start);
+        let tree = DecodedTree::new(header.vertices, header.triangles, known);
         Ok(CameDecoder {
             child_roots: vec![None; index.len()],
             unit_triangles: vec![None; index.len()],
             rank,
-            child_count: children,
-            stream,
+            unit_children: children,
+            header,
+            index,
+            payload_start,
+            bytes,
             params,
             units,
             tree,
@@ -324,11 +409,11 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
     /// Decodes every unit not decoded yet, in stream order, and checks that the hierarchy is
     /// complete.
     pub fn decode_everything(&mut self) -> Result<()> {
-        for i in 0..self.stream.index().len() {
+        for i in 0..self.index.len() {
             if self.child_roots[i].is_none() && !self.decode_unit(i)? {
                 return Err(Error::malformed(
                     i + 1,
-                    self.stream.bytes().len(),
+                    self.bytes.len(),
                     format!("the stream ends inside unit {i}"),
                 ));
             }
@@ -343,7 +428,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
 
     /// The root of unit `i`, if its parent is decoded (the first unit's root is the tree's).
     fn unit_root(&self, i: usize) -> Result<Option<u32>> {
-        let Some(parent) = self.stream.index().units[i].parent else {
+        let Some(parent) = self.index.units[i].parent else {
             return Ok(Some(0));
         };
         let Some(roots) = &self.child_roots[parent] else {
@@ -352,7 +437,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         roots.get(self.rank[i]).copied().map(Some).ok_or_else(|| {
             Error::malformed(
                 i + 1,
-                self.stream.payload_start(),
+                self.payload_start,
                 format!("unit {i} has no meta-node under its parent unit {parent}"),
             )
         })
@@ -361,10 +446,46 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
     /// Decodes unit `i`, its ancestors decoded; `Ok(false)` if its bytes are not in the prefix.
     /// Errors if it is decoded already or a parent is missing.
     pub fn decode_unit(&mut self, i: usize) -> Result<bool> {
-        let index_len = self.stream.index().len();
-        if i >= index_len {
-            return Err(Error::Unsupported(format!(
-                "no unit {i}: the stream has {index_len}"
+        let Some(entry) = self.index.units.get(i) else {
+            return Err(self.no_unit(i));
+        };
+        let start = self.payload_start + entry.offset as usize;
+        let end = self.payload_start + entry.end() as usize;
+        let Some(bytes) = self.bytes.get(start..end) else {
+            return Ok(false);
+        };
+        self.decode_unit_bytes(i, bytes)?;
+        Ok(true)
+    }
+
+    fn no_unit(&self, i: usize) -> Error {
+        Error::Unsupported(format!("no unit {i}: the stream has {}", self.index.len()))
+    }
+
+    /// Decodes unit `i` from `bytes`, the payload its index entry points to (read from wherever
+    /// the stream is), its ancestors decoded. On an error the tree is left as it was before, so
+    /// the other units still decode.
+    pub fn decode_unit_bytes(&mut self, i: usize, bytes: &[u8]) -> Result<()> {
+        self.decode_unit_checked(i, bytes, |_| Ok(()))
+    }
+
+    /// [`CameDecoder::decode_unit_bytes`], then `check` on what the unit added before it is
+    /// kept: an error from either leaves the tree as it was.
+    pub fn decode_unit_checked<T>(
+        &mut self,
+        i: usize,
+        bytes: &[u8],
+        check: impl FnOnce(&DecodedUnit) -> Result<T>,
+    ) -> Result<T> {
+        let Some(entry) = self.index.units.get(i) else {
+            return Err(self.no_unit(i));
+        };
+        let start = self.payload_start + entry.offset as usize;
+        if bytes.len() as u64 != entry.length {
+            return Err(Error::Truncated(format!(
+                "unit {i} has {} of its {} bytes",
+                bytes.len(),
+                entry.length
             )));
         }
         if self.child_roots[i].is_some() {
@@ -375,39 +496,57 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                 "unit {i} needs its parent unit decoded first"
             )));
         };
-        let Some(unit) = self.stream.unit(i) else {
-            return Ok(false);
-        };
-        let first = self.tree.triangles.len();
-        let header = self.stream.header();
-        let children = self.units.decode_unit(
-            &mut self.tree,
-            header,
-            &self.params,
-            root,
-            unit.bytes,
-            unit.start,
-        )?;
-        let expected = self.child_count[i];
-        if children.len() != expected {
-            return Err(Error::malformed(
-                i + 1,
-                unit.start,
-                format!(
-                    "unit {i} opens {} meta-nodes, the index lists {expected} under it",
-                    children.len()
-                ),
-            ));
+        let mark = self.tree.mark();
+        let decoded = self
+            .units
+            .decode_unit(
+                &mut self.tree,
+                &self.header,
+                &self.params,
+                root,
+                bytes,
+                start,
+            )
+            .and_then(|children| {
+                let expected = self.unit_children[i].len();
+                if children.len() != expected {
+                    return Err(Error::malformed(
+                        i + 1,
+                        start,
+                        format!(
+                            "unit {i} opens {} meta-nodes, the index lists {expected} under it",
+                            children.len()
+                        ),
+                    ));
+                }
+                let unit = DecodedUnit {
+                    tree: &self.tree,
+                    root,
+                    since: mark,
+                    child_units: self.unit_children[i]
+                        .iter()
+                        .map(|&j| (j, children[self.rank[j]]))
+                        .collect(),
+                };
+                check(&unit).map(|checked| (checked, children))
+            });
+        match decoded {
+            Ok((checked, children)) => {
+                self.child_roots[i] = Some(children);
+                self.unit_triangles[i] = Some(mark.triangles..self.tree.triangles.len());
+                Ok(checked)
+            }
+            Err(e) => {
+                self.tree.roll_back(mark);
+                Err(e)
+            }
         }
-        self.child_roots[i] = Some(children);
-        self.unit_triangles[i] = Some(first..self.tree.triangles.len());
-        Ok(true)
     }
 
     /// Depth of the next unit in stream order, once its parent is decoded.
     fn next_unit_depth(&self) -> Result<Option<u8>> {
         let i = self.units_in_order;
-        if i >= self.stream.index().len() {
+        if i >= self.index.len() {
             return Ok(None);
         }
         match self.unit_root(i)? {
@@ -415,15 +554,15 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
             Some(root) => Ok(Some(self.tree.nodes[root as usize].id.len())),
             None => Err(Error::malformed(
                 i + 1,
-                self.stream.payload_start(),
+                self.payload_start,
                 format!("unit {i} depends on a unit after it"),
             )),
         }
     }
 
     fn check_complete(&self) -> Result<()> {
-        let at = self.stream.payload_start();
-        let header = self.stream.header();
+        let at = self.payload_start;
+        let header = &self.header;
         if self.child_roots.iter().any(Option::is_none) {
             return Err(Error::malformed(
                 0,
@@ -481,7 +620,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
 
 impl<U: UnitDecoder> LevelDecoder for CameDecoder<'_, U> {
     fn header(&self) -> &Header {
-        self.stream.header()
+        &self.header
     }
 
     fn levels(&self) -> usize {
@@ -516,10 +655,10 @@ impl<U: UnitDecoder> LevelDecoder for CameDecoder<'_, U> {
     }
 
     fn mesh(&self) -> Result<LevelMesh> {
-        let grid = self.stream.header().grid;
+        let grid = &self.header.grid;
         let mesh = self
             .tree
-            .mesh_at(self.levels_decoded as u8, |p| to_world(&grid, p))?;
+            .mesh_at(self.levels_decoded as u8, |p| to_world(grid, p))?;
         Ok(LevelMesh {
             mesh,
             loose_edges: Vec::new(),

@@ -1,9 +1,12 @@
-//! The view-dependent mesh: the front of a decoded CAME hierarchy, split and collapsed to a
-//! view, with the triangles it holds.
+//! The view-dependent mesh: the front of a CAME hierarchy, split and collapsed to a view, with
+//! the triangles it holds — over the meta-nodes loaded so far, asking for the others as the
+//! view needs them.
 //!
 //! Invariants ([`ViewMesh::check_invariants`], after every step in the tests):
 //! - the active nodes form a cut: the root is split or active, a split node's children are
 //!   active or split, an active or below node's children are below;
+//! - only nodes whose split is loaded are split (a node whose meta-node is not loaded, or was
+//!   refused, stays on the front or under it);
 //! - a triangle is present exactly when the node it is born at is split, and its corners are
 //!   then the active nodes on its corners' leaf paths (distinct, since two corners part at its
 //!   birth node and the third at an ancestor of it);
@@ -11,18 +14,17 @@
 //!   depend on it;
 //! - each active node lists exactly the present triangles with a corner at it.
 //!
-//! Refining everything gives the full decode's triangles on the full decode's vertices.
+//! Loading everything and refining everything gives the full decode's triangles on the full
+//! decode's vertices.
 
+use super::loader::{ByteSource, Dependency, Fetch, Loaded, Loader, SeekSource, UnitDelta, NONE};
 use super::view::View;
-use crate::codecs::came::decoded::{to_world, DecodedTree};
-use crate::container::Header;
 use crate::error::{Error, Result};
 use crate::hierarchy::came::NodeId;
 use crate::mesh::TriMesh;
 use glam::DVec3;
 use smallvec::SmallVec;
-
-const NONE: u32 = u32::MAX;
+use std::path::Path;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum State {
@@ -32,6 +34,29 @@ enum State {
     Active,
     /// Above the front.
     Split,
+}
+
+/// Where a meta-node stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum UnitState {
+    /// Not asked for.
+    Idle,
+    /// Asked for, not arrived.
+    Requested,
+    Loaded,
+    /// Corrupt or cut: its branch stays as coarse as its parent unit leaves it.
+    Refused,
+}
+
+/// Whether an active node can be split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ready {
+    Now,
+    /// Its meta-node is on its way.
+    Waiting,
+    /// A leaf, or a split the stream cannot make (a refused meta-node, a dependency on a
+    /// vertex or a cycle of dependencies).
+    Never,
 }
 
 /// Limits of one [`ViewMesh::adapt`].
@@ -58,12 +83,49 @@ pub struct Adapted {
     pub collapses: usize,
     /// Passes over the active nodes.
     pub passes: usize,
+    /// Meta-nodes that arrived and were taken in at the start of the call.
+    pub loaded: usize,
+    /// Splits the view wanted that wait for a meta-node (asked for; a later call makes them).
+    pub waiting: usize,
+    /// Splits the view wanted that the stream cannot make (a refused meta-node's branch).
+    pub blocked: usize,
     /// Whether the face budget held back a split the view wanted (the tolerance is raised for
     /// the next call).
     pub capped: bool,
-    /// Whether the front is settled for this view: a pass found nothing more to do and
-    /// nothing was held back.
+    /// Whether the front is settled for this view: a pass found nothing more to do, nothing
+    /// was held back and nothing waits for a meta-node.
     pub settled: bool,
+}
+
+impl Adapted {
+    /// `self` followed by `next`.
+    fn then(self, next: Adapted) -> Adapted {
+        Adapted {
+            splits: self.splits + next.splits,
+            collapses: self.collapses + next.collapses,
+            passes: self.passes + next.passes,
+            loaded: self.loaded + next.loaded,
+            waiting: next.waiting,
+            blocked: next.blocked,
+            capped: next.capped,
+            settled: next.settled,
+        }
+    }
+}
+
+/// What has been fetched of the stream.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fetched {
+    /// Meta-nodes decoded and taken in.
+    pub units_loaded: usize,
+    /// Meta-nodes refused (corrupt or cut).
+    pub units_refused: usize,
+    /// Meta-nodes of the stream.
+    pub units: usize,
+    /// Bytes read from the source (header and index included).
+    pub bytes_read: u64,
+    /// The stream's bytes, as its header and index give them.
+    pub stream_bytes: u64,
 }
 
 /// A hit of [`ViewMesh::pick`].
@@ -79,11 +141,13 @@ pub struct Pick {
 
 /// The front of a hierarchy and the triangles it holds.
 pub struct ViewMesh {
-    // Per node, in the decoded tree's numbering.
+    // Per node, in the loader's decoding order.
     ids: Vec<NodeId>,
     parent: Vec<u32>,
-    /// Children, `[NONE; 2]` for leaves.
+    /// Children, `[NONE; 2]` for leaves and nodes whose split is not loaded.
     children: Vec<[u32; 2]>,
+    /// The meta-node that splits the node, while it is not loaded (else `NONE`).
+    opens: Vec<u32>,
     /// Position and error-sphere radius, in world units.
     center: Vec<DVec3>,
     radius: Vec<f64>,
@@ -91,7 +155,7 @@ pub struct ViewMesh {
     /// Triangles born at the node's split.
     born: Vec<SmallVec<[u32; 2]>>,
     /// Nodes whose splits the node's split needs.
-    depends_on: Vec<SmallVec<[u32; 2]>>,
+    depends_on: Vec<SmallVec<[Dependency; 2]>>,
     /// Split nodes depending on the node.
     split_dependants: Vec<u32>,
     /// Present triangles with a corner at the node (active nodes only).
@@ -110,97 +174,77 @@ pub struct ViewMesh {
     scale: f64,
     /// The active nodes a pass visits (kept to save allocating one a pass).
     pass: Vec<u32>,
+    /// Splits planned by a forced split, in order, and each node's mark of being planned.
+    plan: Vec<u32>,
+    planned: Vec<bool>,
+    // Meta-nodes.
+    loader: Loader,
+    units: Vec<UnitState>,
+    /// Asked for and not arrived.
+    outstanding: usize,
+    refusals: Vec<(usize, String)>,
+    bytes_read: u64,
+    stream_bytes: u64,
 }
 
 impl ViewMesh {
-    /// The front at the root of a completely decoded `tree` of the stream with `header`.
-    pub fn new(tree: &DecodedTree, header: &Header) -> Result<ViewMesh> {
-        let bad = |what: &str| Error::malformed(0, 0, what.to_string());
-        let n = tree.nodes.len();
-        if n == 0 {
-            return Err(bad("the hierarchy has no root"));
-        }
-        let grid = header.grid;
-        let cell = grid.cell.iter().fold(0.0f64, |m, &c| m.max(c.abs()));
-        let mut parent = vec![NONE; n];
-        let mut children = vec![[NONE; 2]; n];
-        for (i, node) in tree.nodes.iter().enumerate() {
-            match (node.leaf, node.children) {
-                (false, Some(c)) => {
-                    children[i] = c;
-                    for x in c {
-                        parent[x as usize] = i as u32;
-                    }
-                }
-                (true, None) => {}
-                _ => return Err(bad("the hierarchy is not completely decoded")),
-            }
-        }
-        let mut born: Vec<SmallVec<[u32; 2]>> = vec![SmallVec::new(); n];
-        let mut leaf_corners = Vec::with_capacity(tree.triangles.len());
-        for (t, triangle) in tree.triangles.iter().enumerate() {
-            let c = triangle.corners;
-            // Two corners part at the birth node, the third higher up.
-            let birth_len = c[0]
-                .common_len(c[1])
-                .max(c[1].common_len(c[2]))
-                .max(c[0].common_len(c[2]));
-            let birth = (0..3)
-                .map(|k| c[k].ancestor(birth_len))
-                .find(|b| b.len() == triangle.birth_depth)
-                .and_then(|b| tree.get(b))
-                .ok_or_else(|| bad("a triangle's corners do not part at its split"))?;
-            born[birth as usize].push(t as u32);
-            leaf_corners.push(c);
-        }
-        let mut depends_on: Vec<SmallVec<[u32; 2]>> = vec![SmallVec::new(); n];
-        for i in 0..tree.dependencies.len() {
-            let (s, deps) = tree.dependencies_of(i);
-            let s = tree.get(s).ok_or_else(|| bad("a dependency of no node"))?;
-            for &d in deps {
-                let d = tree
-                    .get(d)
-                    .filter(|&d| children[d as usize][0] != NONE)
-                    .ok_or_else(|| bad("a dependency on no split of the hierarchy"))?;
-                depends_on[s as usize].push(d);
-            }
-        }
-        let mut state = vec![State::Below; n];
-        state[0] = State::Active;
-        let mut active_slot = vec![NONE; n];
-        active_slot[0] = 0;
-        let triangles = tree.triangles.len();
-        Ok(ViewMesh {
-            ids: tree.nodes.iter().map(|n| n.id).collect(),
-            parent,
-            children,
-            center: tree
-                .nodes
-                .iter()
-                .map(|n| to_world(&grid, n.position))
-                .collect(),
-            radius: tree.nodes.iter().map(|n| n.radius * cell).collect(),
-            state,
-            born,
-            depends_on,
-            split_dependants: vec![0; n],
-            faces_at: vec![SmallVec::new(); n],
-            active: vec![0],
-            active_slot,
-            leaf_corners,
-            corners: vec![[NONE; 3]; triangles],
-            present: vec![false; triangles],
+    /// The front at the root of the stream in `source`, having read its header, its index and
+    /// its first meta-node only; the others are fetched as views need them.
+    pub fn open(source: impl ByteSource + 'static, fetch: Fetch) -> Result<ViewMesh> {
+        let (loader, opened) = Loader::open(Box::new(source), fetch)?;
+        let mut units = vec![UnitState::Idle; opened.index.len()];
+        units[0] = UnitState::Requested;
+        let mut vm = ViewMesh {
+            ids: Vec::new(),
+            parent: Vec::new(),
+            children: Vec::new(),
+            opens: Vec::new(),
+            center: Vec::new(),
+            radius: Vec::new(),
+            state: Vec::new(),
+            born: Vec::new(),
+            depends_on: Vec::new(),
+            split_dependants: Vec::new(),
+            faces_at: Vec::new(),
+            active: Vec::new(),
+            active_slot: Vec::new(),
+            leaf_corners: Vec::new(),
+            corners: Vec::new(),
+            present: Vec::new(),
             faces: 0,
             cursor: 0,
             scale: 1.0,
             pass: Vec::new(),
-        })
+            plan: Vec::new(),
+            planned: Vec::new(),
+            loader,
+            units,
+            outstanding: 1,
+            refusals: Vec::new(),
+            bytes_read: opened.head_bytes,
+            stream_bytes: opened.stream_bytes,
+        };
+        let root = opened.root;
+        if let Err(e) = &root.outcome {
+            return Err(Error::malformed(1, 0, format!("the root meta-node: {e}")));
+        }
+        vm.take_in(root);
+        vm.state[0] = State::Active;
+        vm.active_slot[0] = 0;
+        vm.active.push(0);
+        Ok(vm)
     }
 
-    /// The front of a whole CAME stream (either codec), at its root.
+    /// The front of the stream in file `path`, its meta-nodes read by a loader thread.
+    pub fn open_file(path: &Path) -> Result<ViewMesh> {
+        let file = std::fs::File::open(path)?;
+        ViewMesh::open(SeekSource(std::io::BufReader::new(file)), Fetch::Background)
+    }
+
+    /// The front of a stream (or prefix) in memory, meta-nodes decoded inline as they are
+    /// needed.
     pub fn from_stream(bytes: &[u8]) -> Result<ViewMesh> {
-        let (header, tree) = crate::codecs::came::decode_tree(bytes)?;
-        ViewMesh::new(&tree, &header)
+        ViewMesh::open(bytes.to_vec(), Fetch::Inline)
     }
 
     /// Faces present.
@@ -218,8 +262,92 @@ impl ViewMesh {
         self.scale
     }
 
-    fn is_inner(&self, v: u32) -> bool {
-        self.children[v as usize][0] != NONE
+    /// What has been fetched so far.
+    pub fn fetched(&self) -> Fetched {
+        Fetched {
+            units_loaded: self
+                .units
+                .iter()
+                .filter(|&&u| u == UnitState::Loaded)
+                .count(),
+            units_refused: self.refusals.len(),
+            units: self.units.len(),
+            bytes_read: self.bytes_read,
+            stream_bytes: self.stream_bytes,
+        }
+    }
+
+    /// The meta-nodes refused, and why.
+    pub fn refusals(&self) -> &[(usize, String)] {
+        &self.refusals
+    }
+
+    /// Takes in a fetched meta-node: its nodes, triangles and dependencies join the hierarchy
+    /// (under the front: nothing present changes).
+    fn take_in(&mut self, loaded: Loaded) {
+        self.outstanding -= 1;
+        self.bytes_read += loaded.bytes;
+        match loaded.outcome {
+            Ok(delta) => {
+                self.units[loaded.unit] = UnitState::Loaded;
+                self.grow(delta);
+            }
+            Err(e) => {
+                self.units[loaded.unit] = UnitState::Refused;
+                self.refusals.push((loaded.unit, e.to_string()));
+            }
+        }
+    }
+
+    fn grow(&mut self, delta: UnitDelta) {
+        for n in delta.nodes {
+            let v = self.ids.len() as u32;
+            if n.parent != NONE {
+                let p = n.parent as usize;
+                self.children[p][n.id.bit(n.id.len() - 1) as usize] = v;
+                self.opens[p] = NONE;
+            }
+            self.ids.push(n.id);
+            self.parent.push(n.parent);
+            self.children.push([NONE; 2]);
+            self.opens.push(NONE);
+            self.center.push(n.center);
+            self.radius.push(n.radius);
+            self.state.push(State::Below);
+            self.born.push(SmallVec::new());
+            self.depends_on.push(SmallVec::new());
+            self.split_dependants.push(0);
+            self.faces_at.push(SmallVec::new());
+            self.active_slot.push(NONE);
+            self.planned.push(false);
+        }
+        for (birth, corners) in delta.triangles {
+            self.born[birth as usize].push(self.leaf_corners.len() as u32);
+            self.leaf_corners.push(corners);
+            self.corners.push([NONE; 3]);
+            self.present.push(false);
+        }
+        for (s, deps) in delta.splits {
+            self.depends_on[s as usize] = deps;
+        }
+        for (unit, root) in delta.opens {
+            self.opens[root as usize] = unit as u32;
+        }
+    }
+
+    /// Takes in the meta-nodes that have arrived (all those asked for when `block`).
+    fn take_arrivals(&mut self, block: bool) -> usize {
+        let arrived = self.loader.collect(self.outstanding, block);
+        let count = arrived.len();
+        for loaded in arrived {
+            self.take_in(loaded);
+        }
+        count
+    }
+
+    /// Waits until every meta-node asked for has arrived, and takes them in.
+    pub fn wait_for_units(&mut self) -> usize {
+        self.take_arrivals(true)
     }
 
     fn activate(&mut self, v: u32) {
@@ -238,17 +366,104 @@ impl ViewMesh {
         self.active_slot[v as usize] = NONE;
     }
 
-    /// The active node on leaf path `leaf`.
-    fn active_on(&self, leaf: NodeId) -> u32 {
+    /// The active node on leaf path `leaf`; `None` if the path ends at a split node (a
+    /// corrupt stream's corner).
+    fn active_on(&self, leaf: NodeId) -> Option<u32> {
         let mut v = 0u32;
         while self.state[v as usize] == State::Split {
-            let bit = leaf.bit(self.ids[v as usize].len());
-            v = self.children[v as usize][bit as usize];
+            let len = self.ids[v as usize].len();
+            if len >= leaf.len() {
+                return None;
+            }
+            v = self.children[v as usize][leaf.bit(len) as usize];
         }
-        v
+        Some(v)
     }
 
-    /// vsplit of active inner node `s` whose dependencies are split.
+    /// Whether active node `v` can be split now; asks for its meta-node if that is missing.
+    fn ready(&mut self, v: u32) -> Ready {
+        let vu = v as usize;
+        if self.children[vu][0] != NONE {
+            return Ready::Now;
+        }
+        let unit = self.opens[vu];
+        if unit == NONE {
+            return Ready::Never;
+        }
+        match self.units[unit as usize] {
+            UnitState::Idle => {
+                self.units[unit as usize] = UnitState::Requested;
+                self.outstanding += 1;
+                self.loader.request(unit as usize);
+                Ready::Waiting
+            }
+            UnitState::Requested => Ready::Waiting,
+            UnitState::Loaded | UnitState::Refused => Ready::Never,
+        }
+    }
+
+    /// Whether every corner at `s` or born at it has a leaf path reaching below `s`, and every
+    /// third corner of a triangle born at it an active node (always, unless the stream is
+    /// corrupt). Checked right before each split.
+    fn corners_descend(&self, s: u32) -> bool {
+        let su = s as usize;
+        let depth = self.ids[su].len();
+        let own = self.ids[su];
+        let deep = |c: NodeId| c.len() > depth;
+        self.faces_at[su].iter().all(|&f| {
+            (0..3)
+                .all(|k| self.corners[f as usize][k] != s || deep(self.leaf_corners[f as usize][k]))
+        }) && self.born[su].iter().all(|&f| {
+            self.leaf_corners[f as usize].iter().all(|&c| {
+                if own.is_ancestor_of(c) {
+                    deep(c)
+                } else {
+                    self.active_on(c).is_some()
+                }
+            })
+        })
+    }
+
+    /// The deepest loaded node on the path to `id`, and whether it is `id`.
+    fn toward(&self, id: NodeId) -> (u32, bool) {
+        let mut v = 0u32;
+        loop {
+            let len = self.ids[v as usize].len();
+            if len >= id.len() {
+                return (v, self.ids[v as usize] == id);
+            }
+            match self.children[v as usize][id.bit(len) as usize] {
+                NONE => return (v, false),
+                c => v = c,
+            }
+        }
+    }
+
+    /// A node to split before `v` may be: its first dependency not split (or planned to be),
+    /// or the deepest loaded node on the way to one not loaded yet.
+    fn unmet_dependency(&mut self, v: u32) -> Option<u32> {
+        for k in 0..self.depends_on[v as usize].len() {
+            let dep = self.depends_on[v as usize][k];
+            let node = if dep.node != NONE {
+                dep.node
+            } else {
+                match self.toward(dep.id) {
+                    (x, true) => {
+                        self.depends_on[v as usize][k].node = x;
+                        x
+                    }
+                    (x, false) => return Some(x),
+                }
+            };
+            if self.planned_state(node) != State::Split {
+                return Some(node);
+            }
+        }
+        None
+    }
+
+    /// vsplit of active inner node `s` whose dependencies are split ([`Self::corners_descend`]
+    /// holding).
     fn split(&mut self, s: u32) {
         let su = s as usize;
         let [t, u] = self.children[su];
@@ -274,7 +489,7 @@ impl ViewMesh {
                 if own.is_ancestor_of(c) {
                     self.children[su][c.bit(depth) as usize]
                 } else {
-                    self.active_on(c)
+                    self.active_on(c).expect("checked by corners_descend")
                 }
             });
             for &c in &corners {
@@ -285,7 +500,7 @@ impl ViewMesh {
         }
         self.faces += self.born[su].len();
         for &d in &self.depends_on[su] {
-            self.split_dependants[d as usize] += 1;
+            self.split_dependants[d.node as usize] += 1;
         }
     }
 
@@ -327,55 +542,107 @@ impl ViewMesh {
         }
         self.activate(s);
         for &d in &self.depends_on[su] {
-            self.split_dependants[d as usize] -= 1;
+            self.split_dependants[d.node as usize] -= 1;
+        }
+    }
+
+    /// The node's state once the splits planned so far are made.
+    fn planned_state(&self, v: u32) -> State {
+        let vu = v as usize;
+        match self.state[vu] {
+            _ if self.planned[vu] => State::Split,
+            State::Below if self.planned[self.parent[vu] as usize] => State::Active,
+            state => state,
         }
     }
 
     /// Splits active node `s`, and first whatever its dependencies need (Hoppe's forced
-    /// split); returns the splits made, and appends the children it activated to `activated`.
-    fn force_split(&mut self, s: u32, activated: &mut Vec<u32>) -> Result<usize> {
+    /// split), all or nothing: the splits are planned first, and made only if every one can be
+    /// (none waits for a meta-node) — so that a chain cut short is not left half made for the
+    /// next pass to collapse and the one after to make again. Returns the splits made and
+    /// whether it stopped short, and appends the children it activated to `activated`.
+    fn force_split(&mut self, s: u32, activated: &mut Vec<u32>) -> (usize, Ready) {
+        let mut plan = std::mem::take(&mut self.plan);
+        plan.clear();
         let mut stack = vec![s];
-        let mut splits = 0;
-        while let Some(&v) = stack.last() {
+        let outcome = loop {
+            let Some(&v) = stack.last() else {
+                break Ready::Now;
+            };
             if stack.len() > self.ids.len() {
-                return Err(Error::malformed(0, 0, "the dependencies form a cycle"));
+                // The dependencies form a cycle: a corrupt stream.
+                break Ready::Never;
             }
-            match self.state[v as usize] {
+            match self.planned_state(v) {
                 State::Split => {
                     stack.pop();
                 }
                 State::Below => stack.push(self.parent[v as usize]),
-                State::Active => {
-                    let waiting = self.depends_on[v as usize]
-                        .iter()
-                        .copied()
-                        .find(|&d| self.state[d as usize] != State::Split);
-                    match waiting {
+                State::Active => match self.ready(v) {
+                    Ready::Now => match self.unmet_dependency(v) {
                         Some(d) => stack.push(d),
                         None => {
-                            self.split(v);
-                            activated.extend(self.children[v as usize]);
-                            splits += 1;
+                            self.planned[v as usize] = true;
+                            plan.push(v);
                             stack.pop();
                         }
-                    }
+                    },
+                    stop => break stop,
+                },
+            }
+        };
+        for &v in &plan {
+            self.planned[v as usize] = false;
+        }
+        let mut made = 0;
+        let mut outcome = outcome;
+        if outcome == Ready::Now {
+            for &v in &plan {
+                if !self.corners_descend(v) {
+                    outcome = Ready::Never;
+                    break;
                 }
+                self.split(v);
+                activated.extend(self.children[v as usize]);
+                made += 1;
             }
         }
-        Ok(splits)
+        self.plan = plan;
+        (made, outcome)
     }
 
-    /// Adapts the front to `view`: passes over the active nodes, refining each the view wants
-    /// refined down its subtree (dependencies first) and collapsing the parents of the others
-    /// up the tree while the view does not want them, until a pass changes nothing or the
-    /// budget is spent. Errors only on a stream whose dependencies form a cycle.
-    pub fn adapt(&mut self, view: &View, budget: Budget) -> Result<Adapted> {
-        let mut done = Adapted::default();
+    /// Adapts the front to `view` with the meta-nodes at hand: takes in those that have
+    /// arrived, then passes over the active nodes, refining each the view wants refined down
+    /// its subtree (dependencies first) and collapsing the parents of the others up the tree
+    /// while the view does not want them, until a pass changes nothing or the budget is spent.
+    /// Splits that need a meta-node not loaded ask for it and wait.
+    pub fn adapt(&mut self, view: &View, budget: Budget) -> Adapted {
+        let mut done = Adapted {
+            loaded: self.take_arrivals(false),
+            ..Adapted::default()
+        };
         let mut pass = std::mem::take(&mut self.pass);
-        let result = self.adapt_passes(view, budget, &mut done, &mut pass);
+        self.adapt_passes(view, budget, &mut done, &mut pass);
         self.pass = pass;
         self.regulate(budget.faces, done.capped);
-        result.map(|()| done)
+        done
+    }
+
+    /// Adapts to `view` until the front settles, waiting for the meta-nodes it asks for
+    /// (at most `calls` adaptations: a face budget may take several to regulate).
+    pub fn settle(&mut self, view: &View, budget: Budget, calls: usize) -> Adapted {
+        let mut total = Adapted::default();
+        for _ in 0..calls {
+            let done = self.adapt(view, budget);
+            total = total.then(done);
+            if done.settled {
+                break;
+            }
+            if done.waiting > 0 {
+                total.loaded += self.wait_for_units();
+            }
+        }
+        total
     }
 
     fn adapt_passes(
@@ -384,16 +651,18 @@ impl ViewMesh {
         budget: Budget,
         done: &mut Adapted,
         pass: &mut Vec<u32>,
-    ) -> Result<()> {
+    ) {
         let limit = budget.faces.unwrap_or(usize::MAX);
         let wants = |m: &ViewMesh, v: u32| {
             let vu = v as usize;
-            m.is_inner(v) && view.wants_split(m.center[vu], m.radius[vu], m.scale)
+            view.wants_split(m.center[vu], m.radius[vu], m.scale)
         };
         let mut below: Vec<u32> = Vec::new();
         loop {
             let before = *done;
             done.passes += 1;
+            done.waiting = 0;
+            done.blocked = 0;
             let start = self.cursor.min(self.active.len());
             pass.clear();
             pass.extend_from_slice(&self.active[start..]);
@@ -402,12 +671,12 @@ impl ViewMesh {
             for (i, &v) in pass.iter().enumerate() {
                 if done.splits + done.collapses >= budget.operations {
                     self.cursor = (start + i) % pass.len().max(1);
-                    return Ok(());
+                    return;
                 }
                 if self.state[v as usize] != State::Active {
                     continue;
                 }
-                if wants(self, v) {
+                if wants(self, v) && self.ready(v) != Ready::Never {
                     // Down the subtree at once rather than a level a pass.
                     below.clear();
                     below.push(v);
@@ -418,11 +687,25 @@ impl ViewMesh {
                         {
                             continue;
                         }
+                        match self.ready(x) {
+                            Ready::Now => {}
+                            Ready::Waiting => {
+                                done.waiting += 1;
+                                continue;
+                            }
+                            Ready::Never => continue,
+                        }
                         if self.faces >= limit {
                             done.capped = true;
                             continue;
                         }
-                        done.splits += self.force_split(x, &mut below)?;
+                        let (splits, stop) = self.force_split(x, &mut below);
+                        done.splits += splits;
+                        match stop {
+                            Ready::Now => {}
+                            Ready::Waiting => done.waiting += 1,
+                            Ready::Never => done.blocked += 1,
+                        }
                     }
                     continue;
                 }
@@ -439,8 +722,8 @@ impl ViewMesh {
                 }
             }
             if (done.splits, done.collapses) == (before.splits, before.collapses) {
-                done.settled = !done.capped;
-                return Ok(());
+                done.settled = !done.capped && done.waiting == 0;
+                return;
             }
         }
     }
@@ -457,6 +740,12 @@ impl ViewMesh {
         } else if (self.faces as f64) < 0.8 * target as f64 {
             self.scale = (self.scale / 1.25).max(1.0);
         }
+    }
+
+    /// Where the vertex with leaf path `leaf` stands in the adapted mesh: the position of the
+    /// active node on its path (`None` if the path leaves the hierarchy above the front).
+    pub fn position_of(&self, leaf: NodeId) -> Option<DVec3> {
+        self.active_on(leaf).map(|v| self.center[v as usize])
     }
 
     /// The adapted mesh: the active nodes' positions, the present triangles.
@@ -526,16 +815,19 @@ impl ViewMesh {
             if st == State::Split {
                 if let Some(d) = self.depends_on[v]
                     .iter()
-                    .find(|&&d| self.state[d as usize] != State::Split)
+                    .find(|d| d.node == NONE || self.state[d.node as usize] != State::Split)
                 {
-                    return Err(format!("split node {v} depends on {d}, which is not split"));
+                    return Err(format!(
+                        "split node {v} depends on {:?}, which is not split",
+                        d.id
+                    ));
                 }
             }
         }
         let mut dependants = vec![0u32; n];
         for v in (0..n).filter(|&v| self.state[v] == State::Split) {
-            for &d in &self.depends_on[v] {
-                dependants[d as usize] += 1;
+            for d in &self.depends_on[v] {
+                dependants[d.node as usize] += 1;
             }
         }
         if dependants != self.split_dependants {
@@ -607,6 +899,7 @@ mod tests {
     use super::super::view::Camera;
     use super::*;
     use crate::codecs::{self, EncodeOptions, Stop};
+    use crate::container::read_header_and_index;
     use crate::mesh::generate;
     use crate::mesh::quantize::GridShape;
     use proptest::prelude::*;
@@ -661,14 +954,22 @@ mod tests {
     fn refining_everything_gives_the_full_decode_and_coarsening_everything_the_root() {
         let mut vm = ViewMesh::from_stream(stream()).unwrap();
         vm.check_invariants().unwrap();
-        let done = vm.adapt(&View::everything(), Budget::UNLIMITED).unwrap();
+        assert_eq!(
+            vm.fetched().units_loaded,
+            1,
+            "only the root meta-node at first"
+        );
+        let done = vm.settle(&View::everything(), Budget::UNLIMITED, 64);
         assert!(done.settled && done.collapses == 0);
+        let fetched = vm.fetched();
+        assert_eq!(fetched.units_loaded, fetched.units);
+        assert_eq!(fetched.bytes_read, stream().len() as u64);
         vm.check_invariants().unwrap();
         let (full, _) = codecs::decode(stream(), Stop::All).unwrap();
         let adapted = vm.mesh();
         assert_eq!(adapted.vertex_count(), full.mesh.vertex_count());
         assert_eq!(triangles(&adapted), triangles(&full.mesh));
-        let done = vm.adapt(&View::nothing(), Budget::UNLIMITED).unwrap();
+        let done = vm.adapt(&View::nothing(), Budget::UNLIMITED);
         assert_eq!(
             (done.splits, done.collapses),
             (0, full.mesh.vertex_count() - 1)
@@ -696,11 +997,11 @@ mod tests {
     fn a_near_view_refines_what_it_sees_and_not_what_is_behind() {
         let mut vm = ViewMesh::from_stream(stream()).unwrap();
         let view = View::new(&camera(DVec3::new(0.5, 0.8, 6.0)), 1.0).unwrap();
-        vm.adapt(&view, Budget::UNLIMITED).unwrap();
+        vm.settle(&view, Budget::UNLIMITED, 64);
         vm.check_invariants().unwrap();
         let near = vm.face_count();
         let far = View::new(&camera(DVec3::new(0.5, 0.8, 60.0)), 1.0).unwrap();
-        let done = vm.adapt(&far, Budget::UNLIMITED).unwrap();
+        let done = vm.settle(&far, Budget::UNLIMITED, 64);
         vm.check_invariants().unwrap();
         assert!(
             done.collapses > 0 && vm.face_count() < near,
@@ -713,7 +1014,7 @@ mod tests {
     fn an_operation_budget_spreads_the_work_over_calls_and_ends_where_one_call_does() {
         let view = View::new(&camera(DVec3::new(1.0, 1.0, 5.0)), 0.5).unwrap();
         let mut whole = ViewMesh::from_stream(stream()).unwrap();
-        whole.adapt(&view, Budget::UNLIMITED).unwrap();
+        whole.settle(&view, Budget::UNLIMITED, 64);
         let mut stepped = ViewMesh::from_stream(stream()).unwrap();
         let budget = Budget {
             operations: 50,
@@ -721,7 +1022,7 @@ mod tests {
         };
         let mut calls = 0;
         loop {
-            let done = stepped.adapt(&view, budget).unwrap();
+            let done = stepped.adapt(&view, budget);
             stepped.check_invariants().unwrap();
             assert!(
                 done.splits + done.collapses <= 50 + 52,
@@ -741,7 +1042,7 @@ mod tests {
     fn a_face_budget_raises_the_tolerance_until_the_front_holds_it() {
         let view = View::new(&camera(DVec3::new(1.0, 1.0, 4.0)), 0.2).unwrap();
         let mut vm = ViewMesh::from_stream(stream()).unwrap();
-        vm.adapt(&view, Budget::UNLIMITED).unwrap();
+        vm.settle(&view, Budget::UNLIMITED, 64);
         let free = vm.face_count();
         let target = free / 4;
         let budget = Budget {
@@ -749,7 +1050,7 @@ mod tests {
             faces: Some(target),
         };
         for _ in 0..40 {
-            vm.adapt(&view, budget).unwrap();
+            vm.adapt(&view, budget);
         }
         vm.check_invariants().unwrap();
         assert!(
@@ -768,12 +1069,111 @@ mod tests {
     #[test]
     fn picking_hits_the_front_where_the_ray_meets_it() {
         let mut vm = ViewMesh::from_stream(stream()).unwrap();
-        vm.adapt(&View::everything(), Budget::UNLIMITED).unwrap();
+        vm.settle(&View::everything(), Budget::UNLIMITED, 64);
         // The unit sphere at the origin (icosphere of radius 1): a ray up the z axis, from the
         // side away from the loose triangle.
         let hit = vm.pick(DVec3::new(0.01, 0.02, -5.0), DVec3::Z).unwrap();
         assert!((hit.distance - 4.0).abs() < 0.05, "{hit:?}");
         assert!(vm.pick(DVec3::new(9.0, 9.0, 9.0), DVec3::Z).is_none());
+    }
+
+    #[test]
+    fn a_view_of_one_part_fetches_only_the_meta_nodes_it_needs() {
+        let mut vm = ViewMesh::from_stream(stream()).unwrap();
+        // The torus, close; the spheres below it out of the frustum.
+        let torus = Camera {
+            eye: DVec3::new(0.0, 2.5, 3.0),
+            target: DVec3::new(0.0, 2.5, 0.0),
+            fov_degrees: 30.0,
+            ..camera(DVec3::Z)
+        };
+        let view = View::new(&torus, 1.0).unwrap();
+        let done = vm.settle(&view, Budget::UNLIMITED, 64);
+        vm.check_invariants().unwrap();
+        let fetched = vm.fetched();
+        assert!(done.settled && done.loaded > 0, "{done:?}");
+        assert!(fetched.units_loaded < fetched.units, "{fetched:?}");
+        assert!(fetched.bytes_read < fetched.stream_bytes, "{fetched:?}");
+    }
+
+    #[test]
+    fn a_loader_thread_over_a_reader_gives_what_inline_loading_gives() {
+        let view = View::new(&camera(DVec3::new(1.0, 1.0, 5.0)), 0.5).unwrap();
+        let mut inline = ViewMesh::from_stream(stream()).unwrap();
+        inline.settle(&view, Budget::UNLIMITED, 64);
+        let reader = SeekSource(std::io::Cursor::new(stream().to_vec()));
+        let mut background = ViewMesh::open(reader, Fetch::Background).unwrap();
+        let done = background.settle(&view, Budget::UNLIMITED, 64);
+        assert!(done.settled, "{done:?}");
+        background.check_invariants().unwrap();
+        assert_eq!(triangles(&background.mesh()), triangles(&inline.mesh()));
+        assert_eq!(background.fetched(), inline.fetched());
+    }
+
+    /// The stream with the unit laid out last in its payload given `length` bytes in the
+    /// index (the payload itself unchanged), and that unit.
+    fn with_last_unit_claiming(length: u64) -> (Vec<u8>, usize) {
+        let (header, mut index, start) = read_header_and_index(stream()).unwrap();
+        let last = (0..index.len())
+            .max_by_key(|&i| index.units[i].offset)
+            .unwrap();
+        index.units[last].length = length;
+        index.payload_bytes = index.units.iter().map(|u| u.length).sum();
+        let mut bytes = Vec::new();
+        header.write(&mut bytes);
+        index.write(&mut bytes);
+        bytes.extend_from_slice(&stream()[start..]);
+        (bytes, last)
+    }
+
+    /// Everything refined over `bytes`: the front must hold every invariant, and the meta-nodes
+    /// refused are returned.
+    fn refine_everything(bytes: &[u8]) -> (ViewMesh, Vec<usize>) {
+        let mut vm = ViewMesh::from_stream(bytes).unwrap();
+        let done = vm.settle(&View::everything(), Budget::UNLIMITED, 64);
+        assert!(done.settled, "{done:?}");
+        vm.check_invariants().unwrap();
+        let refused = vm.refusals().iter().map(|(u, _)| *u).collect();
+        (vm, refused)
+    }
+
+    #[test]
+    fn a_lying_index_is_refused_unread_for_that_branch_alone() {
+        let (full, _) = refine_everything(stream());
+        let (bytes, last) = with_last_unit_claiming(1 << 40);
+        let (vm, refused) = refine_everything(&bytes);
+        assert_eq!(refused, vec![last]);
+        assert!(
+            vm.refusals()[0].1.contains("past the stream's end"),
+            "{:?}",
+            vm.refusals()
+        );
+        let fetched = vm.fetched();
+        assert!(fetched.bytes_read < bytes.len() as u64, "{fetched:?}");
+        assert!(vm.face_count() < full.face_count() && vm.face_count() > full.face_count() / 2);
+    }
+
+    #[test]
+    fn a_cut_or_corrupt_meta_node_is_refused_and_the_rest_refines() {
+        let (full, _) = refine_everything(stream());
+        let reader = crate::container::StreamReader::open(stream()).unwrap();
+        let last = (0..reader.index().len())
+            .max_by_key(|&i| reader.index().units[i].offset)
+            .unwrap();
+        let unit = reader.unit(last).unwrap();
+        // Cut inside the last unit laid out.
+        let cut = &stream()[..unit.start + unit.bytes.len() / 2];
+        let (vm, refused) = refine_everything(cut);
+        assert_eq!(refused, vec![last]);
+        assert!(vm.face_count() < full.face_count());
+        // Its bytes garbled instead.
+        let mut garbled = stream().to_vec();
+        for b in &mut garbled[unit.start..unit.start + unit.bytes.len()] {
+            *b = !*b;
+        }
+        let (vm, refused) = refine_everything(&garbled);
+        assert_eq!(refused, vec![last], "{:?}", vm.refusals());
+        assert!(vm.face_count() < full.face_count());
     }
 
     proptest! {
@@ -793,8 +1193,12 @@ mod tests {
                 }
                 let view = View::new(&camera(eye), tolerance).unwrap();
                 let budget = Budget { operations, faces: None };
-                vm.adapt(&view, budget).unwrap();
+                vm.adapt(&view, budget);
                 prop_assert_eq!(vm.check_invariants(), Ok(()));
+                if operations % 3 == 0 {
+                    vm.wait_for_units();
+                    prop_assert_eq!(vm.check_invariants(), Ok(()));
+                }
             }
         }
     }

@@ -20,7 +20,9 @@
 //! node facing away is refined like one facing the eye.
 
 mod front;
+mod loader;
 mod view;
 
-pub use front::{Adapted, Budget, Pick, ViewMesh};
+pub use front::{Adapted, Budget, Fetched, Pick, ViewMesh};
+pub use loader::{ByteSource, Fetch, SeekSource};
 pub use view::{Camera, View};

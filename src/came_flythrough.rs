@@ -1,0 +1,464 @@
+//! The CAME fly-through: a scripted camera path of [`FRAMES`] views around and into a mesh of
+//! over a million triangles (the large mesh of the CAME tables), its `came` stream read from a
+//! file meta-node by meta-node as the views need them (the loader thread). Per frame: active
+//! faces, splits and collapses, adaptation time, bytes fetched so far, the share of the surface
+//! in view, and the measured screen-space error against the tolerance.
+//!
+//! The measured error of a frame: every vertex of the full mesh inside the view frustum and
+//! the vertex standing for it in the adapted mesh (the active node on its leaf path) are
+//! projected to the screen; the largest distance between the two, in pixels (no occlusion
+//! test: hidden vertices count too).
+//!
+//! Writes results/came/flythrough.{json,csv}, the series as a chart (flythrough.{png,svg}), and
+//! renders of the farthest and nearest frames, adapted and full.
+
+use crate::came_extras::{QUANT_BITS, TABLE_MESHES};
+use crate::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+use crate::codecs::{self, EncodeOptions};
+use crate::error::{Error, Result};
+use crate::mesh::io::{read_mesh, resolve, write_atomically};
+use crate::mesh::quantize::GridShape;
+use crate::mesh::{generate, TriMesh};
+use crate::plot::{Chart, Mark, Series};
+use crate::render::{render_perspective, Perspective};
+use glam::DVec3;
+use plotters::prelude::SeriesLabelPosition;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Views along the path.
+pub const FRAMES: usize = 100;
+/// Frames orbiting the mesh before flying in.
+pub const ORBIT_FRAMES: usize = 40;
+/// Screen-space tolerance τ.
+pub const TOLERANCE_PX: f64 = 1.0;
+/// Viewport and field of view.
+pub const WIDTH: u32 = 1024;
+pub const HEIGHT: u32 = 768;
+pub const FOV_DEGREES: f64 = 45.0;
+/// The command that makes it.
+pub const COMMAND: &str = "cargo run --release --bin experiment -- came-fly";
+
+/// One view of the path.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Frame {
+    pub frame: usize,
+    pub eye: [f64; 3],
+    pub target: [f64; 3],
+    /// Faces and vertices of the adapted mesh.
+    pub faces: usize,
+    pub vertices: usize,
+    pub splits: usize,
+    pub collapses: usize,
+    /// Time in adaptation (splits, collapses, view tests, taking in meta-nodes).
+    pub adapt_ms: f64,
+    /// Time waiting for meta-nodes the view asked for.
+    pub wait_ms: f64,
+    /// Bytes read from the stream's file so far, and meta-nodes decoded.
+    pub bytes_fetched: u64,
+    pub units_loaded: usize,
+    /// Share of the full mesh's surface (by area) inside the view frustum.
+    pub surface_in_view: f64,
+    /// Full-mesh vertices inside the frustum, and the measured screen-space error over them.
+    pub visible_vertices: usize,
+    pub max_error_px: f64,
+    pub mean_error_px: f64,
+}
+
+/// One view from a cold start: what it alone fetches.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ColdView {
+    /// The frame of the path it repeats.
+    pub frame: usize,
+    pub surface_in_view: f64,
+    pub bytes_read: u64,
+    pub units_loaded: usize,
+    /// Bytes read over the stream's bytes.
+    pub share_of_stream: f64,
+}
+
+/// The whole run.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Flythrough {
+    pub command: String,
+    pub mesh: String,
+    pub subdivisions: u32,
+    pub vertices: usize,
+    pub triangles: usize,
+    pub quant_bits: u8,
+    pub stream_bytes: u64,
+    pub units: usize,
+    pub tolerance_px: f64,
+    pub width: u32,
+    pub height: u32,
+    pub fov_degrees: f64,
+    /// Splits plus collapses per second of adaptation over the path.
+    pub operations_per_second: f64,
+    pub frames: Vec<Frame>,
+    /// The frame whose view holds the share of the surface nearest a tenth, from a cold start.
+    pub tenth_of_surface: ColdView,
+}
+
+/// The camera of frame `i`: an orbit at three bounding radii, then a flight (geometric in
+/// distance) to `close` above the surface point `spot`, the target gliding from the centre to it.
+fn camera_at(i: usize, centre: DVec3, radius: f64, spot: DVec3) -> Camera {
+    let lift = 0.3;
+    let orbit = |angle: f64| centre + 3.0 * radius * DVec3::new(angle.sin(), lift, angle.cos()).normalize();
+    let (eye, target) = if i < ORBIT_FRAMES {
+        let angle = std::f64::consts::TAU * i as f64 / ORBIT_FRAMES as f64;
+        (orbit(angle), centre)
+    } else {
+        let t = (i - ORBIT_FRAMES + 1) as f64 / (FRAMES - ORBIT_FRAMES) as f64;
+        let start = orbit(0.0);
+        let away = (start - spot).normalize();
+        let (far, near) = ((start - spot).length(), 0.03 * radius);
+        let distance = far * (near / far).powf(t);
+        let smooth = t * t * (3.0 - 2.0 * t);
+        (spot + away * distance, centre.lerp(spot, smooth))
+    };
+    Camera {
+        eye,
+        target,
+        up: DVec3::Y,
+        fov_degrees: FOV_DEGREES,
+        width: WIDTH,
+        height: HEIGHT,
+    }
+}
+
+/// Pixel position of `p` seen by `camera` (`None` behind the eye).
+fn project(camera: &Camera, p: DVec3) -> Option<(f64, f64)> {
+    let forward = (camera.target - camera.eye).normalize();
+    let right = forward.cross(camera.up).normalize();
+    let up = right.cross(forward);
+    let focal = 0.5 * camera.height as f64 / (camera.fov_degrees.to_radians() / 2.0).tan();
+    let d = p - camera.eye;
+    let z = d.dot(forward);
+    (z > 1e-12).then(|| (d.dot(right) / z * focal, d.dot(up) / z * focal))
+}
+
+/// Share of `mesh`'s area whose triangles' centroids `view` sees.
+fn surface_in_view(mesh: &TriMesh, view: &View) -> f64 {
+    let (mut seen, mut all) = (0.0, 0.0);
+    for f in &mesh.faces {
+        let [a, b, c] = mesh.corners(*f);
+        let area = (b - a).cross(c - a).length();
+        all += area;
+        if view.sees((a + b + c) / 3.0, 0.0) {
+            seen += area;
+        }
+    }
+    if all > 0.0 {
+        seen / all
+    } else {
+        0.0
+    }
+}
+
+/// The largest and mean screen distance between each vertex in view and where it stands in
+/// the adapted mesh, and how many vertices are in view.
+fn measured_error(
+    front: &ViewMesh,
+    leaves: &[(crate::hierarchy::came::NodeId, DVec3)],
+    camera: &Camera,
+    view: &View,
+) -> Result<(f64, f64, usize)> {
+    let (mut max, mut sum, mut count) = (0.0f64, 0.0, 0usize);
+    for &(id, p) in leaves {
+        if !view.sees(p, 0.0) {
+            continue;
+        }
+        let q = front
+            .position_of(id)
+            .ok_or_else(|| Error::mesh("a vertex has no place in the adapted mesh"))?;
+        let error = match (project(camera, p), project(camera, q)) {
+            (Some(a), Some(b)) => ((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt(),
+            // Its stand-in behind the eye: off the screen altogether.
+            _ => f64::INFINITY,
+        };
+        max = max.max(error);
+        sum += error;
+        count += 1;
+    }
+    Ok((max, sum / count.max(1) as f64, count))
+}
+
+/// The stream's path under the system's temporary folder (the stream is rebuilt each run and
+/// not kept: it is 4 MB).
+fn stream_path() -> PathBuf {
+    std::env::temp_dir().join(format!("meshcodec-flythrough-{}.mc", std::process::id()))
+}
+
+/// Runs the fly-through and writes its results under `results/came/`; `log` gets one line per
+/// step and a line every ten frames.
+pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
+    let (name, subdivisions) = TABLE_MESHES[3];
+    let mut mesh = read_mesh(&resolve(name)?)?;
+    for _ in 0..subdivisions {
+        mesh = generate::subdivide(&mesh);
+    }
+    let options = EncodeOptions {
+        quant_bits: QUANT_BITS,
+        grid: GridShape::Cubic,
+    };
+    let canonical = codecs::canonical_for(&mesh, &options)?;
+    let started = Instant::now();
+    let stream = codecs::by_name("came")?.encode(&canonical)?.bytes;
+    log(format!(
+        "{name} x{}: {} triangles, came stream {} bytes in {:.1} s",
+        4u32.pow(subdivisions),
+        canonical.face_count(),
+        stream.len(),
+        started.elapsed().as_secs_f64()
+    ));
+    // The reference: every vertex's leaf path and position, from the whole stream.
+    let (header, tree) = codecs::came::decode_tree(&stream)?;
+    let leaves: Vec<_> = tree
+        .nodes
+        .iter()
+        .filter(|n| n.leaf)
+        .map(|n| (n.id, codecs::came::decoded::to_world(&header.grid, n.position)))
+        .collect();
+    let (full, _) = codecs::decode(&stream, codecs::Stop::All)?;
+    let full = full.mesh;
+    drop(tree);
+    let path = stream_path();
+    std::fs::write(&path, &stream)?;
+    let outcome = fly(results, &path, &full, &leaves, stream.len() as u64, log);
+    let _ = std::fs::remove_file(&path);
+    let mut report = outcome?;
+    report.mesh = name.to_string();
+    report.subdivisions = subdivisions;
+    report.vertices = canonical.vertex_count();
+    report.triangles = canonical.face_count();
+    let out = results.join("came").join("flythrough.json");
+    let json = serde_json::to_string_pretty(&report).map_err(|e| Error::Io(e.into()))?;
+    write_atomically(&out, format!("{json}\n").as_bytes())?;
+    write_atomically(&out.with_extension("csv"), csv(&report).as_bytes())?;
+    Chart::draw_panels(&chart(&report), 2, &results.join("came").join("flythrough"))?;
+    Ok(out)
+}
+
+/// Adapts along the path with the stream read from `path`.
+fn fly(
+    results: &Path,
+    path: &Path,
+    full: &TriMesh,
+    leaves: &[(crate::hierarchy::came::NodeId, DVec3)],
+    stream_bytes: u64,
+    log: &mut dyn FnMut(String),
+) -> Result<Flythrough> {
+    let bounds = crate::mesh::Aabb::around(full.positions.iter().copied())
+        .ok_or_else(|| Error::mesh("an empty mesh"))?;
+    let centre = (bounds.min + bounds.max) / 2.0;
+    let radius = (bounds.max - bounds.min).length() / 2.0;
+    // The spot flown to: the surface point farthest along the path's first direction.
+    let towards = DVec3::new(0.0, 0.3, 1.0).normalize();
+    let spot = full
+        .positions
+        .iter()
+        .copied()
+        .max_by(|a, b| (*a - centre).dot(towards).total_cmp(&(*b - centre).dot(towards)))
+        .ok_or_else(|| Error::mesh("an empty mesh"))?;
+    let mut front = ViewMesh::open_file(path)?;
+    let units = front.fetched().units;
+    let mut frames = Vec::with_capacity(FRAMES);
+    let (mut operations, mut adapting) = (0usize, 0.0f64);
+    for i in 0..FRAMES {
+        let camera = camera_at(i, centre, radius, spot);
+        let view = View::new(&camera, TOLERANCE_PX)?;
+        let (mut splits, mut collapses, mut adapt_s, mut wait_s) = (0, 0, 0.0, 0.0);
+        // Adapt, wait for the meta-nodes asked for, adapt again, until the front settles.
+        for _ in 0..256 {
+            let started = Instant::now();
+            let done = front.adapt(&view, Budget::UNLIMITED);
+            adapt_s += started.elapsed().as_secs_f64();
+            splits += done.splits;
+            collapses += done.collapses;
+            if done.settled {
+                break;
+            }
+            let started = Instant::now();
+            front.wait_for_units();
+            wait_s += started.elapsed().as_secs_f64();
+        }
+        operations += splits + collapses;
+        adapting += adapt_s;
+        let (max_error_px, mean_error_px, visible_vertices) =
+            measured_error(&front, leaves, &camera, &view)?;
+        let fetched = front.fetched();
+        let frame = Frame {
+            frame: i,
+            eye: camera.eye.to_array(),
+            target: camera.target.to_array(),
+            faces: front.face_count(),
+            vertices: front.vertex_count(),
+            splits,
+            collapses,
+            adapt_ms: adapt_s * 1e3,
+            wait_ms: wait_s * 1e3,
+            bytes_fetched: fetched.bytes_read,
+            units_loaded: fetched.units_loaded,
+            surface_in_view: surface_in_view(full, &view),
+            visible_vertices,
+            max_error_px,
+            mean_error_px,
+        };
+        if i % 10 == 0 || i + 1 == FRAMES {
+            log(format!(
+                "frame {i}: {} faces, {} splits, {} collapses, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
+                frame.faces,
+                splits,
+                collapses,
+                frame.adapt_ms,
+                100.0 * fetched.bytes_read as f64 / stream_bytes as f64,
+                max_error_px,
+                mean_error_px,
+                visible_vertices
+            ));
+        }
+        if i == 0 || i + 1 == FRAMES {
+            let which = if i == 0 { "far" } else { "near" };
+            let perspective = Perspective {
+                eye: camera.eye,
+                target: camera.target,
+                up: camera.up,
+                fov_degrees: camera.fov_degrees,
+            };
+            let folder = results.join("came");
+            render_perspective(&front.mesh(), &perspective, WIDTH, HEIGHT)
+                .save_png(&folder.join(format!("flythrough-{which}.png")))?;
+            render_perspective(full, &perspective, WIDTH, HEIGHT)
+                .save_png(&folder.join(format!("flythrough-{which}-full.png")))?;
+        }
+        frames.push(frame);
+    }
+    drop(front);
+    // The view nearest a tenth of the surface, alone from a cold start.
+    let tenth = frames
+        .iter()
+        .min_by(|a, b| {
+            (a.surface_in_view - 0.1)
+                .abs()
+                .total_cmp(&(b.surface_in_view - 0.1).abs())
+        })
+        .ok_or_else(|| Error::mesh("no frames"))?;
+    let camera = camera_at(tenth.frame, centre, radius, spot);
+    let mut cold = ViewMesh::open_file(path)?;
+    cold.settle(&View::new(&camera, TOLERANCE_PX)?, Budget::UNLIMITED, 256);
+    let fetched = cold.fetched();
+    let tenth_of_surface = ColdView {
+        frame: tenth.frame,
+        surface_in_view: tenth.surface_in_view,
+        bytes_read: fetched.bytes_read,
+        units_loaded: fetched.units_loaded,
+        share_of_stream: fetched.bytes_read as f64 / stream_bytes as f64,
+    };
+    log(format!(
+        "frame {} alone ({:.1}% of the surface in view): {} bytes, {:.1}% of the stream",
+        tenth.frame,
+        100.0 * tenth.surface_in_view,
+        fetched.bytes_read,
+        100.0 * tenth_of_surface.share_of_stream
+    ));
+    Ok(Flythrough {
+        command: COMMAND.to_string(),
+        mesh: String::new(),
+        subdivisions: 0,
+        vertices: 0,
+        triangles: full.face_count(),
+        quant_bits: QUANT_BITS,
+        stream_bytes,
+        units,
+        tolerance_px: TOLERANCE_PX,
+        width: WIDTH,
+        height: HEIGHT,
+        fov_degrees: FOV_DEGREES,
+        operations_per_second: operations as f64 / adapting.max(1e-9),
+        frames,
+        tenth_of_surface,
+    })
+}
+
+fn csv(report: &Flythrough) -> String {
+    let mut out = String::from(
+        "frame,faces,vertices,splits,collapses,adapt_ms,wait_ms,bytes_fetched,units_loaded,surface_in_view,visible_vertices,max_error_px,mean_error_px\n",
+    );
+    for f in &report.frames {
+        out += &format!(
+            "{},{},{},{},{},{:.3},{:.3},{},{},{:.5},{},{:.4},{:.4}\n",
+            f.frame,
+            f.faces,
+            f.vertices,
+            f.splits,
+            f.collapses,
+            f.adapt_ms,
+            f.wait_ms,
+            f.bytes_fetched,
+            f.units_loaded,
+            f.surface_in_view,
+            f.visible_vertices,
+            f.max_error_px,
+            f.mean_error_px
+        );
+    }
+    out
+}
+
+/// The series against the frame: faces; operations; adaptation time; bytes fetched; the
+/// measured error with the tolerance.
+pub fn chart(report: &Flythrough) -> Vec<Chart> {
+    let series = |label: &str, y: &dyn Fn(&Frame) -> f64| Series {
+        label: label.to_string(),
+        points: report.frames.iter().map(|f| (f.frame as f64, y(f))).collect(),
+        mark: Mark::Line,
+    };
+    let panel = |title: &str, y_desc: &str, series: Vec<Series>| Chart {
+        title: title.to_string(),
+        x_desc: format!(
+            "frame (orbit to {}, then flying in)",
+            ORBIT_FRAMES - 1
+        ),
+        y_desc: y_desc.to_string(),
+        x_log: false,
+        y_log: false,
+        series,
+        legend: SeriesLabelPosition::UpperLeft,
+    };
+    vec![
+        panel(
+            "Adapted mesh",
+            "faces",
+            vec![series("active faces", &|f| f.faces as f64)],
+        ),
+        panel(
+            "Work per frame",
+            "operations / ms",
+            vec![
+                series("splits", &|f| f.splits as f64),
+                series("collapses", &|f| f.collapses as f64),
+                series("adapt time (ms)", &|f| f.adapt_ms),
+            ],
+        ),
+        panel(
+            "Stream fetched",
+            "% of the stream's bytes",
+            vec![
+                series("bytes fetched so far", &|f| {
+                    100.0 * f.bytes_fetched as f64 / report.stream_bytes as f64
+                }),
+                series("surface in view", &|f| 100.0 * f.surface_in_view),
+            ],
+        ),
+        panel(
+            "Measured screen-space error",
+            "pixels",
+            vec![
+                series("largest", &|f| f.max_error_px),
+                series("mean", &|f| f.mean_error_px),
+                series("tolerance", &|_| report.tolerance_px),
+            ],
+        ),
+    ]
+}

@@ -1,0 +1,380 @@
+//! Meta-nodes fetched on demand: where a stream's bytes come from, and the loader that reads a
+//! unit by its byte range and decodes it — on a thread of its own, or inline at the next
+//! adaptation — handing the view-dependent mesh only what the unit added.
+//!
+//! Allocation follows what arrives, never what the index claims: a unit is read with the
+//! source's length as its bound (a unit said to lie past the source's end is refused unread),
+//! and the decoded tree grows unit by unit.
+
+use crate::codecs::came::decoded::{to_world, CameDecoder, DecodedTree, DecodedUnit, UnitDecoder};
+use crate::codecs::came::{modelled, paper};
+use crate::container::{read_header_and_index, Header, Index};
+use crate::error::{Error, Result};
+use crate::hierarchy::came::NodeId;
+use glam::DVec3;
+use smallvec::SmallVec;
+use std::collections::VecDeque;
+use std::io::{Read, Seek, SeekFrom};
+use std::sync::mpsc;
+
+pub(super) const NONE: u32 = u32::MAX;
+
+/// Where a stream's bytes come from: a file, any `Read + Seek`, or bytes already fetched.
+pub trait ByteSource: Send {
+    /// Up to `len` bytes from offset `start`; fewer only where the source ends.
+    fn read_at(&mut self, start: u64, len: u64) -> std::io::Result<Vec<u8>>;
+    /// The source's length in bytes, when it is known.
+    fn size(&mut self) -> Option<u64>;
+}
+
+/// Any seekable reader (a file, a cursor) as a [`ByteSource`].
+pub struct SeekSource<R>(pub R);
+
+impl<R: Read + Seek + Send> ByteSource for SeekSource<R> {
+    fn read_at(&mut self, start: u64, len: u64) -> std::io::Result<Vec<u8>> {
+        self.0.seek(SeekFrom::Start(start))?;
+        let mut bytes = Vec::new();
+        (&mut self.0).take(len).read_to_end(&mut bytes)?;
+        Ok(bytes)
+    }
+
+    fn size(&mut self) -> Option<u64> {
+        self.0.seek(SeekFrom::End(0)).ok()
+    }
+}
+
+/// Bytes already fetched: a whole stream, or a prefix of one.
+impl ByteSource for Vec<u8> {
+    fn read_at(&mut self, start: u64, len: u64) -> std::io::Result<Vec<u8>> {
+        let from = (start.min(self.len() as u64)) as usize;
+        let to = (start.saturating_add(len).min(self.len() as u64)) as usize;
+        Ok(self[from..to].to_vec())
+    }
+
+    fn size(&mut self) -> Option<u64> {
+        Some(self.len() as u64)
+    }
+}
+
+/// How units are fetched.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fetch {
+    /// A loader thread reads and decodes the units asked for while the caller goes on; an
+    /// adaptation uses those that have arrived.
+    Background,
+    /// The units one adaptation asks for are read and decoded at the start of the next, on
+    /// the caller's thread (deterministic: for tests and fuzzing).
+    Inline,
+}
+
+/// A node a unit added.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct NewNode {
+    pub id: NodeId,
+    /// `NONE` for the root.
+    pub parent: u32,
+    /// Position and error-sphere radius in world units.
+    pub center: DVec3,
+    pub radius: f64,
+}
+
+/// A split's dependency: the node, once it is decoded (`NONE` before).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Dependency {
+    pub id: NodeId,
+    pub node: u32,
+}
+
+/// What one unit added to the hierarchy, numbered as the loader's tree numbers it (which the
+/// view-dependent mesh follows by taking the units in the order they were decoded).
+#[derive(Debug, Default)]
+pub(super) struct UnitDelta {
+    pub nodes: Vec<NewNode>,
+    /// Per triangle: the node whose split creates it, and its corners' leaf paths.
+    pub triangles: Vec<(u32, [NodeId; 3])>,
+    /// Per split: the node and the splits it depends on.
+    pub splits: Vec<(u32, SmallVec<[Dependency; 2]>)>,
+    /// The units under this one and their root nodes, open until they are loaded.
+    pub opens: Vec<(usize, u32)>,
+}
+
+/// A unit fetched, or why it was refused.
+pub(super) struct Loaded {
+    pub unit: usize,
+    /// Bytes read from the source for it.
+    pub bytes: u64,
+    pub outcome: Result<UnitDelta>,
+}
+
+/// Decodes units given their bytes: either codec's [`CameDecoder`], detached from the stream.
+trait UnitLoading: Send {
+    fn load(&mut self, unit: usize, bytes: &[u8], header: &Header) -> Result<UnitDelta>;
+}
+
+impl<U: UnitDecoder + Send> UnitLoading for CameDecoder<'static, U> {
+    fn load(&mut self, unit: usize, bytes: &[u8], header: &Header) -> Result<UnitDelta> {
+        self.decode_unit_checked(unit, bytes, |decoded| delta(decoded, header))
+    }
+}
+
+/// What `decoded` added, checked so that the view-dependent mesh can take it as it is.
+fn delta(decoded: &DecodedUnit, header: &Header) -> Result<UnitDelta> {
+    let bad = |what: &str| Error::malformed(0, 0, what.to_string());
+    let tree: &DecodedTree = decoded.tree;
+    let since = decoded.since;
+    let cell = header.grid.cell.iter().fold(0.0f64, |m, &c| m.max(c.abs()));
+    let root_id = tree.nodes[decoded.root as usize].id;
+    let split_here = |i: u32| tree.nodes[i as usize].split_unit == Some(root_id);
+    let mut out = UnitDelta::default();
+    for (i, n) in tree.nodes.iter().enumerate().skip(since.nodes) {
+        let parent = match n.id.parent() {
+            None if i == 0 => NONE,
+            None => return Err(bad("a second root")),
+            Some(p) => tree
+                .get(p)
+                .ok_or_else(|| bad("a node without its parent"))?,
+        };
+        out.nodes.push(NewNode {
+            id: n.id,
+            parent,
+            center: to_world(&header.grid, n.position),
+            radius: n.radius * cell,
+        });
+    }
+    for t in &tree.triangles[since.triangles..] {
+        let c = t.corners;
+        // Two corners part at the birth node, the third higher up.
+        let birth_len = c[0]
+            .common_len(c[1])
+            .max(c[1].common_len(c[2]))
+            .max(c[0].common_len(c[2]));
+        let birth = (0..3)
+            .map(|k| c[k].ancestor(birth_len))
+            .find(|b| b.len() == t.birth_depth)
+            .and_then(|b| tree.get(b))
+            .filter(|&b| split_here(b))
+            .ok_or_else(|| bad("a triangle's corners do not part at a split of its unit"))?;
+        out.triangles.push((birth, c));
+    }
+    for k in since.dependencies..tree.dependencies.len() {
+        let (s, deps) = tree.dependencies_of(k);
+        let s = tree
+            .get(s)
+            .filter(|&s| split_here(s))
+            .ok_or_else(|| bad("dependencies of no split of the unit"))?;
+        let mut list = SmallVec::new();
+        for &d in deps {
+            let node = tree.get(d).unwrap_or(NONE);
+            if node != NONE && tree.nodes[node as usize].leaf {
+                return Err(bad("a split depends on a vertex"));
+            }
+            list.push(Dependency { id: d, node });
+        }
+        out.splits.push((s, list));
+    }
+    out.opens = decoded.child_units.clone();
+    Ok(out)
+}
+
+/// Reads units from a source and decodes them.
+pub(super) struct Worker {
+    source: Box<dyn ByteSource>,
+    /// The stream's first bytes, read with the header and index (the first units are in them).
+    head: Vec<u8>,
+    decoder: Box<dyn UnitLoading>,
+    header: Header,
+    index: Index,
+    payload_start: u64,
+    size: Option<u64>,
+}
+
+impl Worker {
+    fn load(&mut self, unit: usize) -> Loaded {
+        let entry = self.index.units[unit];
+        let start = self.payload_start + entry.offset;
+        let refused = |bytes: u64, e: Error| Loaded {
+            unit,
+            bytes,
+            outcome: Err(e),
+        };
+        if let Some(size) = self.size.filter(|&size| start + entry.length > size) {
+            return refused(
+                0,
+                Error::Truncated(format!(
+                    "unit {unit} ends at byte {}, past the stream's end at {size}",
+                    start + entry.length
+                )),
+            );
+        }
+        // What the head holds is not read again.
+        let end = start + entry.length;
+        let held = self.head.len() as u64;
+        let mut bytes = self.head[start.min(held) as usize..end.min(held) as usize].to_vec();
+        let from = start.max(held);
+        let mut read = 0;
+        if from < end {
+            match self.source.read_at(from, end - from) {
+                Ok(rest) => {
+                    read = rest.len() as u64;
+                    bytes.extend_from_slice(&rest);
+                }
+                Err(e) => return refused(0, Error::Io(e)),
+            }
+        }
+        Loaded {
+            unit,
+            bytes: read,
+            outcome: self.decoder.load(unit, &bytes, &self.header),
+        }
+    }
+}
+
+/// What [`Loader::open`] read before the first unit: the header, the index, the root unit.
+pub(super) struct Opened {
+    pub index: Index,
+    /// The stream's length as the header and index give it.
+    pub stream_bytes: u64,
+    /// Bytes read for the header and index.
+    pub head_bytes: u64,
+    pub root: Loaded,
+}
+
+/// The loader: a thread reading and decoding units, or a queue worked through inline.
+pub(super) enum Loader {
+    Inline {
+        worker: Box<Worker>,
+        queue: VecDeque<usize>,
+    },
+    Background {
+        requests: mpsc::Sender<usize>,
+        results: mpsc::Receiver<Loaded>,
+    },
+}
+
+impl Loader {
+    /// Reads the header and index of the stream in `source` and its first (root) unit.
+    pub fn open(mut source: Box<dyn ByteSource>, fetch: Fetch) -> Result<(Loader, Opened)> {
+        let size = source.size();
+        // The header's and index's length is known once they parse: read growing prefixes.
+        let mut want = 4096u64;
+        let mut head = Vec::new();
+        let mut head_bytes = 0u64;
+        let (header, index, payload_start) = loop {
+            // Each try reads on from where the last stopped.
+            let more = source.read_at(head.len() as u64, want - head.len() as u64)?;
+            head_bytes += more.len() as u64;
+            let ended = (more.len() as u64) < want - head.len() as u64;
+            head.extend_from_slice(&more);
+            match read_header_and_index(&head) {
+                Ok(parts) => break parts,
+                Err(Error::Truncated(_)) if !ended => want *= 4,
+                Err(e) => return Err(e),
+            }
+        };
+        let payload_start = payload_start as u64;
+        let stream_bytes = payload_start + index.payload_bytes;
+        if let Some(extra) = size
+            .and_then(|s| s.checked_sub(stream_bytes))
+            .filter(|&e| e > 0)
+        {
+            return Err(Error::malformed(
+                index.len(),
+                stream_bytes as usize,
+                format!("{extra} bytes after the last unit"),
+            ));
+        }
+        let name = crate::codecs::by_id(header.codec_id)?.name();
+        let start = payload_start as usize;
+        let decoder: Box<dyn UnitLoading> = match name {
+            "came" => Box::new(CameDecoder::detached(
+                header.clone(),
+                index.clone(),
+                start,
+                modelled::params(&header)?,
+                modelled::ModelledUnits,
+            )?),
+            "came-paper" => Box::new(CameDecoder::detached(
+                header.clone(),
+                index.clone(),
+                start,
+                paper::params(&header)?,
+                paper::PaperUnits::default(),
+            )?),
+            other => {
+                return Err(Error::Unsupported(format!(
+                    "{other} streams hold no vertex hierarchy; view-dependent refinement needs came or came-paper"
+                )))
+            }
+        };
+        if index.is_empty() {
+            return Err(Error::malformed(0, start, "a CAME stream has no units"));
+        }
+        let mut worker = Box::new(Worker {
+            source,
+            head,
+            decoder,
+            header: header.clone(),
+            index: index.clone(),
+            payload_start,
+            size,
+        });
+        let root = worker.load(0);
+        let loader = match fetch {
+            Fetch::Inline => Loader::Inline {
+                worker,
+                queue: VecDeque::new(),
+            },
+            Fetch::Background => {
+                let (requests, inbox) = mpsc::channel::<usize>();
+                let (outbox, results) = mpsc::channel();
+                std::thread::Builder::new()
+                    .name("came-loader".into())
+                    .spawn(move || {
+                        // Ends when the view-dependent mesh is dropped (its sender with it).
+                        for unit in inbox {
+                            if outbox.send(worker.load(unit)).is_err() {
+                                break;
+                            }
+                        }
+                    })?;
+                Loader::Background { requests, results }
+            }
+        };
+        let opened = Opened {
+            index,
+            stream_bytes,
+            head_bytes,
+            root,
+        };
+        Ok((loader, opened))
+    }
+
+    /// Asks for `unit` (once: the caller keeps track).
+    pub fn request(&mut self, unit: usize) {
+        match self {
+            Loader::Inline { queue, .. } => queue.push_back(unit),
+            Loader::Background { requests, .. } => {
+                // A loader thread that ended (it only ends with us) leaves the unit waiting.
+                let _ = requests.send(unit);
+            }
+        }
+    }
+
+    /// The units fetched since the last call: every one asked for when `block`, else what has
+    /// arrived. `outstanding` is how many were asked for and not yet handed back.
+    pub fn collect(&mut self, outstanding: usize, block: bool) -> Vec<Loaded> {
+        match self {
+            Loader::Inline { worker, queue } => queue.drain(..).map(|u| worker.load(u)).collect(),
+            Loader::Background { results, .. } => {
+                let mut out: Vec<Loaded> = results.try_iter().collect();
+                while block && out.len() < outstanding {
+                    match results.recv() {
+                        Ok(loaded) => out.push(loaded),
+                        Err(_) => break,
+                    }
+                }
+                out
+            }
+        }
+    }
+}
