@@ -51,6 +51,9 @@ pub struct Frame {
     pub vertices: usize,
     pub splits: usize,
     pub collapses: usize,
+    /// Passes over the active nodes, and adaptations (one more after each wait for meta-nodes).
+    pub passes: usize,
+    pub adaptations: usize,
     /// Time in adaptation (splits, collapses, view tests, taking in meta-nodes).
     pub adapt_ms: f64,
     /// Time waiting for meta-nodes the view asked for.
@@ -104,7 +107,8 @@ pub struct Flythrough {
 /// distance) to `close` above the surface point `spot`, the target gliding from the centre to it.
 fn camera_at(i: usize, centre: DVec3, radius: f64, spot: DVec3) -> Camera {
     let lift = 0.3;
-    let orbit = |angle: f64| centre + 3.0 * radius * DVec3::new(angle.sin(), lift, angle.cos()).normalize();
+    let orbit =
+        |angle: f64| centre + 3.0 * radius * DVec3::new(angle.sin(), lift, angle.cos()).normalize();
     let (eye, target) = if i < ORBIT_FRAMES {
         let angle = std::f64::consts::TAU * i as f64 / ORBIT_FRAMES as f64;
         (orbit(angle), centre)
@@ -112,7 +116,7 @@ fn camera_at(i: usize, centre: DVec3, radius: f64, spot: DVec3) -> Camera {
         let t = (i - ORBIT_FRAMES + 1) as f64 / (FRAMES - ORBIT_FRAMES) as f64;
         let start = orbit(0.0);
         let away = (start - spot).normalize();
-        let (far, near) = ((start - spot).length(), 0.03 * radius);
+        let (far, near) = ((start - spot).length(), 0.12 * radius);
         let distance = far * (near / far).powf(t);
         let smooth = t * t * (3.0 - 2.0 * t);
         (spot + away * distance, centre.lerp(spot, smooth))
@@ -218,7 +222,12 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
         .nodes
         .iter()
         .filter(|n| n.leaf)
-        .map(|n| (n.id, codecs::came::decoded::to_world(&header.grid, n.position)))
+        .map(|n| {
+            (
+                n.id,
+                codecs::came::decoded::to_world(&header.grid, n.position),
+            )
+        })
         .collect();
     let (full, _) = codecs::decode(&stream, codecs::Stop::All)?;
     let full = full.mesh;
@@ -259,7 +268,11 @@ fn fly(
         .positions
         .iter()
         .copied()
-        .max_by(|a, b| (*a - centre).dot(towards).total_cmp(&(*b - centre).dot(towards)))
+        .max_by(|a, b| {
+            (*a - centre)
+                .dot(towards)
+                .total_cmp(&(*b - centre).dot(towards))
+        })
         .ok_or_else(|| Error::mesh("an empty mesh"))?;
     let mut front = ViewMesh::open_file(path)?;
     let units = front.fetched().units;
@@ -269,6 +282,7 @@ fn fly(
         let camera = camera_at(i, centre, radius, spot);
         let view = View::new(&camera, TOLERANCE_PX)?;
         let (mut splits, mut collapses, mut adapt_s, mut wait_s) = (0, 0, 0.0, 0.0);
+        let (mut passes, mut adaptations) = (0, 0);
         // Adapt, wait for the meta-nodes asked for, adapt again, until the front settles.
         for _ in 0..256 {
             let started = Instant::now();
@@ -276,6 +290,8 @@ fn fly(
             adapt_s += started.elapsed().as_secs_f64();
             splits += done.splits;
             collapses += done.collapses;
+            passes += done.passes;
+            adaptations += 1;
             if done.settled {
                 break;
             }
@@ -296,6 +312,8 @@ fn fly(
             vertices: front.vertex_count(),
             splits,
             collapses,
+            passes,
+            adaptations,
             adapt_ms: adapt_s * 1e3,
             wait_ms: wait_s * 1e3,
             bytes_fetched: fetched.bytes_read,
@@ -307,7 +325,7 @@ fn fly(
         };
         if i % 10 == 0 || i + 1 == FRAMES {
             log(format!(
-                "frame {i}: {} faces, {} splits, {} collapses, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
+                "frame {i}: {} faces, {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
                 frame.faces,
                 splits,
                 collapses,
@@ -383,16 +401,18 @@ fn fly(
 
 fn csv(report: &Flythrough) -> String {
     let mut out = String::from(
-        "frame,faces,vertices,splits,collapses,adapt_ms,wait_ms,bytes_fetched,units_loaded,surface_in_view,visible_vertices,max_error_px,mean_error_px\n",
+        "frame,faces,vertices,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,surface_in_view,visible_vertices,max_error_px,mean_error_px\n",
     );
     for f in &report.frames {
         out += &format!(
-            "{},{},{},{},{},{:.3},{:.3},{},{},{:.5},{},{:.4},{:.4}\n",
+            "{},{},{},{},{},{},{},{:.3},{:.3},{},{},{:.5},{},{:.4},{:.4}\n",
             f.frame,
             f.faces,
             f.vertices,
             f.splits,
             f.collapses,
+            f.passes,
+            f.adaptations,
             f.adapt_ms,
             f.wait_ms,
             f.bytes_fetched,
@@ -411,18 +431,19 @@ fn csv(report: &Flythrough) -> String {
 pub fn chart(report: &Flythrough) -> Vec<Chart> {
     let series = |label: &str, y: &dyn Fn(&Frame) -> f64| Series {
         label: label.to_string(),
-        points: report.frames.iter().map(|f| (f.frame as f64, y(f))).collect(),
+        points: report
+            .frames
+            .iter()
+            .map(|f| (f.frame as f64, y(f)))
+            .collect(),
         mark: Mark::Line,
     };
-    let panel = |title: &str, y_desc: &str, series: Vec<Series>| Chart {
+    let panel = |title: &str, y_desc: &str, y_log: bool, series: Vec<Series>| Chart {
         title: title.to_string(),
-        x_desc: format!(
-            "frame (orbit to {}, then flying in)",
-            ORBIT_FRAMES - 1
-        ),
+        x_desc: format!("frame (orbit to {}, then flying in)", ORBIT_FRAMES - 1),
         y_desc: y_desc.to_string(),
         x_log: false,
-        y_log: false,
+        y_log,
         series,
         legend: SeriesLabelPosition::UpperLeft,
     };
@@ -430,11 +451,13 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
         panel(
             "Adapted mesh",
             "faces",
+            false,
             vec![series("active faces", &|f| f.faces as f64)],
         ),
         panel(
             "Work per frame",
-            "operations / ms",
+            "operations, or ms (log)",
+            true,
             vec![
                 series("splits", &|f| f.splits as f64),
                 series("collapses", &|f| f.collapses as f64),
@@ -443,7 +466,8 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
         ),
         panel(
             "Stream fetched",
-            "% of the stream's bytes",
+            "% of the stream's bytes, or of the surface",
+            false,
             vec![
                 series("bytes fetched so far", &|f| {
                     100.0 * f.bytes_fetched as f64 / report.stream_bytes as f64
@@ -454,6 +478,7 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
         panel(
             "Measured screen-space error",
             "pixels",
+            false,
             vec![
                 series("largest", &|f| f.max_error_px),
                 series("mean", &|f| f.mean_error_px),

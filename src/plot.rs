@@ -193,8 +193,18 @@ impl Chart {
             }
             root.present().map_err(plot_error)
         }
-        panels(charts, BitMapBackend::new(&png, size).into_drawing_area(), rows, columns)?;
-        panels(charts, SVGBackend::new(&svg, size).into_drawing_area(), rows, columns)?;
+        panels(
+            charts,
+            BitMapBackend::new(&png, size).into_drawing_area(),
+            rows,
+            columns,
+        )?;
+        panels(
+            charts,
+            SVGBackend::new(&svg, size).into_drawing_area(),
+            rows,
+            columns,
+        )?;
         Ok(vec![png, svg])
     }
 
@@ -232,7 +242,11 @@ impl Chart {
                 format!("{value:.1e}")
             }
         };
-        let linear_label = |v: &f64| format!("{v}");
+        // Ticks are round numbers; printed with a few decimals at most, not float noise.
+        let linear_label = |v: &f64| {
+            let text = format!("{v:.3}");
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        };
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, ("sans-serif", 30))
             .margin(20)

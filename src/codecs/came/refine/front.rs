@@ -149,8 +149,8 @@ pub struct ViewMesh {
     /// The meta-node that splits the node, while it is not loaded (else `NONE`).
     opens: Vec<u32>,
     /// Position and error-sphere radius, in world units.
-    center: Vec<DVec3>,
-    radius: Vec<f64>,
+    /// (One array: the view test of every active node, every pass, reads both.)
+    spheres: Vec<(DVec3, f64)>,
     state: Vec<State>,
     /// Triangles born at the node's split.
     born: Vec<SmallVec<[u32; 2]>>,
@@ -168,12 +168,14 @@ pub struct ViewMesh {
     corners: Vec<[u32; 3]>,
     present: Vec<bool>,
     faces: usize,
-    /// Where an interrupted pass resumes.
-    cursor: usize,
+    /// Where an interrupted pass resumes: the node it stopped at (passes go in node order).
+    cursor: u32,
     /// κ's scale, regulated to a face budget.
     scale: f64,
     /// The active nodes a pass visits (kept to save allocating one a pass).
     pass: Vec<u32>,
+    /// Split nodes a collapse left with no split dependant: they may collapse now.
+    freed: Vec<u32>,
     /// Splits planned by a forced split, in order, and each node's mark of being planned.
     plan: Vec<u32>,
     planned: Vec<bool>,
@@ -199,8 +201,7 @@ impl ViewMesh {
             parent: Vec::new(),
             children: Vec::new(),
             opens: Vec::new(),
-            center: Vec::new(),
-            radius: Vec::new(),
+            spheres: Vec::new(),
             state: Vec::new(),
             born: Vec::new(),
             depends_on: Vec::new(),
@@ -215,6 +216,7 @@ impl ViewMesh {
             cursor: 0,
             scale: 1.0,
             pass: Vec::new(),
+            freed: Vec::new(),
             plan: Vec::new(),
             planned: Vec::new(),
             loader,
@@ -311,8 +313,7 @@ impl ViewMesh {
             self.parent.push(n.parent);
             self.children.push([NONE; 2]);
             self.opens.push(NONE);
-            self.center.push(n.center);
-            self.radius.push(n.radius);
+            self.spheres.push((n.center, n.radius));
             self.state.push(State::Below);
             self.born.push(SmallVec::new());
             self.depends_on.push(SmallVec::new());
@@ -542,7 +543,11 @@ impl ViewMesh {
         }
         self.activate(s);
         for &d in &self.depends_on[su] {
-            self.split_dependants[d.node as usize] -= 1;
+            let count = &mut self.split_dependants[d.node as usize];
+            *count -= 1;
+            if *count == 0 {
+                self.freed.push(d.node);
+            }
         }
     }
 
@@ -655,7 +660,8 @@ impl ViewMesh {
         let limit = budget.faces.unwrap_or(usize::MAX);
         let wants = |m: &ViewMesh, v: u32| {
             let vu = v as usize;
-            view.wants_split(m.center[vu], m.radius[vu], m.scale)
+            let (center, radius) = m.spheres[vu];
+            view.wants_split(center, radius, m.scale)
         };
         let mut below: Vec<u32> = Vec::new();
         loop {
@@ -663,14 +669,17 @@ impl ViewMesh {
             done.passes += 1;
             done.waiting = 0;
             done.blocked = 0;
-            let start = self.cursor.min(self.active.len());
+            // In node order (the loader's, which keeps a meta-node's nodes together) rather
+            // than the list's: the nodes' records are then read nearly in memory order.
             pass.clear();
-            pass.extend_from_slice(&self.active[start..]);
-            pass.extend_from_slice(&self.active[..start]);
+            pass.extend_from_slice(&self.active);
+            pass.sort_unstable();
+            let start = pass.partition_point(|&v| v < self.cursor);
+            pass.rotate_left(start);
             self.cursor = 0;
-            for (i, &v) in pass.iter().enumerate() {
+            for &v in pass.iter() {
                 if done.splits + done.collapses >= budget.operations {
-                    self.cursor = (start + i) % pass.len().max(1);
+                    self.cursor = v;
                     return;
                 }
                 if self.state[v as usize] != State::Active {
@@ -709,16 +718,24 @@ impl ViewMesh {
                     }
                     continue;
                 }
-                // Up the tree while the parent may and should go.
+                // Up the tree while the parent may and should go; then the same from each
+                // node those collapses freed of its last split dependant (so that a chain of
+                // dependencies unwinds in one pass, not one pass a link).
                 let mut p = self.parent[v as usize];
-                while p != NONE
-                    && done.splits + done.collapses < budget.operations
-                    && self.can_collapse(p)
-                    && !wants(self, p)
-                {
-                    self.collapse(p);
-                    done.collapses += 1;
-                    p = self.parent[p as usize];
+                loop {
+                    while p != NONE
+                        && done.splits + done.collapses < budget.operations
+                        && self.can_collapse(p)
+                        && !wants(self, p)
+                    {
+                        self.collapse(p);
+                        done.collapses += 1;
+                        p = self.parent[p as usize];
+                    }
+                    match self.freed.pop() {
+                        Some(d) if done.splits + done.collapses < budget.operations => p = d,
+                        _ => break,
+                    }
                 }
             }
             if (done.splits, done.collapses) == (before.splits, before.collapses) {
@@ -745,7 +762,7 @@ impl ViewMesh {
     /// Where the vertex with leaf path `leaf` stands in the adapted mesh: the position of the
     /// active node on its path (`None` if the path leaves the hierarchy above the front).
     pub fn position_of(&self, leaf: NodeId) -> Option<DVec3> {
-        self.active_on(leaf).map(|v| self.center[v as usize])
+        self.active_on(leaf).map(|v| self.spheres[v as usize].0)
     }
 
     /// The adapted mesh: the active nodes' positions, the present triangles.
@@ -754,7 +771,7 @@ impl ViewMesh {
         let mut positions = Vec::with_capacity(self.active.len());
         for &v in &self.active {
             index[v as usize] = positions.len() as u32;
-            positions.push(self.center[v as usize]);
+            positions.push(self.spheres[v as usize].0);
         }
         let faces = self
             .present
@@ -773,7 +790,7 @@ impl ViewMesh {
             if !present {
                 continue;
             }
-            let [a, b, c] = self.corners[t].map(|v| self.center[v as usize]);
+            let [a, b, c] = self.corners[t].map(|v| self.spheres[v as usize].0);
             if let Some(d) = ray_triangle(origin, direction, a, b, c) {
                 if best.is_none_or(|p| d < p.distance) {
                     best = Some(Pick {

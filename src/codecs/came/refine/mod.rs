@@ -13,8 +13,10 @@
 //!   split node depends on v_s.
 //! - r_v: the error sphere's radius at v (every vertex of v's subtree lies within r_v of v).
 //! - τ: the screen-space tolerance in pixels; φ: the vertical field of view; H: the viewport's
-//!   height in pixels; κ = 2·τ·tan(φ/2) / H. A node is refined while r_v ≥ κ·|v − e| (its sphere
-//!   would span τ pixels or more) and its sphere meets the view frustum.
+//!   height in pixels; κ = 2·τ·tan(φ/2) / H. A node is refined while its sphere meets the view
+//!   frustum and a vertex of its subtree could land τ pixels or more from it on the screen:
+//!   r_v·√(1 + t²) ≥ κ·z, z the sphere's least depth and t its largest tangent off the axis
+//!   ([`View::wants_split`]) — Hoppe's r_v ≥ κ·|v − e|, made an upper bound.
 //!
 //! No normal cones are stored (the streams carry none), so there is no back-face culling: a
 //! node facing away is refined like one facing the eye.

@@ -20,6 +20,8 @@ pub struct Camera {
 #[derive(Clone, Debug, PartialEq)]
 pub struct View {
     eye: DVec3,
+    /// The viewing direction (zero for the views of no camera).
+    forward: DVec3,
     /// Inward unit normals of planes through the eye (sides, and the near plane at the eye).
     planes: Vec<DVec3>,
     /// κ = 2·τ·tan(φ/2) / H: a sphere of radius r at distance d spans about τ·r / (κ·d) pixels.
@@ -56,6 +58,7 @@ impl View {
         ];
         Ok(View {
             eye: camera.eye,
+            forward,
             planes,
             kappa: 2.0 * tolerance * tan_y / camera.height as f64,
         })
@@ -65,6 +68,7 @@ impl View {
     pub fn everything() -> View {
         View {
             eye: DVec3::ZERO,
+            forward: DVec3::ZERO,
             planes: Vec::new(),
             kappa: 0.0,
         }
@@ -74,6 +78,7 @@ impl View {
     pub fn nothing() -> View {
         View {
             eye: DVec3::ZERO,
+            forward: DVec3::ZERO,
             planes: Vec::new(),
             kappa: f64::INFINITY,
         }
@@ -97,12 +102,30 @@ impl View {
 
     /// Whether a node with this error sphere is to be refined, κ scaled by `scale` (the face
     /// budget's regulation): visible and spanning the tolerance or more.
+    ///
+    /// "Spanning" is bounded from above, so that no vertex of the node's subtree lands τ
+    /// pixels or more from the node on the screen while the node stands for it: over the
+    /// sphere, the projection (x/z, y/z) stretches lengths by at most √(1 + t²) / z, with z
+    /// the least depth and t the largest tangent off the axis, so the node is refined while
+    /// r·√(1 + t²) ≥ κ·z_min (z_min = depth of the centre − r; t = (lateral distance + r) /
+    /// z_min). A sphere reaching the eye's plane is always refined.
     pub fn wants_split(&self, center: DVec3, radius: f64, scale: f64) -> bool {
-        if radius <= 0.0 || !self.sees(center, radius) {
+        let k = self.kappa * scale;
+        if radius <= 0.0 || !k.is_finite() || !self.sees(center, radius) {
             return false;
         }
-        let k = self.kappa * scale;
-        k.is_finite() && radius * radius >= k * k * center.distance_squared(self.eye)
+        if k == 0.0 {
+            return true;
+        }
+        let d = center - self.eye;
+        let depth = d.dot(self.forward);
+        let nearest = depth - radius;
+        if nearest <= 0.0 {
+            return true;
+        }
+        let lateral = (d - self.forward * depth).length() + radius;
+        let tangent = lateral / nearest;
+        radius * (1.0 + tangent * tangent).sqrt() >= k * nearest
     }
 }
 
@@ -143,6 +166,13 @@ mod tests {
         assert!(!v.wants_split(DVec3::ZERO, 1.9 * pixel, 1.0));
         assert!(!v.wants_split(DVec3::ZERO, 2.1 * pixel, 1.2));
         assert!(!v.wants_split(DVec3::new(0.0, 0.0, 30.0), 10.0, 1.0));
+        // Off the axis a sphere's subtree can spread further on the screen: at the edge of
+        // the view (tangent ≈ 0.5 here) 1.9 pixels' radius is refined.
+        assert!(v.wants_split(DVec3::new(5.0, 0.0, 0.0), 1.9 * pixel, 1.0));
+        // A sphere reaching the eye's plane is.
+        assert!(v.wants_split(DVec3::new(0.0, 0.5, 9.5), 0.6, 1.0));
+        assert!(View::everything().wants_split(DVec3::ZERO, 1e-9, 1.0));
+        assert!(!View::nothing().wants_split(DVec3::ZERO, 1e9, 1.0));
     }
 
     #[test]
