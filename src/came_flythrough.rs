@@ -63,6 +63,9 @@ pub struct Frame {
     pub units_loaded: usize,
     /// Share of the full mesh's surface (by area) inside the view frustum.
     pub surface_in_view: f64,
+    /// Present faces turned over against the same triangle of the full mesh (their normals
+    /// more than 90° apart): fold-overs, which nothing in the build prevents.
+    pub fold_overs: usize,
     /// Full-mesh vertices inside the frustum, and the measured screen-space error over them.
     pub visible_vertices: usize,
     pub max_error_px: f64,
@@ -188,6 +191,19 @@ fn measured_error(
     Ok((max, sum / count.max(1) as f64, count))
 }
 
+/// Present faces of `front` whose normal points against their full-resolution counterpart's
+/// (`at`: each vertex's position by leaf path).
+fn fold_overs(front: &ViewMesh, at: &std::collections::HashMap<u64, DVec3>) -> usize {
+    let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
+    front
+        .present_triangles()
+        .filter(|(leaves, adapted)| {
+            let full = leaves.map(|l| at.get(&l.packed()).copied().unwrap_or(DVec3::ZERO));
+            normal(*adapted).dot(normal(full)) < 0.0
+        })
+        .count()
+}
+
 /// The stream's path under the system's temporary folder (the stream is rebuilt each run and
 /// not kept: it is 4 MB).
 fn stream_path() -> PathBuf {
@@ -274,6 +290,8 @@ fn fly(
                 .total_cmp(&(*b - centre).dot(towards))
         })
         .ok_or_else(|| Error::mesh("an empty mesh"))?;
+    let at: std::collections::HashMap<u64, DVec3> =
+        leaves.iter().map(|&(id, p)| (id.packed(), p)).collect();
     let mut front = ViewMesh::open_file(path)?;
     let units = front.fetched().units;
     let mut frames = Vec::with_capacity(FRAMES);
@@ -319,14 +337,16 @@ fn fly(
             bytes_fetched: fetched.bytes_read,
             units_loaded: fetched.units_loaded,
             surface_in_view: surface_in_view(full, &view),
+            fold_overs: fold_overs(&front, &at),
             visible_vertices,
             max_error_px,
             mean_error_px,
         };
         if i % 10 == 0 || i + 1 == FRAMES {
             log(format!(
-                "frame {i}: {} faces, {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
+                "frame {i}: {} faces ({} folded over), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
                 frame.faces,
+                frame.fold_overs,
                 splits,
                 collapses,
                 frame.adapt_ms,
@@ -401,11 +421,11 @@ fn fly(
 
 fn csv(report: &Flythrough) -> String {
     let mut out = String::from(
-        "frame,faces,vertices,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,surface_in_view,visible_vertices,max_error_px,mean_error_px\n",
+        "frame,faces,vertices,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,surface_in_view,fold_overs,visible_vertices,max_error_px,mean_error_px\n",
     );
     for f in &report.frames {
         out += &format!(
-            "{},{},{},{},{},{},{},{:.3},{:.3},{},{},{:.5},{},{:.4},{:.4}\n",
+            "{},{},{},{},{},{},{},{:.3},{:.3},{},{},{:.5},{},{},{:.4},{:.4}\n",
             f.frame,
             f.faces,
             f.vertices,
@@ -418,6 +438,7 @@ fn csv(report: &Flythrough) -> String {
             f.bytes_fetched,
             f.units_loaded,
             f.surface_in_view,
+            f.fold_overs,
             f.visible_vertices,
             f.max_error_px,
             f.mean_error_px
@@ -452,7 +473,10 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
             "Adapted mesh",
             "faces",
             false,
-            vec![series("active faces", &|f| f.faces as f64)],
+            vec![
+                series("active faces", &|f| f.faces as f64),
+                series("folded over", &|f| f.fold_overs as f64),
+            ],
         ),
         panel(
             "Work per frame",

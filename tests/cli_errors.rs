@@ -251,7 +251,8 @@ fn emc_commands_work_on_every_shared_mesh() {
             let out = run(MESHCODEC, args, d);
             assert_eq!(out.code, Some(0), "{args:?}: {}", out.stderr);
         };
-        ok(&["encode", "--codec", codec, f, "m.mc"]);
+        // Their geometry: some also hold normals, colours or texture coordinates.
+        ok(&["encode", "--codec", codec, "--drop-attributes", f, "m.mc"]);
         let info = Command::new(MESHCODEC)
             .args(["info", "m.mc", "--json"])
             .current_dir(d)
@@ -396,4 +397,45 @@ fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
     args.extend_from_slice(&camera);
     assert_clean_failure(&run(MESHCODEC, &args, d), "head.mc");
     assert!(!d.join("x.ply").exists());
+}
+
+#[test]
+fn encode_refuses_a_file_with_appearance_unless_told_to_drop_it() {
+    let dir = scratch();
+    let d = dir.path();
+    // The shared textured bunny: 6,451 texture coordinates and a material.
+    let out = run(
+        MESHCODEC,
+        &["encode", "--codec", "emc", "bunny-10k-textured", "t.mc"],
+        d,
+    );
+    assert_clean_failure(&out, "bunny-10k-textured.obj");
+    assert!(
+        out.stderr.contains("6451 texture coordinates") && out.stderr.contains("--drop-attributes"),
+        "{}",
+        out.stderr
+    );
+    assert!(!d.join("t.mc").exists());
+    let out = run(
+        MESHCODEC,
+        &[
+            "encode",
+            "--codec",
+            "emc",
+            "--drop-attributes",
+            "bunny-10k-textured",
+            "t.mc",
+        ],
+        d,
+    );
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    assert!(
+        out.stderr.starts_with("note: ") && out.stderr.contains("dropped"),
+        "{}",
+        out.stderr
+    );
+    assert!(d.join("t.mc").is_file());
+    // A file of geometry alone encodes without a word.
+    let out = run(MESHCODEC, &["encode", "--codec", "emc", "bunny", "b.mc"], d);
+    assert_eq!((out.code, out.stderr.as_str()), (Some(0), ""));
 }

@@ -190,8 +190,11 @@ pub fn check_level_mesh(level: &LevelMesh, header: &Header) {
 
 /// Reads `bytes` as a mesh file of `format`; a mesh that reads must be valid.
 pub fn read_as(format: &str, bytes: &[u8]) {
+    // The appearance count scans any bytes, read or not.
+    let _ = io::appearance_of(bytes, format, 3, 1);
     if let Ok(mesh) = io::read_mesh_bytes(bytes, format) {
         mesh.validate().expect("a mesh the reader accepted");
+        let _ = io::appearance_of(bytes, format, mesh.positions.len(), mesh.faces.len());
     }
 }
 

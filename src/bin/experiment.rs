@@ -157,6 +157,16 @@ fn run_codec(
     out: &Path,
     keep_stream: bool,
 ) -> Result<RunResult> {
+    // The harness measures geometry; what else the file holds is said, not dropped unseen.
+    let (_, appearance) = meshcodec::mesh::io::read_mesh_and_appearance(path)
+        .with_context(|| path.display().to_string())?;
+    if !appearance.is_empty() {
+        eprintln!(
+            "note: {}: {appearance} not coded ({} carries positions and triangles only)",
+            path.display(),
+            codec.name()
+        );
+    }
     let harness::RunOutput { result, stream } =
         harness::run(codec, path, options).with_context(|| path.display().to_string())?;
     meshcodec::outln!(

@@ -36,6 +36,11 @@ enum Command {
         /// Grid shape: cubic or per-axis (default: the codec's).
         #[arg(long, value_parser = meshcodec::cli::parse_grid)]
         grid: Option<GridShape>,
+        /// Encode the geometry of a file that also holds normals, texture coordinates,
+        /// colours or materials, which no codec of this build carries (without it, such a file
+        /// is refused).
+        #[arg(long)]
+        drop_attributes: bool,
         /// Mesh file or name.
         input: String,
         /// Stream file to write.
@@ -125,9 +130,10 @@ fn main() -> ExitCode {
             codec,
             quant,
             grid,
+            drop_attributes,
             input,
             output,
-        } => encode(&codec, quant, grid, &input, &output),
+        } => encode(&codec, quant, grid, drop_attributes, &input, &output),
         Command::Decode {
             input,
             output,
@@ -180,11 +186,27 @@ fn encode(
     codec: &str,
     quant: Option<u8>,
     grid: Option<GridShape>,
+    drop_attributes: bool,
     input: &str,
     output: &Path,
 ) -> Result<()> {
     let codec = codecs::by_name(codec)?;
-    let (path, mesh) = load(input)?;
+    let path = resolve(input).with_context(|| input.to_string())?;
+    let (mesh, appearance) = meshcodec::mesh::io::read_mesh_and_appearance(&path)
+        .with_context(|| path.display().to_string())?;
+    if !appearance.is_empty() {
+        if !drop_attributes {
+            return Err(meshcodec::Error::Unsupported(format!(
+                "holds {appearance}, which {} does not carry (no codec of this build does: positions and triangles only); --drop-attributes encodes the geometry alone",
+                codec.name()
+            )))
+            .with_context(|| path.display().to_string());
+        }
+        eprintln!(
+            "note: {}: {appearance} dropped (--drop-attributes)",
+            path.display()
+        );
+    }
     let options = encode_options(
         codec,
         &RunOptions {

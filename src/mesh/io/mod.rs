@@ -4,6 +4,7 @@
 //! Readers return the mesh as stored (unreferenced vertices kept where the format keeps them),
 //! validated: finite coordinates, indices in range, at least one face.
 
+mod appearance;
 mod m;
 mod obj;
 mod off;
@@ -11,6 +12,8 @@ mod ply;
 mod stl;
 mod text;
 pub mod vrml;
+
+pub use appearance::{appearance_of, Appearance};
 
 use super::TriMesh;
 use crate::error::{Error, Result};
@@ -20,16 +23,31 @@ use std::path::{Path, PathBuf};
 /// File extensions the readers understand, in the order a bare mesh name prefers them.
 pub const EXTENSIONS: [&str; 5] = ["ply", "obj", "off", "m", "stl"];
 
-/// Reads a mesh, choosing the reader by the file's extension.
+/// Reads a mesh, choosing the reader by the file's extension: positions and triangles only
+/// ([`read_mesh_and_appearance`] says what else the file holds).
 pub fn read_mesh(path: &Path) -> Result<TriMesh> {
     let ext = extension(path);
     let bytes = std::fs::read(path)?;
-    let mesh = match ext.as_str() {
-        "obj" => obj::read(&bytes)?,
-        "ply" => ply::read(&bytes)?,
-        "off" => off::read(&bytes)?,
-        "stl" => stl::read(&bytes)?,
-        "m" => m::read(&bytes)?,
+    read_by_extension(&bytes, &ext)
+}
+
+/// Reads a mesh as [`read_mesh`] does, and counts the appearance attributes (normals, texture
+/// coordinates, colours, materials) the file holds beyond it, which the mesh does not carry.
+pub fn read_mesh_and_appearance(path: &Path) -> Result<(TriMesh, Appearance)> {
+    let ext = extension(path);
+    let bytes = std::fs::read(path)?;
+    let mesh = read_by_extension(&bytes, &ext)?;
+    let found = appearance::appearance_of(&bytes, &ext, mesh.positions.len(), mesh.faces.len());
+    Ok((mesh, found))
+}
+
+fn read_by_extension(bytes: &[u8], ext: &str) -> Result<TriMesh> {
+    let mesh = match ext {
+        "obj" => obj::read(bytes)?,
+        "ply" => ply::read(bytes)?,
+        "off" => off::read(bytes)?,
+        "stl" => stl::read(bytes)?,
+        "m" => m::read(bytes)?,
         _ => {
             return Err(Error::Unsupported(format!(
                 "mesh format '.{ext}' (readers: {})",

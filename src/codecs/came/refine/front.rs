@@ -853,6 +853,17 @@ impl ViewMesh {
         self.active_on(leaf).map(|v| self.spheres[v as usize].0)
     }
 
+    /// The present triangles: each one's corners' leaf paths (which name the full mesh's
+    /// triangle it stands for) and its corners' positions in the adapted mesh.
+    pub fn present_triangles(&self) -> impl Iterator<Item = ([NodeId; 3], [DVec3; 3])> + '_ {
+        (0..self.present.len())
+            .filter(|&t| self.present[t])
+            .map(|t| {
+                let at = self.corners[t].map(|v| self.spheres[v as usize].0);
+                (self.leaf_corners[t], at)
+            })
+    }
+
     /// The adapted mesh: the active nodes' positions, the present triangles.
     pub fn mesh(&self) -> TriMesh {
         let mut index = vec![NONE; self.ids.len()];
