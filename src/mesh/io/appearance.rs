@@ -111,10 +111,8 @@ fn ply(bytes: &[u8], vertices: usize, faces: usize) -> Appearance {
                 }
                 _ => {}
             },
-            ["property", "list", .., name] if element == "face" => {
-                if name.starts_with("texcoord") {
-                    face_uvs = true;
-                }
+            ["property", "list", .., name] if element == "face" && name.starts_with("texcoord") => {
+                face_uvs = true
             }
             _ => {}
         }
