@@ -37,7 +37,7 @@ def resolve(name):
 
 def canonical_counts(path, quant, tmp):
     stream = tmp / "raw.mc"
-    subprocess.run([str(BIN), "encode", "--codec", "raw", "--quant", str(quant), str(path), str(stream)],
+    subprocess.run([str(BIN), "encode", "--codec", "raw", "--quant", str(quant), "--drop-attributes", str(path), str(stream)],
                    check=True, capture_output=True)
     info = json.loads(subprocess.run([str(BIN), "info", str(stream), "--json"], check=True,
                                      capture_output=True, text=True).stdout)

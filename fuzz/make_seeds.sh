@@ -79,7 +79,7 @@ for codec in raw emc emc-paper pm pm-reordered came came-paper; do
   mkdir -p "$dir"
   for mesh in $seeds/read_obj/torus.obj $seeds/read_off/colour.off; do
     name=$(basename "$mesh"); name=${name%.*}
-    target/release/meshcodec encode --codec "$codec" --quant 10 "$mesh" "$stream" >/dev/null
+    target/release/meshcodec encode --codec "$codec" --quant 10 --drop-attributes "$mesh" "$stream" >/dev/null 2>&1
     tail -c +7 "$stream" > "$dir/$name.body"
   done
 done

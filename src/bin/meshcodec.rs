@@ -202,10 +202,6 @@ fn encode(
             )))
             .with_context(|| path.display().to_string());
         }
-        eprintln!(
-            "note: {}: {appearance} dropped (--drop-attributes)",
-            path.display()
-        );
     }
     let options = encode_options(
         codec,
@@ -221,6 +217,13 @@ fn encode(
         .encode(&canonical)
         .with_context(|| path.display().to_string())?;
     write_atomically(output, &encoded.bytes).with_context(|| output.display().to_string())?;
+    // Said once the stream is written, so that a failure stays one line.
+    if !appearance.is_empty() {
+        eprintln!(
+            "note: {}: {appearance} dropped (--drop-attributes)",
+            path.display()
+        );
+    }
     let bits = encoded.bytes.len() as f64 * 8.0;
     meshcodec::outln!(
         "{}: {} vertices, {} triangles at {} bits -> {} bytes in {} levels ({:.3} bits/vertex, {:.3} bits/triangle)",

@@ -61,16 +61,7 @@ fn read_by_extension(bytes: &[u8], ext: &str) -> Result<TriMesh> {
 
 /// Reads a mesh from bytes in the given format (an extension such as "ply").
 pub fn read_mesh_bytes(bytes: &[u8], format: &str) -> Result<TriMesh> {
-    let mesh = match format {
-        "obj" => obj::read(bytes)?,
-        "ply" => ply::read(bytes)?,
-        "off" => off::read(bytes)?,
-        "stl" => stl::read(bytes)?,
-        "m" => m::read(bytes)?,
-        _ => return Err(Error::Unsupported(format!("mesh format '.{format}'"))),
-    };
-    mesh.validate()?;
-    Ok(mesh)
+    read_by_extension(bytes, format)
 }
 
 /// Writes `mesh` as binary PLY (double positions), OBJ or VRML, by the extension of `path`. The file
