@@ -194,14 +194,12 @@ fn encode(
     let path = resolve(input).with_context(|| input.to_string())?;
     let (mesh, appearance) = meshcodec::mesh::io::read_mesh_and_appearance(&path)
         .with_context(|| path.display().to_string())?;
-    if !appearance.is_empty() {
-        if !drop_attributes {
-            return Err(meshcodec::Error::Unsupported(format!(
-                "holds {appearance}, which {} does not carry (no codec of this build does: positions and triangles only); --drop-attributes encodes the geometry alone",
-                codec.name()
-            )))
-            .with_context(|| path.display().to_string());
-        }
+    if !appearance.is_empty() && !drop_attributes {
+        return Err(meshcodec::Error::Unsupported(format!(
+            "holds {appearance}, which {} does not carry (no codec of this build does: positions and triangles only); --drop-attributes encodes the geometry alone",
+            codec.name()
+        )))
+        .with_context(|| path.display().to_string());
     }
     let options = encode_options(
         codec,
