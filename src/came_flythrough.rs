@@ -134,28 +134,61 @@ fn camera_at(i: usize, centre: DVec3, radius: f64, spot: DVec3) -> Camera {
     }
 }
 
-/// Pixel position of `p` seen by `camera` (`None` behind the eye).
-fn project(camera: &Camera, p: DVec3) -> Option<(f64, f64)> {
-    let forward = (camera.target - camera.eye).normalize();
-    let right = forward.cross(camera.up).normalize();
-    let up = right.cross(forward);
-    let focal = 0.5 * camera.height as f64 / (camera.fov_degrees.to_radians() / 2.0).tan();
-    let d = p - camera.eye;
-    let z = d.dot(forward);
-    (z > 1e-12).then(|| (d.dot(right) / z * focal, d.dot(up) / z * focal))
+/// A camera's projection to pixels (from the centre of the screen), set up once a frame.
+struct Projection {
+    eye: DVec3,
+    forward: DVec3,
+    right: DVec3,
+    up: DVec3,
+    focal: f64,
 }
 
-/// Share of `mesh`'s area whose triangles' centroids `view` sees.
-fn surface_in_view(mesh: &TriMesh, view: &View) -> f64 {
-    let (mut seen, mut all) = (0.0, 0.0);
-    for f in &mesh.faces {
-        let [a, b, c] = mesh.corners(*f);
-        let area = (b - a).cross(c - a).length();
-        all += area;
-        if view.sees((a + b + c) / 3.0, 0.0) {
-            seen += area;
+impl Projection {
+    fn new(camera: &Camera) -> Projection {
+        let forward = (camera.target - camera.eye).normalize();
+        let right = forward.cross(camera.up).normalize();
+        Projection {
+            eye: camera.eye,
+            forward,
+            right,
+            up: right.cross(forward),
+            focal: 0.5 * camera.height as f64 / (camera.fov_degrees.to_radians() / 2.0).tan(),
         }
     }
+
+    /// Pixel position of `p` (`None` behind the eye).
+    fn project(&self, p: DVec3) -> Option<(f64, f64)> {
+        let d = p - self.eye;
+        let z = d.dot(self.forward);
+        (z > 1e-12).then(|| {
+            (
+                d.dot(self.right) / z * self.focal,
+                d.dot(self.up) / z * self.focal,
+            )
+        })
+    }
+}
+
+/// The full mesh's triangles as centroid and area, once for every frame's share in view.
+fn centroids_and_areas(mesh: &TriMesh) -> Vec<(DVec3, f64)> {
+    mesh.faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = mesh.corners(*f);
+            ((a + b + c) / 3.0, (b - a).cross(c - a).length())
+        })
+        .collect()
+}
+
+/// Share of the surface (`triangles`: centroids and areas) whose triangles' centroids `view`
+/// sees.
+fn surface_in_view(triangles: &[(DVec3, f64)], view: &View) -> f64 {
+    let all: f64 = triangles.iter().map(|t| t.1).sum();
+    let seen: f64 = triangles
+        .iter()
+        .filter(|t| view.sees(t.0, 0.0))
+        .map(|t| t.1)
+        .sum();
     if all > 0.0 {
         seen / all
     } else {
@@ -171,6 +204,7 @@ fn measured_error(
     camera: &Camera,
     view: &View,
 ) -> Result<(f64, f64, usize)> {
+    let projection = Projection::new(camera);
     let (mut max, mut sum, mut count) = (0.0f64, 0.0, 0usize);
     for &(id, p) in leaves {
         if !view.sees(p, 0.0) {
@@ -179,7 +213,7 @@ fn measured_error(
         let q = front
             .position_of(id)
             .ok_or_else(|| Error::mesh("a vertex has no place in the adapted mesh"))?;
-        let error = match (project(camera, p), project(camera, q)) {
+        let error = match (projection.project(p), projection.project(q)) {
             (Some(a), Some(b)) => ((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt(),
             // Its stand-in behind the eye: off the screen altogether.
             _ => f64::INFINITY,
@@ -245,8 +279,8 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
             )
         })
         .collect();
-    let (full, _) = codecs::decode(&stream, codecs::Stop::All)?;
-    let full = full.mesh;
+    // `came` is lossless: its full decode is the canonical mesh.
+    let full = canonical.to_mesh();
     drop(tree);
     let path = stream_path();
     std::fs::write(&path, &stream)?;
@@ -292,6 +326,7 @@ fn fly(
         .ok_or_else(|| Error::mesh("an empty mesh"))?;
     let at: std::collections::HashMap<u64, DVec3> =
         leaves.iter().map(|&(id, p)| (id.packed(), p)).collect();
+    let triangles = centroids_and_areas(full);
     let mut front = ViewMesh::open_file(path)?;
     let units = front.fetched().units;
     let mut frames = Vec::with_capacity(FRAMES);
@@ -336,7 +371,7 @@ fn fly(
             wait_ms: wait_s * 1e3,
             bytes_fetched: fetched.bytes_read,
             units_loaded: fetched.units_loaded,
-            surface_in_view: surface_in_view(full, &view),
+            surface_in_view: surface_in_view(&triangles, &view),
             fold_overs: fold_overs(&front, &at),
             visible_vertices,
             max_error_px,

@@ -4,7 +4,7 @@
 
 use crate::codecs::{self, Codec, EncodeOptions, LevelDecoder};
 use crate::error::{Error, Result};
-use crate::mesh::io::{mesh_name, read_mesh};
+use crate::mesh::io::{mesh_name, read_mesh_and_appearance};
 use crate::mesh::quantize::GridShape;
 use crate::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
 use crate::plot;
@@ -54,11 +54,13 @@ pub struct RunOutput {
     pub result: RunResult,
     /// The encoded stream.
     pub stream: Vec<u8>,
+    /// What the file holds beyond the geometry measured (not coded).
+    pub appearance: crate::mesh::io::Appearance,
 }
 
 /// Runs `codec` on the mesh file at `path`.
 pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOutput> {
-    let original = read_mesh(path)?;
+    let (original, appearance) = read_mesh_and_appearance(path)?;
     let encode = encode_options(codec, options);
     let canonical = codecs::canonical_for(&original, &encode)?;
 
@@ -129,6 +131,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
     Ok(RunOutput {
         result,
         stream: encoded.bytes,
+        appearance,
     })
 }
 

@@ -157,9 +157,12 @@ fn run_codec(
     out: &Path,
     keep_stream: bool,
 ) -> Result<RunResult> {
+    let harness::RunOutput {
+        result,
+        stream,
+        appearance,
+    } = harness::run(codec, path, options).with_context(|| path.display().to_string())?;
     // The harness measures geometry; what else the file holds is said, not dropped unseen.
-    let (_, appearance) = meshcodec::mesh::io::read_mesh_and_appearance(path)
-        .with_context(|| path.display().to_string())?;
     if !appearance.is_empty() {
         eprintln!(
             "note: {}: {appearance} not coded ({} carries positions and triangles only)",
@@ -167,8 +170,6 @@ fn run_codec(
             codec.name()
         );
     }
-    let harness::RunOutput { result, stream } =
-        harness::run(codec, path, options).with_context(|| path.display().to_string())?;
     meshcodec::outln!(
         "{} on {} ({}): {} vertices, {} triangles at {} bits; {} bytes = {:.3} bits/vertex, \
          {:.3} bits/triangle",

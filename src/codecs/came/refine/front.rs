@@ -715,9 +715,8 @@ impl ViewMesh {
                     self.refine_down(v, view, budget, done, &mut below);
                 }
             }
-            self.waiting_nodes = waiting;
-            self.waiting_nodes.clear();
-            self.waiting_nodes.append(&mut self.waited_now);
+            // The splits still waiting are the next list; the old one's buffer is reused.
+            self.waiting_nodes = std::mem::replace(&mut self.waited_now, waiting);
             if done.waiting == 0 {
                 done.settled = !done.capped;
             } else {

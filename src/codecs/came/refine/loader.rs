@@ -306,9 +306,6 @@ impl Loader {
                 )))
             }
         };
-        if index.is_empty() {
-            return Err(Error::malformed(0, start, "a CAME stream has no units"));
-        }
         let mut worker = Box::new(Worker {
             source,
             head,
@@ -318,6 +315,7 @@ impl Loader {
             payload_start,
             size,
         });
+        // The index lists a unit at least (`Index::read` refuses one that lists none).
         let root = worker.load(0);
         let loader = match fetch {
             Fetch::Inline => Loader::Inline {
