@@ -43,7 +43,7 @@ pub mod came_flythrough;
 pub mod cli;
 #[cfg(feature = "lab")]
 pub mod harness;
-#[cfg(feature = "lab")]
+#[cfg(feature = "metrics")]
 pub mod metrics;
 #[cfg(feature = "lab")]
 pub mod plot;

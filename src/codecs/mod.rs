@@ -96,10 +96,24 @@ pub trait Codec: Send + Sync {
     /// Codec-specific measurements of an encoded stream (PM: iteration rates), stored with the
     /// run's results; codecs with none return an empty set.
     fn measure(&self, stream: &[u8]) -> Result<Stats>;
+    /// How many bytes of the stream, from its first, decoding each level needs (entry k for
+    /// level k + 1): where a reader of a stream still arriving can decode the next level. From
+    /// the header and index alone; this default is for streams whose units are their levels.
+    fn level_ends(&self, stream: &StreamReader) -> Result<Vec<u64>> {
+        stream.require_layered()?;
+        let start = stream.payload_start() as u64;
+        Ok(stream
+            .index()
+            .units
+            .iter()
+            .map(|u| start + u.end())
+            .collect())
+    }
 }
 
-/// Walks a stream level by level.
-pub trait LevelDecoder {
+/// Walks a stream level by level. `Send`, so a decoder can move to another thread (the Python
+/// package decodes with the interpreter's lock released).
+pub trait LevelDecoder: Send {
     /// The stream's header.
     fn header(&self) -> &Header;
     /// Levels the stream holds when whole.
@@ -196,6 +210,13 @@ pub fn canonical_for(mesh: &TriMesh, options: &EncodeOptions) -> Result<Canonica
 pub fn open(bytes: &[u8]) -> Result<Box<dyn LevelDecoder + '_>> {
     let reader = StreamReader::open(bytes)?;
     by_id(reader.header().codec_id)?.decoder(reader)
+}
+
+/// The bytes each level of a stream needs ([`Codec::level_ends`]), from a prefix holding at
+/// least its header and index ([`Error::Truncated`] when it does not yet).
+pub fn level_ends(bytes: &[u8]) -> Result<Vec<u64>> {
+    let reader = StreamReader::open(bytes)?;
+    by_id(reader.header().codec_id)?.level_ends(&reader)
 }
 
 /// Where to stop decoding.

@@ -618,7 +618,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
     }
 }
 
-impl<U: UnitDecoder> LevelDecoder for CameDecoder<'_, U> {
+impl<U: UnitDecoder + Send> LevelDecoder for CameDecoder<'_, U> {
     fn header(&self) -> &Header {
         &self.header
     }

@@ -41,6 +41,46 @@ use crate::hierarchy::came::{build, BuildOptions, VertexTree};
 use crate::mesh::CanonicalMesh;
 use partition::Partition;
 
+/// The bytes each level (front depth) of a CAME stream needs: the front at depth k needs every
+/// unit whose root lies above depth k, and a unit's root lies L levels below its parent's.
+/// Units come in the order their roots deepen (docs/FORMAT.md §9), so level k needs the stream
+/// up to the end of the last such unit.
+pub fn level_ends(stream: &crate::container::StreamReader, params: &Params) -> Result<Vec<u64>> {
+    let units = &stream.index().units;
+    let mut root_depth: Vec<u64> = Vec::with_capacity(units.len());
+    for (i, unit) in units.iter().enumerate() {
+        let depth = match unit.parent {
+            None if i == 0 => 0,
+            Some(p) if p < i => root_depth[p] + params.meta_levels as u64,
+            _ => {
+                return Err(Error::malformed(
+                    0,
+                    stream.payload_start(),
+                    format!("unit {i} hangs from no unit before it"),
+                ))
+            }
+        };
+        root_depth.push(depth);
+    }
+    // The last byte of a unit rooted at each depth, then the furthest of those above each level.
+    let levels = params.depth as usize;
+    let mut last_at_depth = vec![0u64; levels];
+    for (unit, &depth) in units.iter().zip(&root_depth) {
+        if let Some(last) = last_at_depth.get_mut(depth as usize) {
+            *last = (*last).max(unit.end());
+        }
+    }
+    let start = stream.payload_start() as u64;
+    let mut furthest = 0;
+    Ok(last_at_depth
+        .iter()
+        .map(|&end| {
+            furthest = furthest.max(end);
+            start + furthest
+        })
+        .collect())
+}
+
 /// The whole hierarchy of a stream of either CAME codec, every unit decoded, with its header.
 pub fn decode_tree(bytes: &[u8]) -> Result<(Header, decoded::DecodedTree)> {
     let reader = crate::container::StreamReader::open(bytes)?;

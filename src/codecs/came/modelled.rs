@@ -153,6 +153,10 @@ impl Codec for Came {
         })
     }
 
+    fn level_ends(&self, stream: &StreamReader) -> Result<Vec<u64>> {
+        super::level_ends(stream, &params(stream.header())?)
+    }
+
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
         let params = params(stream.header())?;
         Ok(Box::new(CameDecoder::new(stream, params, ModelledUnits)?))

@@ -14,7 +14,7 @@ use glam::DVec3;
 
 /// Reads vsplit records one at a time from a stream's levels.
 struct SplitReader<'a> {
-    source: Box<dyn LevelSource + 'a>,
+    source: Box<dyn LevelSource + Send + 'a>,
     contexts: SplitContexts,
     coder: Option<ArithDecoder>,
     left_in_level: u64,
@@ -93,11 +93,11 @@ impl<'a> PMeshIter<'a> {
 
     /// An iterator at M⁰ of a stream read from `reader` (a file, a socket) as records are needed:
     /// Hoppe's PMeshRStream over an input stream. Records read are kept, so `prev` works.
-    pub fn from_reader(reader: impl std::io::Read + 'a) -> Result<PMeshIter<'a>> {
+    pub fn from_reader(reader: impl std::io::Read + Send + 'a) -> Result<PMeshIter<'a>> {
         Self::from_source(Box::new(ReadLevels::open(reader)?))
     }
 
-    fn from_source(mut stream: Box<dyn LevelSource + 'a>) -> Result<PMeshIter<'a>> {
+    fn from_source(mut stream: Box<dyn LevelSource + Send + 'a>) -> Result<PMeshIter<'a>> {
         let header = stream.header().clone();
         let params = PmParams::from_header(&header)?;
         let base = stream

@@ -1,0 +1,322 @@
+"""meshcodec: progressive triangle-mesh compression over numpy arrays.
+
+The codecs of the Rust crate of the same name — EMC (Magnor & Girod's embedded mesh coding, as
+published and context-modelled), Hoppe's progressive meshes, Grabner's CAME vertex hierarchy and
+the uncompressed baseline — with the guarantees of its docs/CONTRACT.md: a mesh is quantized to
+a grid of ``quant_bits`` bits per axis, every lossless codec's full decode is exactly that
+quantized ("canonical") mesh, and any prefix of a stream decodes to the levels it holds.
+
+>>> import numpy as np, meshcodec
+>>> v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+>>> f = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+>>> stream = meshcodec.encode(v, f, codec="emc")
+>>> mesh = meshcodec.decode(stream)
+>>> mesh.faces.shape
+(4, 3)
+
+Errors in the input — arrays of the wrong shape or dtype, NaN, an index out of range, a
+corrupt stream — raise :class:`MeshcodecError` (a :class:`ValueError`) with the library's
+one-line message; a stream that ends too soon raises its subclass
+:class:`TruncatedStreamError`. The interpreter's lock is released while meshes are encoded,
+decoded, read, written or measured, so threads run codecs in parallel.
+"""
+
+from __future__ import annotations
+
+import bisect
+import os
+from dataclasses import dataclass
+from typing import IO, Any, Dict, Iterator, List, Optional, Union
+
+import numpy as np
+
+from . import _core
+from ._core import FORMAT_VERSION, MeshcodecError, TruncatedStreamError
+
+__all__ = [
+    "FORMAT_VERSION",
+    "Mesh",
+    "MeshcodecError",
+    "TruncatedStreamError",
+    "codecs",
+    "decode",
+    "distance",
+    "encode",
+    "info",
+    "level_ends",
+    "levels",
+    "load",
+    "save",
+]
+
+Bytes = Union[bytes, bytearray, memoryview]
+PathLike = Union[str, "os.PathLike[str]"]
+
+# What `encode` accepts beyond the arrays, codec and quantization.
+_CODEC_OPTIONS = ("grid",)
+# Appearance arrays no codec of this build carries.
+_ATTRIBUTES = ("normals", "uvs", "colors", "colours", "materials")
+
+
+@dataclass
+class Mesh:
+    """A triangle mesh: positions, faces and, for a coarse level, edges on no face.
+
+    Attributes:
+        vertices: float64 array (n, 3).
+        faces: uint32 array (m, 3), counter-clockwise seen from the front.
+        loose_edges: uint32 array (k, 2): edges of a decoded level that belong to no face (an
+            embedded coder's coarse levels may have edges before triangles); empty otherwise.
+        level: the levels decoded (None for a mesh not decoded from a stream).
+        levels: the levels the whole stream holds (None likewise).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    loose_edges: Optional[np.ndarray] = None
+    level: Optional[int] = None
+    levels: Optional[int] = None
+
+    def __post_init__(self) -> None:
+        if self.loose_edges is None:
+            self.loose_edges = np.zeros((0, 2), dtype=np.uint32)
+
+    @property
+    def vertex_count(self) -> int:
+        return int(self.vertices.shape[0])
+
+    @property
+    def face_count(self) -> int:
+        return int(self.faces.shape[0])
+
+    def __repr__(self) -> str:
+        at = "" if self.level is None else f", level {self.level} of {self.levels}"
+        return f"Mesh({self.vertex_count} vertices, {self.face_count} faces{at})"
+
+
+def _mesh(arrays: Any, level: Optional[int] = None, levels: Optional[int] = None) -> Mesh:
+    vertices, faces, loose_edges = arrays
+    return Mesh(vertices, faces, loose_edges, level, levels)
+
+
+def _vertices(vertices: Any, name: str = "vertices") -> np.ndarray:
+    array = np.asarray(vertices)
+    if array.dtype.kind not in "fiu":
+        raise MeshcodecError(f"{name} must be numbers, not {array.dtype}")
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise MeshcodecError(f"{name} must be an (n, 3) array, not {array.shape}")
+    return np.ascontiguousarray(array, dtype=np.float64)
+
+
+def _faces(faces: Any, name: str = "faces") -> np.ndarray:
+    array = np.asarray(faces)
+    if array.dtype.kind not in "iu":
+        raise MeshcodecError(f"{name} must be integers, not {array.dtype}")
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise MeshcodecError(f"{name} must be an (m, 3) array, not {array.shape}")
+    if array.dtype == np.uint64 and array.size and array.max() > np.iinfo(np.int64).max:
+        raise MeshcodecError(f"{name} holds an index beyond any vertex")
+    return np.ascontiguousarray(array, dtype=np.int64)
+
+
+def _stream(stream: Any) -> bytes:
+    if isinstance(stream, bytes):
+        return stream
+    if isinstance(stream, (bytearray, memoryview)):
+        return bytes(stream)
+    raise MeshcodecError(f"a stream is bytes, not {type(stream).__name__}")
+
+
+def _arrays_of(mesh: Any, name: str) -> tuple:
+    if isinstance(mesh, Mesh):
+        return _vertices(mesh.vertices, name), _faces(mesh.faces, name)
+    if isinstance(mesh, tuple) and len(mesh) == 2:
+        return _vertices(mesh[0], name), _faces(mesh[1], name)
+    raise MeshcodecError(f"{name} must be a Mesh or a (vertices, faces) pair")
+
+
+def encode(
+    vertices: Any,
+    faces: Any,
+    codec: str = "emc",
+    quant_bits: int = 12,
+    **codec_options: Any,
+) -> bytes:
+    """Encodes a mesh; returns the stream.
+
+    Args:
+        vertices: (n, 3) positions, any float or integer dtype.
+        faces: (m, 3) vertex indices, any integer dtype, counter-clockwise.
+        codec: a name from :func:`codecs` ("emc", "emc-paper", "pm", "pm-reordered", "came",
+            "came-paper", "raw").
+        quant_bits: bits per axis of the quantization grid (1 to 24 as the codec allows).
+        grid: "cubic" (one cell size on every axis, the default) or "per-axis".
+        drop_attributes: must be True to pass appearance arrays (normals=, uvs=, colors=,
+            materials=) the codec does not carry; they are then left out, never coded.
+
+    Raises:
+        MeshcodecError: bad arrays, an unknown codec or option, a mesh the codec refuses
+            (``pm`` takes oriented manifolds only), or attributes it would drop.
+    """
+    drop = bool(codec_options.pop("drop_attributes", False))
+    given = [k for k in _ATTRIBUTES if codec_options.get(k) is not None]
+    for key in _ATTRIBUTES:
+        codec_options.pop(key, None)
+    if given and not drop:
+        raise MeshcodecError(
+            f"codec {codec} does not carry {', '.join(given)}; "
+            "pass drop_attributes=True to encode positions and faces only"
+        )
+    unknown = sorted(set(codec_options) - set(_CODEC_OPTIONS))
+    if unknown:
+        raise MeshcodecError(
+            f"unknown option {', '.join(unknown)} (options: {', '.join(_CODEC_OPTIONS)})"
+        )
+    if isinstance(quant_bits, bool) or not isinstance(quant_bits, (int, np.integer)):
+        raise MeshcodecError(f"quant_bits must be an integer, not {quant_bits!r}")
+    if not 1 <= quant_bits <= 32:
+        raise MeshcodecError(f"quant_bits {quant_bits} is outside 1..32")
+    return _core.encode(
+        _vertices(vertices),
+        _faces(faces),
+        codec,
+        int(quant_bits),
+        codec_options.get("grid"),
+    )
+
+
+def decode(stream: Bytes, level: Optional[int] = None, nbytes: Optional[int] = None) -> Mesh:
+    """Decodes a stream, or any prefix of it.
+
+    Args:
+        stream: the stream's bytes (a prefix decodes to the levels it holds; codecs that can
+            also decode part of a cut level, as EMC, do so when ``level`` is None).
+        level: stop after this many levels (None: every level present).
+        nbytes: decode only the first ``nbytes`` bytes, as if the rest had not arrived.
+
+    Returns:
+        The :class:`Mesh`, with ``level`` the levels decoded and ``levels`` the stream's.
+    """
+    if level is not None and (isinstance(level, bool) or level < 0):
+        raise MeshcodecError(f"level must be a count of levels, not {level!r}")
+    if nbytes is not None and (isinstance(nbytes, bool) or nbytes < 0):
+        raise MeshcodecError(f"nbytes must be a count of bytes, not {nbytes!r}")
+    arrays, decoded, total = _core.decode(_stream(stream), level, nbytes)
+    return _mesh(arrays, decoded, total)
+
+
+def levels(stream: Union[Bytes, IO[bytes]], chunk_size: int = 1 << 16) -> Iterator[Mesh]:
+    """The meshes of a stream's successive levels, coarse to fine.
+
+    ``stream`` is either the stream's bytes — each level then decodes from the one before —
+    or a binary file-like object (a file, a socket's ``makefile("rb")``, anything with
+    ``read``) whose bytes may still be arriving: each level is yielded as soon as the bytes it
+    needs (:func:`level_ends`) have been read, ``chunk_size`` bytes at a time. A stream that
+    ends early yields the levels it holds and stops.
+    """
+    if isinstance(stream, (bytes, bytearray, memoryview)):
+        return _levels_of_bytes(_stream(stream))
+    if not hasattr(stream, "read"):
+        raise MeshcodecError(f"levels() takes bytes or a file-like object, not {type(stream).__name__}")
+    return _levels_arriving(stream, chunk_size)
+
+
+def _levels_of_bytes(stream: bytes) -> Iterator[Mesh]:
+    it = _core.LevelIterator(stream)
+    for arrays, level in it:
+        yield _mesh(arrays, level, it.levels)
+
+
+def _levels_arriving(source: IO[bytes], chunk_size: int) -> Iterator[Mesh]:
+    if chunk_size < 1:
+        raise MeshcodecError("chunk_size must be at least 1")
+    buffer = bytearray()
+    ends: Optional[List[int]] = None
+    done = 0
+    while True:
+        chunk = source.read(chunk_size)
+        finished = not chunk
+        buffer.extend(chunk or b"")
+        if ends is None:
+            try:
+                ends = _core.level_ends(bytes(buffer))
+            except TruncatedStreamError:
+                if finished:
+                    raise
+                continue
+        ready = bisect.bisect_right(ends, len(buffer))
+        if ready > done:
+            # A decoder over what has arrived walks up to the last level it completes (the
+            # levels before are decoded again: a decoder cannot follow a growing buffer).
+            it = _core.LevelIterator(bytes(buffer))
+            for arrays, level in it:
+                if level > done:
+                    yield _mesh(arrays, level, it.levels)
+                    done = level
+                if level >= ready:
+                    break
+        if finished or done >= len(ends):
+            return
+
+
+def level_ends(stream: Bytes) -> List[int]:
+    """Bytes of the stream, from its first, that decoding each level needs (entry k for level
+    k + 1), from a prefix that holds at least the header and index."""
+    return list(_core.level_ends(_stream(stream)))
+
+
+def info(stream: Bytes) -> Dict[str, Any]:
+    """What a stream's header and index say, without decoding it: codec, format version,
+    quantization grid, vertex and triangle counts, levels and the bytes each needs, and every
+    unit (for CAME: every meta-node) with its parent and byte range."""
+    return _core.info(_stream(stream))
+
+
+def load(path: PathLike, drop_attributes: bool = False) -> Mesh:
+    """Reads a mesh file (PLY, OBJ, OFF, .m, STL) as positions and faces.
+
+    A file that also holds normals, texture coordinates, colours or materials is refused,
+    naming them, unless ``drop_attributes=True``: meshcodec does not carry them yet, and
+    never drops them unasked.
+    """
+    return _mesh(_core.load(os.fspath(path), bool(drop_attributes)))
+
+
+def save(mesh: Union[Mesh, tuple], path: PathLike) -> None:
+    """Writes a mesh (a :class:`Mesh` or a (vertices, faces) pair) as binary PLY, OBJ or VRML
+    by the extension of ``path``; the file appears only when complete."""
+    vertices, faces = _arrays_of(mesh, "mesh")
+    _core.save(vertices, faces, os.fspath(path))
+
+
+def distance(
+    a: Union[Mesh, tuple],
+    b: Union[Mesh, tuple],
+    samples: int = 10,
+    seed: Optional[int] = None,
+) -> Dict[str, float]:
+    """Distances both ways between a reference mesh ``a`` and a mesh ``b``.
+
+    Both surfaces are sampled (``samples`` random points per triangle of ``a`` plus its
+    vertices, as many on ``b``) and each sample's exact distance to the other surface is
+    taken through a BVH, as the experiment harness measures levels (docs/CONTRACT.md §5).
+
+    Returns:
+        ``hausdorff`` (symmetric), ``rms`` (over both directions) and ``hausdorff_paper``
+        (largest distance of a vertex of ``a`` to ``b``, EMC's measure), each over the
+        bounding-box diagonal of ``a``; the same absolute as ``hausdorff_absolute`` and
+        ``rms_absolute``; ``diagonal``.
+    """
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+        raise MeshcodecError(f"samples must be a positive integer, not {samples!r}")
+    av, af = _arrays_of(a, "a")
+    bv, bf = _arrays_of(b, "b")
+    if seed is None:
+        return _core.distance(av, af, bv, bf, int(samples))
+    return _core.distance(av, af, bv, bf, int(samples), int(seed))
+
+
+def codecs() -> List[Dict[str, Any]]:
+    """Every codec of this build: name, id, summary, default ``quant_bits`` and grid, whether
+    its full decode is lossless, and what it does beyond level-by-level decoding."""
+    return list(_core.codec_list())

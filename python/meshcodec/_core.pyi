@@ -1,0 +1,47 @@
+"""Type stubs of the compiled core (python/src/lib.rs); use the wrappers in meshcodec."""
+
+from typing import Any, Dict, Iterator, List, Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+FORMAT_VERSION: int
+
+class MeshcodecError(ValueError): ...
+class TruncatedStreamError(MeshcodecError): ...
+
+_Arrays = Tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]
+
+def encode(
+    vertices: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    codec_name: str,
+    quant_bits: int,
+    grid: Optional[str] = None,
+) -> bytes: ...
+def decode(
+    stream: bytes, level: Optional[int] = None, nbytes: Optional[int] = None
+) -> Tuple[_Arrays, int, int]: ...
+
+class LevelIterator(Iterator[Tuple[_Arrays, int]]):
+    def __init__(self, stream: bytes) -> None: ...
+    @property
+    def levels(self) -> int: ...
+    def __iter__(self) -> "LevelIterator": ...
+    def __next__(self) -> Tuple[_Arrays, int]: ...
+
+def level_ends(stream: bytes) -> List[int]: ...
+def info(stream: bytes) -> Dict[str, Any]: ...
+def load(path: str, drop_attributes: bool = False) -> _Arrays: ...
+def save(
+    vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64], path: str
+) -> None: ...
+def distance(
+    a_vertices: npt.NDArray[np.float64],
+    a_faces: npt.NDArray[np.int64],
+    b_vertices: npt.NDArray[np.float64],
+    b_faces: npt.NDArray[np.int64],
+    samples: int = 10,
+    seed: int = ...,
+) -> Dict[str, float]: ...
+def codec_list() -> List[Dict[str, Any]]: ...
