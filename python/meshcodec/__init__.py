@@ -36,6 +36,7 @@ from ._core import FORMAT_VERSION, MeshcodecError, TruncatedStreamError
 __all__ = [
     "FORMAT_VERSION",
     "Mesh",
+    "canonical",
     "MeshcodecError",
     "TruncatedStreamError",
     "codecs",
@@ -119,6 +120,15 @@ def _faces(faces: Any, name: str = "faces") -> np.ndarray:
     return np.ascontiguousarray(array, dtype=np.int64)
 
 
+def _bits(quant_bits: Any) -> int:
+    if isinstance(quant_bits, bool) or not isinstance(quant_bits, (int, np.integer)):
+        raise MeshcodecError(f"quant_bits must be an integer, not {quant_bits!r}")
+    if not 0 <= quant_bits <= 255:
+        # The library names the range it supports; this only keeps the value a byte.
+        raise MeshcodecError(f"quantization of {quant_bits} bits is not supported")
+    return int(quant_bits)
+
+
 def _stream(stream: Any) -> bytes:
     if isinstance(stream, bytes):
         return stream
@@ -172,17 +182,21 @@ def encode(
         raise MeshcodecError(
             f"unknown option {', '.join(unknown)} (options: {', '.join(_CODEC_OPTIONS)})"
         )
-    if isinstance(quant_bits, bool) or not isinstance(quant_bits, (int, np.integer)):
-        raise MeshcodecError(f"quant_bits must be an integer, not {quant_bits!r}")
-    if not 1 <= quant_bits <= 32:
-        raise MeshcodecError(f"quant_bits {quant_bits} is outside 1..32")
     return _core.encode(
         _vertices(vertices),
         _faces(faces),
         codec,
-        int(quant_bits),
+        _bits(quant_bits),
         codec_options.get("grid"),
     )
+
+
+def canonical(vertices: Any, faces: Any, quant_bits: int = 12, grid: str = "cubic") -> Mesh:
+    """The canonical mesh at ``quant_bits`` (docs/CONTRACT.md §2): unreferenced vertices
+    dropped, positions quantized to cell centres, vertices sharing a cell welded, faces that
+    then repeat a vertex or another face dropped. A lossless codec's full decode is exactly
+    this mesh, up to the order of vertices and faces and the rotation of each face."""
+    return _mesh(_core.canonical(_vertices(vertices), _faces(faces), _bits(quant_bits), grid))
 
 
 def decode(stream: Bytes, level: Optional[int] = None, nbytes: Optional[int] = None) -> Mesh:

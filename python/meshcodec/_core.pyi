@@ -19,6 +19,12 @@ def encode(
     quant_bits: int,
     grid: Optional[str] = None,
 ) -> bytes: ...
+def canonical(
+    vertices: npt.NDArray[np.float64],
+    faces: npt.NDArray[np.int64],
+    quant_bits: int,
+    grid: Optional[str] = None,
+) -> _Arrays: ...
 def decode(
     stream: bytes, level: Optional[int] = None, nbytes: Optional[int] = None
 ) -> Tuple[_Arrays, int, int]: ...

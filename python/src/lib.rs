@@ -157,6 +157,42 @@ fn encode<'py>(
     Ok(PyBytes::new(py, &bytes))
 }
 
+/// The canonical mesh of `vertices` and `faces` at `quant_bits` (docs/CONTRACT.md §2): what a
+/// lossless codec's full decode is, positions at cell centres.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, quant_bits, grid=None))]
+fn canonical<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, i64>,
+    quant_bits: u8,
+    grid: Option<&str>,
+) -> PyResult<MeshArrays<'py>> {
+    let options = EncodeOptions {
+        quant_bits,
+        grid: match grid {
+            None | Some("cubic") => GridShape::Cubic,
+            Some("per-axis") => GridShape::PerAxis,
+            Some(other) => {
+                return Err(refuse(format!(
+                    "unknown grid '{other}' (cubic, per-axis)"
+                )))
+            }
+        },
+    };
+    let mesh = mesh_of(&vertices, &faces)?;
+    let canonical = py
+        .detach(|| codecs::canonical_for(&mesh, &options).map(|c| c.to_mesh()))
+        .map_err(to_py)?;
+    Ok(arrays(
+        py,
+        LevelMesh {
+            mesh: canonical,
+            loose_edges: Vec::new(),
+        },
+    ))
+}
+
 /// Decodes a stream (or its first `nbytes`) up to `level` levels (all present when `None`);
 /// returns the arrays, the levels decoded and the levels the whole stream holds.
 #[pyfunction]
@@ -417,6 +453,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<LevelIterator>()?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(decode, m)?)?;
+    m.add_function(wrap_pyfunction!(canonical, m)?)?;
     m.add_function(wrap_pyfunction!(level_ends, m)?)?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
