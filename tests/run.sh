@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The test suite, from a clean clone: installs what it needs, then runs the Rust tests (unit,
-# integration, property, doc) and the Open3D cross-check of the metrics.
+# integration, property, doc), the Python package's suite and examples, and the Open3D
+# cross-check of the metrics.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -15,5 +16,7 @@ if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
 .venv/bin/pip install -q --disable-pip-version-check -r tests/requirements.txt
+# The Python package, built as a user builds it (maturin, release, in this workspace's target/).
+.venv/bin/pip install -q --disable-pip-version-check ./python
 # -p no:dash: a pytest plugin pulled in by Open3D's dependencies, not used here.
-.venv/bin/python -m pytest -q -p no:dash tests/
+.venv/bin/python -m pytest -q -p no:dash tests/ python/tests/

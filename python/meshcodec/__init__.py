@@ -309,7 +309,8 @@ def distance(
     samples: int = 10,
     seed: Optional[int] = None,
 ) -> Dict[str, float]:
-    """Distances both ways between a reference mesh ``a`` and a mesh ``b``.
+    """Distances both ways between a reference mesh ``a`` and a mesh ``b`` (a decoded level
+    counts its loose edges, and may have no face yet).
 
     Both surfaces are sampled (``samples`` random points per triangle of ``a`` plus its
     vertices, as many on ``b``) and each sample's exact distance to the other surface is
@@ -325,9 +326,11 @@ def distance(
         raise MeshcodecError(f"samples must be a positive integer, not {samples!r}")
     av, af = _arrays_of(a, "a")
     bv, bf = _arrays_of(b, "b")
+    edges = b.loose_edges if isinstance(b, Mesh) else None
+    be = np.zeros((0, 2), dtype=np.int64) if edges is None else np.ascontiguousarray(edges, dtype=np.int64)
     if seed is None:
-        return _core.distance(av, af, bv, bf, int(samples))
-    return _core.distance(av, af, bv, bf, int(samples), int(seed))
+        return _core.distance(av, af, bv, bf, be, int(samples))
+    return _core.distance(av, af, bv, bf, be, int(samples), int(seed))
 
 
 def codecs() -> List[Dict[str, Any]]:

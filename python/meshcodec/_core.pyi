@@ -47,6 +47,7 @@ def distance(
     a_faces: npt.NDArray[np.int64],
     b_vertices: npt.NDArray[np.float64],
     b_faces: npt.NDArray[np.int64],
+    b_edges: npt.NDArray[np.int64],
     samples: int = 10,
     seed: int = ...,
 ) -> Dict[str, float]: ...

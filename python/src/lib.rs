@@ -52,6 +52,14 @@ fn refuse(what: impl Into<String>) -> PyErr {
 /// The mesh of `vertices` and `faces`, checked as the readers check a file's: finite
 /// coordinates, corners within the vertices.
 fn mesh_of(vertices: &PyReadonlyArray2<f64>, faces: &PyReadonlyArray2<i64>) -> PyResult<TriMesh> {
+    let mesh = level_of(vertices, faces)?;
+    mesh.validate().map_err(to_py)?;
+    Ok(mesh)
+}
+
+/// `vertices` and `faces` as a decoded level may be: corners within the vertices, but perhaps
+/// no face yet (the caller checks the coordinates).
+fn level_of(vertices: &PyReadonlyArray2<f64>, faces: &PyReadonlyArray2<i64>) -> PyResult<TriMesh> {
     let (v, f) = (vertices.as_array(), faces.as_array());
     if v.ncols() != 3 || f.ncols() != 3 {
         return Err(refuse(format!(
@@ -79,9 +87,31 @@ fn mesh_of(vertices: &PyReadonlyArray2<f64>, faces: &PyReadonlyArray2<i64>) -> P
         }
         triangles.push(face);
     }
-    let mesh = TriMesh::new(positions, triangles);
-    mesh.validate().map_err(to_py)?;
-    Ok(mesh)
+    Ok(TriMesh::new(positions, triangles))
+}
+
+/// Edges on no face, (k, 2), within `vertices` vertices.
+fn edges_of(edges: &PyReadonlyArray2<i64>, vertices: usize) -> PyResult<Vec<[u32; 2]>> {
+    let e = edges.as_array();
+    if e.ncols() != 2 {
+        return Err(refuse(format!(
+            "loose edges must be (k, 2), not {:?}",
+            e.shape()
+        )));
+    }
+    e.rows()
+        .into_iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let ends = [r[0], r[1]];
+            if ends.iter().any(|&x| !(0..vertices as i64).contains(&x)) {
+                return Err(refuse(format!(
+                    "loose edge {i} {ends:?} out of range ({vertices} vertices)"
+                )));
+            }
+            Ok(ends.map(|x| x as u32))
+        })
+        .collect()
 }
 
 /// Positions (n, 3) float64, faces (m, 3) uint32 and loose edges (k, 2) uint32 as numpy arrays
@@ -368,10 +398,10 @@ fn save<'py>(
         .map_err(|e| about_file(e, &path))
 }
 
-/// Distances both ways between mesh `a` (the reference) and mesh `b`, over samples of both
-/// surfaces (docs/CONTRACT.md §5).
+/// Distances both ways between mesh `a` (the reference) and mesh `b` — a decoded level, which
+/// may have loose edges and even no face yet — over samples of both (docs/CONTRACT.md §5).
 #[pyfunction]
-#[pyo3(signature = (a_vertices, a_faces, b_vertices, b_faces, samples=DEFAULT_SAMPLES_PER_TRIANGLE, seed=DEFAULT_SEED))]
+#[pyo3(signature = (a_vertices, a_faces, b_vertices, b_faces, b_edges, samples=DEFAULT_SAMPLES_PER_TRIANGLE, seed=DEFAULT_SEED))]
 #[allow(clippy::too_many_arguments)]
 fn distance<'py>(
     py: Python<'py>,
@@ -379,6 +409,7 @@ fn distance<'py>(
     a_faces: PyReadonlyArray2<'py, i64>,
     b_vertices: PyReadonlyArray2<'py, f64>,
     b_faces: PyReadonlyArray2<'py, i64>,
+    b_edges: PyReadonlyArray2<'py, i64>,
     samples: usize,
     seed: u64,
 ) -> PyResult<Bound<'py, PyDict>> {
@@ -386,10 +417,12 @@ fn distance<'py>(
         return Err(refuse("samples must be at least 1 a triangle"));
     }
     let a = mesh_of(&a_vertices, &a_faces)?;
-    let b = LevelMesh {
-        mesh: mesh_of(&b_vertices, &b_faces)?,
-        loose_edges: Vec::new(),
-    };
+    let mesh = level_of(&b_vertices, &b_faces)?;
+    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(refuse(format!("vertex {i} of b has a non-finite coordinate")));
+    }
+    let loose_edges = edges_of(&b_edges, mesh.positions.len())?;
+    let b = LevelMesh { mesh, loose_edges };
     let (measured, diagonal) = py.detach(|| {
         let reference = Reference::new(&a, samples, seed);
         let diagonal = a.referenced_bounds().map_or(0.0, |b| b.diagonal());
