@@ -52,6 +52,8 @@ pub mod render;
 #[cfg(feature = "lab")]
 pub mod results;
 #[cfg(feature = "lab")]
+pub mod sweep;
+#[cfg(feature = "lab")]
 pub mod tables;
 
 pub use error::{Error, Result};

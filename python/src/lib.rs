@@ -203,11 +203,7 @@ fn canonical<'py>(
         grid: match grid {
             None | Some("cubic") => GridShape::Cubic,
             Some("per-axis") => GridShape::PerAxis,
-            Some(other) => {
-                return Err(refuse(format!(
-                    "unknown grid '{other}' (cubic, per-axis)"
-                )))
-            }
+            Some(other) => return Err(refuse(format!("unknown grid '{other}' (cubic, per-axis)"))),
         },
     };
     let mesh = mesh_of(&vertices, &faces)?;
@@ -419,7 +415,9 @@ fn distance<'py>(
     let a = mesh_of(&a_vertices, &a_faces)?;
     let mesh = level_of(&b_vertices, &b_faces)?;
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
-        return Err(refuse(format!("vertex {i} of b has a non-finite coordinate")));
+        return Err(refuse(format!(
+            "vertex {i} of b has a non-finite coordinate"
+        )));
     }
     let loose_edges = edges_of(&b_edges, mesh.positions.len())?;
     let b = LevelMesh { mesh, loose_edges };

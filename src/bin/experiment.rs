@@ -10,6 +10,7 @@ use meshcodec::mesh::io::{mesh_name, resolve};
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::plot;
 use meshcodec::results::{self, RunResult};
+use meshcodec::sweep::{JobRecord, Shard, ShardManifest};
 use serde::Deserialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -47,14 +48,44 @@ struct Settings {
     keep_stream: bool,
 }
 
+impl Settings {
+    /// The defaults, results in `out`.
+    fn default_for(out: &Path) -> Settings {
+        Settings {
+            quant: None,
+            grid: None,
+            samples: meshcodec::metrics::DEFAULT_SAMPLES_PER_TRIANGLE,
+            out: out.to_path_buf(),
+            keep_stream: false,
+        }
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Run an experiment set (experiments/*.toml).
     Run {
         /// The set's TOML file.
         file: PathBuf,
+        /// Run only shard I of N (from 1: every N-th job of the set, meshes × codecs ×
+        /// quantizations in order) and write its manifest beside the results for
+        /// `experiment merge`; the comparison charts wait for the merge.
+        #[arg(long, value_parser = meshcodec::sweep::Shard::parse)]
+        shard: Option<meshcodec::sweep::Shard>,
         #[command(flatten)]
         settings: Settings,
+    },
+    /// Join the results folders of a set's shards into one, as a single run writes it (every
+    /// job's files, the comparison charts, the summary); refuses a missing or doubled job.
+    Merge {
+        /// The set's TOML file.
+        file: PathBuf,
+        /// The shards' results folders.
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+        /// Folder for the merged results.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
     },
     /// Time simplification + PM construction on meshes from 5k to 3M faces (shared meshes,
     /// subdivided); writes results/pm/decimation.json.
@@ -114,7 +145,12 @@ struct ExperimentSet {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match &cli.command {
-        Some(Command::Run { file, settings }) => run_set(file, settings),
+        Some(Command::Run {
+            file,
+            shard,
+            settings,
+        }) => run_set(file, *shard, settings),
+        Some(Command::Merge { file, shards, out }) => merge(file, shards, out),
         Some(Command::Tables { results, out }) => tables(results, out),
         Some(Command::Decimation { out }) => decimation(out),
         Some(Command::CameExtras { out }) => came_extras(out),
@@ -138,7 +174,7 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
     }
 }
 
-fn run_one(codec_name: &str, mesh: &str, settings: &Settings) -> Result<RunResult> {
+fn run_one(codec_name: &str, mesh: &str, settings: &Settings) -> Result<(RunResult, Vec<PathBuf>)> {
     let codec = codecs::by_name(codec_name)?;
     let path = resolve(mesh).with_context(|| mesh.to_string())?;
     run_codec(
@@ -150,13 +186,14 @@ fn run_one(codec_name: &str, mesh: &str, settings: &Settings) -> Result<RunResul
     )
 }
 
+/// Runs one job; returns its result and the files it wrote.
 fn run_codec(
     codec: &dyn Codec,
     path: &Path,
     options: &RunOptions,
     out: &Path,
     keep_stream: bool,
-) -> Result<RunResult> {
+) -> Result<(RunResult, Vec<PathBuf>)> {
     let harness::RunOutput {
         result,
         stream,
@@ -203,91 +240,170 @@ fn run_codec(
         result.vertices as f64 / result.decode_seconds.max(1e-9),
     );
     let stem = results::result_stem(&codec.default_options(), &result);
-    let written = harness::write_result(&result, &stem, out)
+    let mut written = harness::write_result(&result, &stem, out)
         .with_context(|| format!("writing results to {}", out.display()))?;
-    for path in written {
-        meshcodec::outln!("wrote {}", path.display());
-    }
     if keep_stream {
         let path = results::path(out, &result.codec, &stem, ".mc");
         meshcodec::mesh::io::write_atomically(&path, &stream)?;
+        written.push(path);
+    }
+    for path in &written {
         meshcodec::outln!("wrote {}", path.display());
     }
     if !result.lossless && codec.lossless() {
         anyhow::bail!("{} on {} is not lossless", result.codec, result.mesh);
     }
-    Ok(result)
+    Ok((result, written))
 }
 
-fn run_set(file: &Path, settings: &Settings) -> Result<()> {
-    let text = std::fs::read_to_string(file).with_context(|| file.display().to_string())?;
-    let set: ExperimentSet =
-        toml::from_str(&text).with_context(|| format!("{}: bad experiment set", file.display()))?;
-    let codecs = set
-        .codecs
-        .iter()
-        .map(|c| codecs::by_name(c))
-        .collect::<meshcodec::Result<Vec<_>>>()
-        .with_context(|| file.display().to_string())?;
-    let paths = set
-        .meshes
-        .iter()
-        .map(|m| resolve(m).with_context(|| m.clone()))
-        .collect::<Result<Vec<_>>>()?;
-    let quants: Vec<Option<u8>> = if set.quant.is_empty() {
-        vec![None]
-    } else {
-        set.quant.iter().map(|&q| Some(q)).collect()
-    };
-    let grid = match &set.grid {
-        Some(g) => Some(meshcodec::cli::parse_grid(g).map_err(anyhow::Error::msg)?),
-        None => settings.grid,
-    };
-    let settings = Settings {
-        samples: set.samples.unwrap_or(settings.samples),
-        grid,
-        keep_stream: settings.keep_stream || set.keep_streams,
-        ..settings.clone()
-    };
-    let set_name = mesh_name(file);
-    if !set.description.is_empty() {
-        meshcodec::outln!("{set_name}: {}", set.description);
+/// An experiment set read and resolved: its name, codecs, meshes and quantizations.
+struct Set {
+    name: String,
+    description: String,
+    codecs: Vec<&'static dyn Codec>,
+    paths: Vec<PathBuf>,
+    quants: Vec<Option<u8>>,
+    settings: Settings,
+}
+
+impl Set {
+    fn read(file: &Path, settings: &Settings) -> Result<Set> {
+        let text = std::fs::read_to_string(file).with_context(|| file.display().to_string())?;
+        let set: ExperimentSet = toml::from_str(&text)
+            .with_context(|| format!("{}: bad experiment set", file.display()))?;
+        let codecs = set
+            .codecs
+            .iter()
+            .map(|c| codecs::by_name(c))
+            .collect::<meshcodec::Result<Vec<_>>>()
+            .with_context(|| file.display().to_string())?;
+        let paths = set
+            .meshes
+            .iter()
+            .map(|m| resolve(m).with_context(|| m.clone()))
+            .collect::<Result<Vec<_>>>()?;
+        let quants: Vec<Option<u8>> = if set.quant.is_empty() {
+            vec![None]
+        } else {
+            set.quant.iter().map(|&q| Some(q)).collect()
+        };
+        let grid = match &set.grid {
+            Some(g) => Some(meshcodec::cli::parse_grid(g).map_err(anyhow::Error::msg)?),
+            None => settings.grid,
+        };
+        let settings = Settings {
+            samples: set.samples.unwrap_or(settings.samples),
+            grid,
+            keep_stream: settings.keep_stream || set.keep_streams,
+            ..settings.clone()
+        };
+        Ok(Set {
+            name: mesh_name(file),
+            description: set.description,
+            codecs,
+            paths,
+            quants,
+            settings,
+        })
     }
-    let mut summary = Vec::new();
-    for path in &paths {
-        let mut runs = Vec::new();
-        for &codec in &codecs {
-            for &quant in &quants {
-                let options = run_options(&settings, quant);
-                match run_codec(codec, path, &options, &settings.out, settings.keep_stream) {
-                    Ok(run) => runs.push(run),
-                    // A codec that cannot take a mesh says why; the set goes on, and the reason
-                    // is kept beside the results for the tables.
-                    Err(e) if is_refusal(&e) => {
-                        let name = mesh_name(path);
-                        let dir = settings.out.join(codec.name());
-                        std::fs::create_dir_all(&dir)?;
-                        let why = format!("{e:#}");
-                        let file = results::refusal_path(&settings.out, codec.name(), &name);
-                        meshcodec::mesh::io::write_atomically(
-                            &file,
-                            format!("{why}\n").as_bytes(),
-                        )?;
-                        meshcodec::outln!("{} refused {name}: {why}", codec.name());
-                    }
-                    Err(e) => return Err(e),
+
+    /// Every job in order (meshes, then codecs, then quantizations), numbered from 0.
+    fn jobs(&self) -> Vec<(usize, &Path, &'static dyn Codec, Option<u8>)> {
+        let mut jobs = Vec::new();
+        for path in &self.paths {
+            for &codec in &self.codecs {
+                for &quant in &self.quants {
+                    jobs.push((jobs.len(), path.as_path(), codec, quant));
                 }
             }
         }
+        jobs
+    }
+}
+
+fn run_set(file: &Path, shard: Option<Shard>, settings: &Settings) -> Result<()> {
+    let set = Set::read(file, settings)?;
+    let settings = &set.settings;
+    let out = &settings.out;
+    if !set.description.is_empty() {
+        meshcodec::outln!("{}: {}", set.name, set.description);
+    }
+    let jobs = set.jobs();
+    let mut records = Vec::new();
+    let mut runs: Vec<Vec<RunResult>> = vec![Vec::new(); set.paths.len()];
+    for &(job, path, codec, quant) in &jobs {
+        if shard.is_some_and(|s| !s.owns(job)) {
+            continue;
+        }
+        let options = run_options(settings, quant);
+        let mesh = mesh_name(path);
+        let (refused, files) = match run_codec(codec, path, &options, out, settings.keep_stream) {
+            Ok((run, files)) => {
+                runs[job / (set.codecs.len() * set.quants.len())].push(run);
+                (false, files)
+            }
+            // A codec that cannot take a mesh says why; the set goes on, and the reason is
+            // kept beside the results for the tables.
+            Err(e) if is_refusal(&e) => {
+                std::fs::create_dir_all(out.join(codec.name()))?;
+                let why = format!("{e:#}");
+                let file = results::refusal_path(out, codec.name(), &mesh);
+                meshcodec::mesh::io::write_atomically(&file, format!("{why}\n").as_bytes())?;
+                meshcodec::outln!("{} refused {mesh}: {why}", codec.name());
+                (true, vec![file])
+            }
+            Err(e) => return Err(e),
+        };
+        let files = files
+            .iter()
+            .map(|f| f.strip_prefix(out).unwrap_or(f).to_path_buf())
+            .collect();
+        records.push(JobRecord {
+            job,
+            codec: codec.name().to_string(),
+            mesh,
+            quant,
+            refused,
+            files,
+        });
+    }
+    match shard {
+        Some(shard) => {
+            let manifest = ShardManifest {
+                set: set.name.clone(),
+                shard,
+                jobs_in_set: jobs.len(),
+                jobs: records,
+            };
+            let path = meshcodec::sweep::manifest_path(out, &set.name, shard);
+            std::fs::create_dir_all(out)?;
+            let text = serde_json::to_string_pretty(&manifest)?;
+            meshcodec::mesh::io::write_atomically(&path, format!("{text}\n").as_bytes())?;
+            meshcodec::outln!(
+                "shard {shard}: {} of the set's {} jobs; wrote {} (experiment merge joins the shards)",
+                manifest.jobs.len(),
+                jobs.len(),
+                path.display()
+            );
+            Ok(())
+        }
+        None => finish_set(&set, &runs, out),
+    }
+}
+
+/// The comparison charts of every mesh and the summary table, from the set's results.
+fn finish_set(set: &Set, runs: &[Vec<RunResult>], out: &Path) -> Result<()> {
+    let mut summary = Vec::new();
+    for (path, runs) in set.paths.iter().zip(runs) {
         if runs.is_empty() {
             continue;
         }
-        let dir = settings.out.join("compare").join(&set_name);
+        let dir = out.join("compare").join(&set.name);
         std::fs::create_dir_all(&dir)?;
         let name = mesh_name(path);
-        let title = format!("{name} ({set_name})");
-        plot::rate_resolution(&runs, &title).draw(&dir.join(format!("{name}-rate-resolution")))?;
-        plot::rate_distortion(&runs, &title).draw(&dir.join(format!("{name}-rate-distortion")))?;
+        let title = format!("{name} ({})", set.name);
+        plot::rate_resolution(runs, &title).draw(&dir.join(format!("{name}-rate-resolution")))?;
+        plot::rate_distortion(runs, &title).draw(&dir.join(format!("{name}-rate-distortion")))?;
         meshcodec::outln!("wrote comparison charts to {}", dir.display());
         summary.extend(runs);
     }
@@ -314,6 +430,50 @@ fn run_set(file: &Path, settings: &Settings) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// `experiment merge`: every job's files copied from the shard that ran it, then the charts
+/// and summary drawn from their results as a single run draws them.
+fn merge(file: &Path, shards: &[PathBuf], out: &Path) -> Result<()> {
+    let set = Set::read(file, &Settings::default_for(out))?;
+    let jobs = set.jobs();
+    let found = meshcodec::sweep::collect(&set.name, jobs.len(), shards)?;
+    let mut runs: Vec<Vec<RunResult>> = vec![Vec::new(); set.paths.len()];
+    for ((job, path, codec, quant), (record, dir)) in jobs.iter().zip(&found) {
+        if record.codec != codec.name() || record.mesh != mesh_name(path) || record.quant != *quant
+        {
+            anyhow::bail!(
+                "{}: job {job} is {} on {}, but the set's job {job} is {} on {}: the set changed since the shard ran",
+                dir.display(),
+                record.codec,
+                record.mesh,
+                codec.name(),
+                mesh_name(path)
+            );
+        }
+        for relative in &record.files {
+            let from = dir.join(relative);
+            let bytes = std::fs::read(&from).with_context(|| from.display().to_string())?;
+            let to = out.join(relative);
+            if let Some(parent) = to.parent() {
+                std::fs::create_dir_all(parent)?;
+            }
+            meshcodec::mesh::io::write_atomically(&to, &bytes)?;
+            if !record.refused && relative.extension().is_some_and(|e| e == "json") {
+                let run: RunResult = serde_json::from_slice(&bytes)
+                    .with_context(|| format!("{}: not a result", from.display()))?;
+                runs[job / (set.codecs.len() * set.quants.len())].push(run);
+            }
+        }
+    }
+    meshcodec::outln!(
+        "merged {} jobs of {} from {} shards into {}",
+        found.len(),
+        set.name,
+        shards.len(),
+        out.display()
+    );
+    finish_set(&set, &runs, out)
 }
 
 fn is_refusal(e: &anyhow::Error) -> bool {
