@@ -68,25 +68,41 @@ fn level_of(vertices: &PyReadonlyArray2<f64>, faces: &PyReadonlyArray2<i64>) -> 
             f.shape()
         )));
     }
-    let positions = v
-        .rows()
-        .into_iter()
-        .map(|r| glam::DVec3::new(r[0], r[1], r[2]))
-        .collect();
+    let positions = match v.as_slice() {
+        // Row after row in memory (the package hands over C-contiguous arrays).
+        Some(flat) => flat
+            .chunks_exact(3)
+            .map(|c| glam::DVec3::new(c[0], c[1], c[2]))
+            .collect(),
+        None => v
+            .rows()
+            .into_iter()
+            .map(|r| glam::DVec3::new(r[0], r[1], r[2]))
+            .collect(),
+    };
     let n = v.nrows() as i64;
-    let mut triangles = Vec::with_capacity(f.nrows());
-    for (i, r) in f.rows().into_iter().enumerate() {
-        let mut face = [0u32; 3];
-        for (k, &index) in r.iter().enumerate() {
-            if !(0..n).contains(&index) {
-                return Err(refuse(format!(
-                    "face {i} index {index} out of range ({n} vertices)"
-                )));
-            }
-            face[k] = index as u32;
+    let corner = |i: usize, index: i64| {
+        if (0..n).contains(&index) {
+            Ok(index as u32)
+        } else {
+            Err(refuse(format!(
+                "face {i} index {index} out of range ({n} vertices)"
+            )))
         }
-        triangles.push(face);
-    }
+    };
+    let triangles = match f.as_slice() {
+        Some(flat) => flat
+            .chunks_exact(3)
+            .enumerate()
+            .map(|(i, c)| Ok([corner(i, c[0])?, corner(i, c[1])?, corner(i, c[2])?]))
+            .collect::<PyResult<Vec<_>>>()?,
+        None => f
+            .rows()
+            .into_iter()
+            .enumerate()
+            .map(|(i, r)| Ok([corner(i, r[0])?, corner(i, r[1])?, corner(i, r[2])?]))
+            .collect::<PyResult<Vec<_>>>()?,
+    };
     Ok(TriMesh::new(positions, triangles))
 }
 
@@ -233,8 +249,9 @@ fn decode<'py>(
     let stop = level.map_or(Stop::All, Stop::Levels);
     let (mesh, decoded, total) = py
         .detach(|| {
-            let total = codecs::open(bytes)?.levels();
-            let (mesh, decoded) = codecs::decode(bytes, stop)?;
+            let mut decoder = codecs::open(bytes)?;
+            let total = decoder.levels();
+            let (mesh, decoded) = codecs::decode_with(decoder.as_mut(), stop)?;
             Ok::<_, meshcodec::Error>((mesh, decoded, total))
         })
         .map_err(to_py)?;

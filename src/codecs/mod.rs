@@ -237,9 +237,13 @@ pub enum Stop {
 /// of levels decoded. A prefix too short to hold the header and index is an error, and so is a
 /// stop the stream or its codec cannot honour.
 pub fn decode(bytes: &[u8], stop: Stop) -> Result<(LevelMesh, usize)> {
-    let reader = StreamReader::open(bytes)?;
-    let codec = by_id(reader.header().codec_id)?;
-    let mut decoder = codec.decoder(reader)?;
+    decode_with(open(bytes)?.as_mut(), stop)
+}
+
+/// [`decode`] with a decoder already opened (where the caller also wants its
+/// [`LevelDecoder::levels`] or header): decodes from where it stands up to `stop`.
+pub fn decode_with(decoder: &mut dyn LevelDecoder, stop: Stop) -> Result<(LevelMesh, usize)> {
+    let codec = by_id(decoder.header().codec_id)?;
     let levels = decoder.levels();
     let per_level = decoder.pass_stops().map(|p| p.passes_per_level());
     // Whole levels to decode, then passes of the next one.
