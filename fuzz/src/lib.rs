@@ -105,6 +105,7 @@ pub fn decode_every_way(bytes: &[u8]) {
             Err(_) => return,
         }
     }
+    check_level_ends(bytes, decoder.levels(), decoder.levels_decoded());
     if let Some(partial) = decoder.partial_levels() {
         if partial.advance_partial().is_ok() {
             if let Ok(mesh) = decoder.mesh() {
@@ -117,6 +118,28 @@ pub fn decode_every_way(bytes: &[u8]) {
     }
     if codecs::by_id(header.codec_id).is_ok_and(|c| c.name().starts_with("pm")) {
         walk_pm_iterator(bytes);
+    }
+}
+
+/// `codecs::level_ends` of a stream of `levels` levels whose first `decoded` levels decoded:
+/// one end a level, never decreasing, and the prefix up to the last decoded level's end decodes
+/// that level again (what a reader of an arriving stream relies on).
+fn check_level_ends(bytes: &[u8], levels: usize, decoded: usize) {
+    let Ok(ends) = codecs::level_ends(bytes) else {
+        return;
+    };
+    assert_eq!(ends.len(), levels, "one end a level");
+    assert!(ends.windows(2).all(|w| w[0] <= w[1]), "ends never decrease");
+    if decoded == 0 {
+        return;
+    }
+    let end = ends[decoded - 1];
+    if end <= bytes.len() as u64 {
+        let again = codecs::decode(&bytes[..end as usize], Stop::Levels(decoded));
+        assert!(
+            again.as_ref().is_ok_and(|(_, n)| *n == decoded),
+            "the first {end} bytes should decode {decoded} levels: {again:?}"
+        );
     }
 }
 
