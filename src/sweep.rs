@@ -244,7 +244,7 @@ mod tests {
             jobs.iter().map(|(r, _)| r.job).collect::<Vec<_>>(),
             [0, 1, 2, 3]
         );
-        assert!(collect("s", 4, &[a.clone()])
+        assert!(collect("s", 4, std::slice::from_ref(&a))
             .unwrap_err()
             .to_string()
             .contains("shard 2/2 is missing"));
