@@ -149,3 +149,59 @@ fn every_shared_mesh_round_trips_losslessly() {
         );
     }
 }
+
+/// Every shared OBJ and PLY reads with its appearance — the same geometry as without it, wedges
+/// that validate, as many attributes as `appearance_of` counts in the file — and each writer
+/// that can hold what it carries writes a file that reads back to the same wedges.
+#[test]
+fn every_shared_obj_and_ply_keeps_its_appearance_through_both_writers() {
+    use meshcodec::mesh::io::{
+        appearance_of, read_attributed, read_attributed_bytes, write_attributed_bytes,
+    };
+    let dir = shared_dir();
+    let mut report = Vec::new();
+    for (file, _, _) in manifest_rows() {
+        let ext = file.rsplit('.').next().unwrap_or("").to_string();
+        if ext != "obj" && ext != "ply" {
+            continue;
+        }
+        let path = dir.join(&file);
+        let m = read_attributed(&path).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(
+            m.mesh == read_mesh(&path).unwrap(),
+            "{file}: geometry differs"
+        );
+        let a = &m.attributes;
+        a.validate(&m.mesh).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let counted = appearance_of(&bytes, &ext, m.mesh.positions.len(), m.mesh.faces.len());
+        assert_eq!(a.normals.is_some(), counted.normals > 0, "{file}: normals");
+        assert_eq!(a.uvs.is_some(), counted.uvs > 0, "{file}: uvs");
+        assert_eq!(a.colours.is_some(), counted.colours > 0, "{file}: colours");
+        assert_eq!(
+            a.materials.is_some(),
+            counted.materials > 0,
+            "{file}: materials"
+        );
+        let mut written = Vec::new();
+        for out in ["obj", "ply"] {
+            let Ok(bytes) = write_attributed_bytes(&m, out) else {
+                continue;
+            };
+            let back = read_attributed_bytes(&bytes, out).unwrap();
+            assert_eq!(
+                back.attributes.wedge_count(),
+                a.wedge_count(),
+                "{file} through {out}"
+            );
+            written.push(out);
+        }
+        if !a.is_empty() {
+            report.push(format!(
+                "{file}: {} wedges, written as {written:?}",
+                a.wedge_count()
+            ));
+        }
+    }
+    assert!(report.len() >= 4, "{report:?}");
+}

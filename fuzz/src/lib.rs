@@ -211,13 +211,40 @@ pub fn check_level_mesh(level: &LevelMesh, header: &Header) {
     }
 }
 
-/// Reads `bytes` as a mesh file of `format`; a mesh that reads must be valid.
+/// Reads `bytes` as a mesh file of `format`; a mesh that reads must be valid. Read with its
+/// appearance, it must have the same geometry and valid wedges, and a writer that takes it must
+/// give a file that reads back to the same corners.
 pub fn read_as(format: &str, bytes: &[u8]) {
     // The appearance count scans any bytes, read or not.
     let _ = io::appearance_of(bytes, format, 3, 1);
-    if let Ok(mesh) = io::read_mesh_bytes(bytes, format) {
+    let plain = io::read_mesh_bytes(bytes, format);
+    if let Ok(mesh) = &plain {
         mesh.validate().expect("a mesh the reader accepted");
         let _ = io::appearance_of(bytes, format, mesh.positions.len(), mesh.faces.len());
+    }
+    let Ok(attributed) = io::read_attributed_bytes(bytes, format) else {
+        return;
+    };
+    let mesh = plain.expect("a file read with its appearance reads without it");
+    assert!(
+        attributed.mesh == mesh,
+        "the appearance changed the geometry"
+    );
+    attributed
+        .attributes
+        .validate(&attributed.mesh)
+        .expect("wedges the reader accepted");
+    for out in ["ply", "obj"] {
+        let Ok(written) = io::write_attributed_bytes(&attributed, out) else {
+            continue;
+        };
+        let back = io::read_attributed_bytes(&written, out).expect("a file we wrote reads");
+        assert_eq!(back.mesh.faces.len(), attributed.mesh.faces.len());
+        // PLY keeps every vertex apart; OBJ objects are joined by exact position, which may
+        // weld two vertices of one place.
+        if out == "ply" {
+            assert!(back == attributed, "ply changed the attributed mesh");
+        }
     }
 }
 

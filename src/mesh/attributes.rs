@@ -188,6 +188,23 @@ impl Attributes {
             .all(|&v| !std::mem::replace(&mut seen[v as usize], true))
     }
 
+    /// Per-vertex values of a per-wedge attribute when every wedge of a vertex has the same
+    /// (vertices without a wedge take `T::default()`); `None` when some vertex has two.
+    pub fn per_vertex_values<T: Copy + Default + PartialEq>(
+        &self,
+        values: &[T],
+        vertices: usize,
+    ) -> Option<Vec<T>> {
+        let mut out: Vec<Option<T>> = vec![None; vertices];
+        for (w, &v) in self.wedge_vertex.iter().enumerate() {
+            match out[v as usize] {
+                Some(seen) if seen != values[w] => return None,
+                _ => out[v as usize] = Some(values[w]),
+            }
+        }
+        Some(out.into_iter().map(Option::unwrap_or_default).collect())
+    }
+
     /// Checks the wedges against `mesh`: one wedge triple a face, each corner's wedge on the
     /// corner's vertex, one value a wedge for each attribute, finite values, material ids
     /// within the names.
@@ -240,7 +257,9 @@ impl Attributes {
                 .flatten()
                 .all(|c| c.iter().all(|x| x.is_finite()));
         if !finite {
-            return Err(Error::mesh("a non-finite normal, texture coordinate or colour"));
+            return Err(Error::mesh(
+                "a non-finite normal, texture coordinate or colour",
+            ));
         }
         if let Some(m) = &self.materials {
             if m.face.len() != mesh.faces.len() {
@@ -299,7 +318,8 @@ mod tests {
         let faces = [[0, 1, 2]];
         let some = [[uv(0.0, 0.0), Corner::default(), uv(1.0, 1.0)]];
         assert!(Attributes::weld(&faces, &some).is_err());
-        let mut a = Attributes::weld(&faces, &[[uv(0.0, 0.0), uv(1.0, 0.0), uv(0.0, 1.0)]]).unwrap();
+        let mut a =
+            Attributes::weld(&faces, &[[uv(0.0, 0.0), uv(1.0, 0.0), uv(0.0, 1.0)]]).unwrap();
         let mesh = TriMesh::new(vec![DVec3::ZERO; 3], faces.to_vec());
         a.validate(&mesh).unwrap();
         a.wedge_vertex[0] = 2;

@@ -1,6 +1,8 @@
-//! Triangle meshes without any notion of bits: the indexed mesh, its file formats, validation,
-//! quantization to a grid, the canonical mesh that "lossless" is judged against, and generators.
+//! Triangle meshes without any notion of bits: the indexed mesh, its appearance (wedges and
+//! materials), its file formats, validation, quantization to a grid, the canonical mesh that
+//! "lossless" is judged against, and generators.
 
+pub mod attributes;
 pub mod canonical;
 pub mod generate;
 pub mod io;

@@ -15,6 +15,7 @@ pub mod vrml;
 
 pub use appearance::{appearance_of, Appearance};
 
+use super::attributes::{AttributedMesh, Attributes};
 use super::TriMesh;
 use crate::error::{Error, Result};
 use std::io::Write;
@@ -57,6 +58,69 @@ fn read_by_extension(bytes: &[u8], ext: &str) -> Result<TriMesh> {
     };
     mesh.validate()?;
     Ok(mesh)
+}
+
+/// Reads a mesh with its appearance — wedges (normals, texture coordinates, colours) and
+/// materials — by the file's extension. OBJ and PLY carry them; a file of another format that
+/// holds appearance the reader cannot keep yet (OFF colours, `.m` normals) is refused, naming it.
+pub fn read_attributed(path: &Path) -> Result<AttributedMesh> {
+    let ext = extension(path);
+    let bytes = std::fs::read(path)?;
+    read_attributed_bytes(&bytes, &ext)
+}
+
+/// [`read_attributed`] from bytes in the given format.
+pub fn read_attributed_bytes(bytes: &[u8], format: &str) -> Result<AttributedMesh> {
+    let read = match format {
+        "obj" => obj::read_attributed(bytes)?,
+        "ply" => ply::read_attributed(bytes)?,
+        _ => {
+            let mesh = read_by_extension(bytes, format)?;
+            let found = appearance_of(bytes, format, mesh.positions.len(), mesh.faces.len());
+            if !found.is_empty() {
+                return Err(Error::Unsupported(format!(
+                    "the .{format} reader keeps positions and faces only, and the file holds {found}"
+                )));
+            }
+            return Ok(AttributedMesh {
+                mesh,
+                attributes: Attributes::default(),
+            });
+        }
+    };
+    read.mesh.validate()?;
+    Ok(read)
+}
+
+/// Writes a mesh with its appearance as OBJ or PLY by the extension of `path` (each holds what
+/// it can: a file that cannot hold some of the appearance is refused, naming it), atomically.
+pub fn write_attributed(mesh: &AttributedMesh, path: &Path) -> Result<()> {
+    let mut bytes = Vec::new();
+    match extension(path).as_str() {
+        "ply" => ply::write_attributed(mesh, &mut bytes)?,
+        "obj" => obj::write_attributed(mesh, &mut bytes)?,
+        other => {
+            return Err(Error::Unsupported(format!(
+                "output format '.{other}' with attributes (writers: ply, obj)"
+            )))
+        }
+    }
+    write_atomically(path, &bytes)
+}
+
+/// [`write_attributed`] to bytes in the given format.
+pub fn write_attributed_bytes(mesh: &AttributedMesh, format: &str) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    match format {
+        "ply" => ply::write_attributed(mesh, &mut bytes)?,
+        "obj" => obj::write_attributed(mesh, &mut bytes)?,
+        other => {
+            return Err(Error::Unsupported(format!(
+                "output format '.{other}' with attributes (writers: ply, obj)"
+            )))
+        }
+    }
+    Ok(bytes)
 }
 
 /// Reads a mesh from bytes in the given format (an extension such as "ply").
@@ -241,5 +305,125 @@ mod tests {
             };
             assert!(sorted(&back) == sorted(&mesh), "{format} changed the mesh");
         }
+    }
+
+    fn shared(name: &str) -> Option<PathBuf> {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../shared/meshes")
+            .join(name);
+        path.exists().then_some(path)
+    }
+
+    /// Written and read again, an attributed mesh is the same mesh: positions, faces, wedges,
+    /// attributes and materials.
+    fn assert_round_trips(mesh: &AttributedMesh, format: &str) {
+        let bytes = write_attributed_bytes(mesh, format).unwrap();
+        let back = read_attributed_bytes(&bytes, format).unwrap();
+        assert_eq!(
+            back.attributes.wedge_count(),
+            mesh.attributes.wedge_count(),
+            "{format}"
+        );
+        if format == "ply" {
+            assert!(back == *mesh, "ply changed the attributed mesh");
+        }
+        // OBJ renumbers vertices by first use: compare what each corner carries.
+        let corners = |m: &AttributedMesh| {
+            let mut all: Vec<String> = (0..m.mesh.faces.len())
+                .map(|f| {
+                    let material = m
+                        .attributes
+                        .materials
+                        .as_ref()
+                        .map(|x| x.names[x.face[f] as usize].clone());
+                    let c: Vec<String> = (0..3)
+                        .map(|k| {
+                            let p = m.mesh.positions[m.mesh.faces[f][k] as usize];
+                            format!("{p:?} {:?}", m.attributes.corner(f, k))
+                        })
+                        .collect();
+                    format!("{c:?} {material:?}")
+                })
+                .collect();
+            all.sort();
+            all
+        };
+        assert!(
+            corners(&back) == corners(mesh),
+            "{format} changed the corners"
+        );
+    }
+
+    #[test]
+    fn textured_obj_files_keep_their_seams_and_materials() {
+        let Some(path) = shared("bunny-10k-textured.obj") else {
+            return;
+        };
+        let mesh = read_attributed(&path).unwrap();
+        let a = &mesh.attributes;
+        let uvs = a.uvs.as_ref().expect("uvs");
+        assert!(a.normals.is_none() && a.colours.is_none());
+        // More wedges than vertices: the seams.
+        assert!(
+            a.wedge_count() > mesh.mesh.positions.len(),
+            "{}",
+            a.wedge_count()
+        );
+        assert_eq!(uvs.len(), a.wedge_count());
+        let materials = a.materials.as_ref().expect("usemtl");
+        assert_eq!(
+            materials.library.as_deref(),
+            Some("./bunny10k_textured.mtl")
+        );
+        assert_eq!(materials.face.len(), mesh.mesh.faces.len());
+        assert_round_trips(&mesh, "obj");
+        // PLY keeps the seams as per-face texcoord lists, and refuses the materials.
+        assert!(write_attributed_bytes(&mesh, "ply").is_err());
+        let mut no_materials = mesh.clone();
+        no_materials.attributes.materials = None;
+        assert_round_trips(&no_materials, "ply");
+    }
+
+    #[test]
+    fn ply_normals_and_colours_round_trip_per_vertex() {
+        for name in ["airplane-colored.ply", "dragon-res3.ply"] {
+            let Some(path) = shared(name) else {
+                continue;
+            };
+            let mesh = read_attributed(&path).unwrap();
+            let a = &mesh.attributes;
+            assert!(a.colours.is_some() || a.normals.is_some(), "{name}");
+            assert!(a.per_vertex(mesh.mesh.positions.len()), "{name}");
+            assert_round_trips(&mesh, "ply");
+            let translucent = a.colours.iter().flatten().any(|c| c[3] != 1.0);
+            if translucent {
+                // OBJ has no alpha: refused rather than dropped.
+                let e = write_attributed_bytes(&mesh, "obj")
+                    .unwrap_err()
+                    .to_string();
+                assert!(e.contains("alpha"), "{e}");
+            } else {
+                assert_round_trips(&mesh, "obj");
+            }
+        }
+    }
+
+    #[test]
+    fn readers_that_cannot_keep_appearance_refuse_it() {
+        let m = "Vertex 1 0 0 0 {normal=(0 0 1)}\nVertex 2 1 0 0\nVertex 3 0 1 0\nFace 1 1 2 3\n";
+        let e = read_attributed_bytes(m.as_bytes(), "m")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("1 normal"), "{e}");
+        let off = "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n";
+        let e = read_attributed_bytes(off.as_bytes(), "off")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("colours"), "{e}");
+        let plain = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+        assert!(read_attributed_bytes(plain.as_bytes(), "off")
+            .unwrap()
+            .attributes
+            .is_empty());
     }
 }

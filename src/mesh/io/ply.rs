@@ -1,21 +1,50 @@
 //! PLY through `ply-rs-bw`: ASCII, binary little- and big-endian; positions of any numeric type;
 //! faces as `face` lists (`vertex_indices` or `vertex_index`) or `tristrips` (−1 separated
-//! strips, alternate triangles flipped to keep one orientation). Other elements and properties
-//! are read past and ignored.
+//! strips, alternate triangles flipped to keep one orientation). [`read_attributed`] also takes
+//! vertex normals (`nx ny nz`), colours (`red green blue [alpha]`, integers over their type's
+//! range or floats in [0, 1]), texture coordinates (`s t`, `u v`, `texture_u texture_v` or
+//! `texture_s texture_t`) and per-face `texcoord` lists (a uv a corner, where seams are).
+//! Other elements and properties are read past and ignored.
 
 use crate::error::{Error, Result};
+use crate::mesh::attributes::{AttributedMesh, Attributes, Corner};
 use crate::mesh::TriMesh;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{
     Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
 };
 
-/// One PLY element as we need it: a position, an index list, or neither.
+/// One PLY element as we need it: a position and its attributes, an index list, or neither.
 #[derive(Default)]
 struct Record {
     xyz: [f64; 3],
     indices: Vec<i64>,
+    normal: [f64; 3],
+    /// RGBA in [0, 1]; alpha 1 unless the file gives it.
+    colour: [f64; 4],
+    uv: [f64; 2],
+    /// A face's corner uvs, two numbers a corner.
+    texcoord: Vec<f64>,
+}
+
+/// A colour channel in [0, 1]: integers over their type's range, floats as they are.
+fn channel(p: &Property) -> Option<f64> {
+    Some(match *p {
+        Property::UChar(v) => v as f64 / 255.0,
+        Property::UShort(v) => v as f64 / 65535.0,
+        Property::Float(v) => v as f64,
+        Property::Double(v) => v,
+        _ => return None,
+    })
+}
+
+fn float_list(p: Property) -> Option<Vec<f64>> {
+    Some(match p {
+        Property::ListFloat(v) => v.into_iter().map(f64::from).collect(),
+        Property::ListDouble(v) => v,
+        _ => return None,
+    })
 }
 
 fn scalar(p: &Property) -> Option<f64> {
@@ -49,36 +78,94 @@ fn integer_list(p: Property) -> Option<Vec<i64>> {
 
 impl PropertyAccess for Record {
     fn new() -> Self {
-        Record::default()
+        Record {
+            colour: [0.0, 0.0, 0.0, 1.0],
+            ..Record::default()
+        }
     }
 
     fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
-        let axis = match name {
-            "x" => 0,
-            "y" => 1,
-            "z" => 2,
-            "vertex_indices" | "vertex_index" => {
-                return match integer_list(property) {
-                    Some(list) => {
-                        self.indices = list;
-                        PropertyAccessResult::Set
-                    }
-                    None => PropertyAccessResult::UnsupportedType,
-                };
-            }
-            _ => return PropertyAccessResult::Ignored,
-        };
-        match scalar(&property) {
+        let set = |slot: &mut f64, value: Option<f64>| match value {
             Some(v) => {
-                self.xyz[axis] = v;
+                *slot = v;
                 PropertyAccessResult::Set
             }
             None => PropertyAccessResult::UnsupportedType,
+        };
+        match name {
+            "x" => set(&mut self.xyz[0], scalar(&property)),
+            "y" => set(&mut self.xyz[1], scalar(&property)),
+            "z" => set(&mut self.xyz[2], scalar(&property)),
+            "nx" => set(&mut self.normal[0], scalar(&property)),
+            "ny" => set(&mut self.normal[1], scalar(&property)),
+            "nz" => set(&mut self.normal[2], scalar(&property)),
+            "red" => set(&mut self.colour[0], channel(&property)),
+            "green" => set(&mut self.colour[1], channel(&property)),
+            "blue" => set(&mut self.colour[2], channel(&property)),
+            "alpha" => set(&mut self.colour[3], channel(&property)),
+            "s" | "u" | "texture_u" | "texture_s" => set(&mut self.uv[0], scalar(&property)),
+            "t" | "v" | "texture_v" | "texture_t" => set(&mut self.uv[1], scalar(&property)),
+            "vertex_indices" | "vertex_index" => match integer_list(property) {
+                Some(list) => {
+                    self.indices = list;
+                    PropertyAccessResult::Set
+                }
+                None => PropertyAccessResult::UnsupportedType,
+            },
+            "texcoord" => match float_list(property) {
+                Some(list) => {
+                    self.texcoord = list;
+                    PropertyAccessResult::Set
+                }
+                None => PropertyAccessResult::UnsupportedType,
+            },
+            _ => PropertyAccessResult::Ignored,
+        }
+    }
+}
+
+/// Which attributes the vertex and face elements declare.
+struct Declared {
+    normals: bool,
+    colours: bool,
+    uvs: bool,
+    face_uvs: bool,
+}
+
+impl Declared {
+    fn of(header: &Header) -> Declared {
+        let vertex = |names: &[&str]| {
+            header
+                .elements
+                .get("vertex")
+                .is_some_and(|e| names.iter().all(|n| e.properties.contains_key(*n)))
+        };
+        let any_pair = ["s", "u", "texture_u", "texture_s"]
+            .iter()
+            .zip(["t", "v", "texture_v", "texture_t"])
+            .any(|(a, b)| vertex(&[a, b]));
+        Declared {
+            normals: vertex(&["nx", "ny", "nz"]),
+            colours: vertex(&["red", "green", "blue"]),
+            uvs: any_pair,
+            face_uvs: header
+                .elements
+                .get("face")
+                .is_some_and(|e| e.properties.contains_key("texcoord")),
         }
     }
 }
 
 pub fn read(bytes: &[u8]) -> Result<TriMesh> {
+    Ok(load(bytes, false)?.mesh)
+}
+
+/// The mesh with its wedges: one a vertex, split where face `texcoord` lists make seams.
+pub fn read_attributed(bytes: &[u8]) -> Result<AttributedMesh> {
+    load(bytes, true)
+}
+
+fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
     let parser = Parser::<Record>::new();
     // ply-rs reports over several lines; errors here are one line (docs/CONTRACT.md §7).
     let fault = |e: ply_rs_bw::parser::ParseError| {
@@ -111,14 +198,52 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
             )))
         }
     };
+    let declared = Declared::of(&header);
+    let vertices = payload.get("vertex").map(Vec::as_slice).unwrap_or_default();
+    // What a corner of vertex v carries from the vertex element.
+    let vertex_corner = |v: u32| {
+        let r = &vertices[v as usize];
+        Corner {
+            normal: declared.normals.then(|| DVec3::from(r.normal)),
+            uv: declared.uvs.then(|| DVec2::from(r.uv)),
+            colour: declared.colours.then_some(r.colour),
+        }
+    };
     let mut faces = Vec::new();
-    for record in payload.get("face").into_iter().flatten() {
+    let mut corners: Vec<[Corner; 3]> = Vec::new();
+    for (f, record) in payload.get("face").into_iter().flatten().enumerate() {
         let polygon = record
             .indices
             .iter()
             .map(|&i| index(i))
             .collect::<Result<Vec<u32>>>()?;
+        let first = faces.len();
         super::text::fan(&polygon, &mut faces);
+        if !with_attributes {
+            continue;
+        }
+        let corner_uvs = declared.face_uvs && !record.texcoord.is_empty();
+        if corner_uvs && record.texcoord.len() != 2 * polygon.len() {
+            return Err(Error::mesh(format!(
+                "PLY: face {f} has {} corners but {} texcoord values",
+                polygon.len(),
+                record.texcoord.len()
+            )));
+        }
+        let corner = |k: usize| {
+            let mut c = vertex_corner(polygon[k]);
+            if corner_uvs {
+                c.uv = Some(DVec2::new(
+                    record.texcoord[2 * k],
+                    record.texcoord[2 * k + 1],
+                ));
+            }
+            c
+        };
+        // The fan's triangles, corner by corner (super::text::fan's order).
+        for k in 1..(faces.len() - first + 1) {
+            corners.push([corner(0), corner(k), corner(k + 1)]);
+        }
     }
     for record in payload.get("tristrips").into_iter().flatten() {
         for strip in record.indices.split(|&i| i < 0) {
@@ -135,11 +260,124 @@ pub fn read(bytes: &[u8]) -> Result<TriMesh> {
                 // Strips repeat a vertex to turn corners; those triangles are not faces.
                 if tri[0] != tri[1] && tri[1] != tri[2] && tri[0] != tri[2] {
                     faces.push(tri);
+                    if with_attributes {
+                        corners.push(tri.map(vertex_corner));
+                    }
                 }
             }
         }
     }
-    Ok(TriMesh::new(positions, faces))
+    let mesh = TriMesh::new(positions, faces);
+    let attributes = if with_attributes {
+        let attributes = Attributes::weld(&mesh.faces, &corners)?;
+        attributes.validate(&mesh)?;
+        attributes
+    } else {
+        Attributes::default()
+    };
+    Ok(AttributedMesh { mesh, attributes })
+}
+
+/// Writes an attributed mesh as binary little-endian PLY: double positions; per vertex, the
+/// normals and colours (uchar channels when every value is a multiple of 1/255, doubles
+/// otherwise) and the uvs when each vertex has one; uvs a vertex has several of (seams) as
+/// per-face `texcoord` lists. PLY holds normals and colours per vertex only: a mesh whose
+/// normals or colours differ between the wedges of a vertex is refused. Materials are refused.
+pub fn write_attributed(m: &AttributedMesh, out: &mut impl std::io::Write) -> Result<()> {
+    let (mesh, a) = (&m.mesh, &m.attributes);
+    let n = mesh.positions.len();
+    if a.materials.is_some() {
+        return Err(Error::Unsupported("PLY holds no materials".into()));
+    }
+    let per_vertex = |what: &str| Error::Unsupported(format!("PLY holds {what} per vertex only"));
+    let normals = match &a.normals {
+        Some(v) => Some(
+            a.per_vertex_values(v, n)
+                .ok_or_else(|| per_vertex("normals"))?,
+        ),
+        None => None,
+    };
+    let colours = match &a.colours {
+        Some(v) => Some(
+            a.per_vertex_values(v, n)
+                .ok_or_else(|| per_vertex("colours"))?,
+        ),
+        None => None,
+    };
+    let vertex_uvs = a.uvs.as_ref().and_then(|v| a.per_vertex_values(v, n));
+    let face_uvs = a.uvs.is_some() && vertex_uvs.is_none();
+    let bytes_colour = colours.as_ref().is_some_and(|c| {
+        c.iter()
+            .flatten()
+            .all(|&x| (0.0..=1.0).contains(&x) && (x * 255.0).round() / 255.0 == x)
+    });
+    let mut header = format!(
+        "ply\nformat binary_little_endian 1.0\ncomment meshcodec\nelement vertex {n}\n\
+         property double x\nproperty double y\nproperty double z\n"
+    );
+    if normals.is_some() {
+        header.push_str("property double nx\nproperty double ny\nproperty double nz\n");
+    }
+    if colours.is_some() {
+        let t = if bytes_colour { "uchar" } else { "double" };
+        for c in ["red", "green", "blue", "alpha"] {
+            header.push_str(&format!("property {t} {c}\n"));
+        }
+    }
+    if vertex_uvs.is_some() {
+        header.push_str("property double s\nproperty double t\n");
+    }
+    header.push_str(&format!(
+        "element face {}\nproperty list uchar int vertex_indices\n",
+        mesh.faces.len()
+    ));
+    if face_uvs {
+        header.push_str("property list uchar double texcoord\n");
+    }
+    header.push_str("end_header\n");
+    let mut body = Vec::with_capacity(n * 80 + mesh.faces.len() * 64);
+    let put = |body: &mut Vec<u8>, x: f64| body.extend_from_slice(&x.to_le_bytes());
+    for (i, p) in mesh.positions.iter().enumerate() {
+        p.to_array().into_iter().for_each(|x| put(&mut body, x));
+        if let Some(normals) = &normals {
+            normals[i]
+                .to_array()
+                .into_iter()
+                .for_each(|x| put(&mut body, x));
+        }
+        if let Some(colours) = &colours {
+            for x in colours[i] {
+                if bytes_colour {
+                    body.push((x * 255.0).round() as u8);
+                } else {
+                    put(&mut body, x);
+                }
+            }
+        }
+        if let Some(uvs) = &vertex_uvs {
+            uvs[i]
+                .to_array()
+                .into_iter()
+                .for_each(|x| put(&mut body, x));
+        }
+    }
+    for (f, face) in mesh.faces.iter().enumerate() {
+        body.push(3);
+        for &v in face {
+            body.extend_from_slice(&(v as i32).to_le_bytes());
+        }
+        if face_uvs {
+            body.push(6);
+            for k in 0..3 {
+                let uv = a.corner(f, k).uv.unwrap_or_default();
+                put(&mut body, uv.x);
+                put(&mut body, uv.y);
+            }
+        }
+    }
+    out.write_all(header.as_bytes())?;
+    out.write_all(&body)?;
+    Ok(())
 }
 
 fn one_line(text: &str) -> String {
