@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --bin meshcodec
 seeds=fuzz/seeds
-mkdir -p $seeds/{read_obj,read_ply,read_off,read_stl,read_m}
+mkdir -p $seeds/{read_obj,read_ply,read_off,read_stl,read_m,read_gltf}
 python3 - "$seeds" <<'EOF'
 import math, struct, sys, os
 os.chdir(sys.argv[1])
@@ -68,6 +68,55 @@ with open('read_stl/triangle-ascii.stl', 'w') as f:
         for v in t: f.write('      vertex %f %f %f\n' % pts[v])
         f.write('    endloop\n  endfacet\n')
     f.write('endsolid seed\n')
+# glTF: the torus split at its uv seam as glTF stores it (a vertex per (position, uv) pair),
+# with normals and two materials; as a .gltf with the buffer embedded and as a .glb.
+import base64, json
+verts, index = [], {}
+def vertex(i, j):
+    key = (i, j)
+    if key not in index:
+        a = 2 * math.pi * i / U; b = 2 * math.pi * j / V
+        index[key] = len(verts)
+        verts.append((pts[(i % U) * V + j % V], (math.cos(a) * math.cos(b), math.sin(a) * math.cos(b), math.sin(b)), (i / U, j / V)))
+    return index[key]
+faces = []
+for i in range(U):
+    for j in range(V):
+        a, b, c, d = vertex(i, j), vertex(i + 1, j), vertex(i + 1, j + 1), vertex(i, j + 1)
+        faces += [(a, b, c), (a, c, d)]
+half = len(faces) // 2
+blob = b''.join(struct.pack('<fff', *v[0]) for v in verts)
+blob += b''.join(struct.pack('<fff', *v[1]) for v in verts)
+blob += b''.join(struct.pack('<ff', *v[2]) for v in verts)
+indices = b''.join(struct.pack('<III', *t) for t in faces)
+offsets = [0, 12 * len(verts), 24 * len(verts), 32 * len(verts)]
+blob += indices
+views = [{"buffer": 0, "byteOffset": offsets[k], "byteLength": offsets[k + 1] - offsets[k]} for k in range(3)]
+views += [{"buffer": 0, "byteOffset": offsets[3], "byteLength": 12 * half},
+          {"buffer": 0, "byteOffset": offsets[3] + 12 * half, "byteLength": 12 * (len(faces) - half)}]
+lo = [min(v[0][k] for v in verts) for k in range(3)]; hi = [max(v[0][k] for v in verts) for k in range(3)]
+accessors = [{"bufferView": 0, "componentType": 5126, "count": len(verts), "type": "VEC3", "min": lo, "max": hi},
+             {"bufferView": 1, "componentType": 5126, "count": len(verts), "type": "VEC3"},
+             {"bufferView": 2, "componentType": 5126, "count": len(verts), "type": "VEC2"},
+             {"bufferView": 3, "componentType": 5125, "count": 3 * half, "type": "SCALAR"},
+             {"bufferView": 4, "componentType": 5125, "count": 3 * (len(faces) - half), "type": "SCALAR"}]
+attributes = {"POSITION": 0, "NORMAL": 1, "TEXCOORD_0": 2}
+doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+       "nodes": [{"mesh": 0, "translation": [0, 0, 1]}],
+       "meshes": [{"primitives": [{"attributes": attributes, "indices": 3, "material": 0},
+                                  {"attributes": attributes, "indices": 4, "material": 1}]}],
+       "materials": [{"name": "inside"}, {"name": "outside"}],
+       "accessors": accessors, "bufferViews": views}
+embedded = dict(doc, buffers=[{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}])
+with open('read_gltf/torus.gltf', 'w') as f:
+    json.dump(embedded, f)
+text = json.dumps(dict(doc, buffers=[{"byteLength": len(blob)}])).encode()
+text += b' ' * (-len(text) % 4)
+blob += b'\0' * (-len(blob) % 4)
+with open('read_gltf/torus.glb', 'wb') as f:
+    f.write(struct.pack('<4sII', b'glTF', 2, 12 + 8 + len(text) + 8 + len(blob)))
+    f.write(struct.pack('<I4s', len(text), b'JSON') + text)
+    f.write(struct.pack('<I4s', len(blob), b'BIN\0') + blob)
 with open('read_m/torus.m', 'w') as f:
     f.write('# seed\n')
     for k, p in enumerate(pts): f.write('Vertex %d %f %f %f {normal=(0 0 1)}\n' % ((k + 1,) + p))

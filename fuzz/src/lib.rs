@@ -234,7 +234,7 @@ pub fn read_as(format: &str, bytes: &[u8]) {
         .attributes
         .validate(&attributed.mesh)
         .expect("wedges the reader accepted");
-    for out in ["ply", "obj"] {
+    for out in ["ply", "obj", "glb"] {
         let Ok(written) = io::write_attributed_bytes(&attributed, out) else {
             continue;
         };

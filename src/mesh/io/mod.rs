@@ -1,10 +1,13 @@
-//! Mesh files: readers for OBJ, PLY, OFF, STL and Hoppe's `.m`; writers for PLY and OBJ; and the
-//! lookup of mesh names in the data folders (`$MESHCODEC_DATA`, then ../shared/meshes).
+//! Mesh files: readers for OBJ, PLY, OFF, STL, Hoppe's `.m` and glTF 2.0; writers for PLY, OBJ,
+//! VRML and glTF; OBJ, PLY and glTF with their appearance (wedges and materials,
+//! `read_attributed` / `write_attributed`); and the lookup of mesh names in the data folders
+//! (`$MESHCODEC_DATA`, then ../shared/meshes).
 //!
 //! Readers return the mesh as stored (unreferenced vertices kept where the format keeps them),
 //! validated: finite coordinates, indices in range, at least one face.
 
 mod appearance;
+mod gltf;
 mod m;
 mod obj;
 mod off;
@@ -22,14 +25,39 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// File extensions the readers understand, in the order a bare mesh name prefers them.
-pub const EXTENSIONS: [&str; 5] = ["ply", "obj", "off", "m", "stl"];
+pub const EXTENSIONS: [&str; 7] = ["ply", "obj", "off", "m", "stl", "gltf", "glb"];
 
 /// Reads a mesh, choosing the reader by the file's extension: positions and triangles only
 /// ([`read_mesh_and_appearance`] says what else the file holds).
 pub fn read_mesh(path: &Path) -> Result<TriMesh> {
     let ext = extension(path);
     let bytes = std::fs::read(path)?;
+    if is_gltf(&ext) {
+        // A .gltf file's buffers may be files beside it.
+        let mesh = gltf::read_attributed(&bytes, path.parent())?.mesh;
+        mesh.validate()?;
+        return Ok(mesh);
+    }
     read_by_extension(&bytes, &ext)
+}
+
+fn is_gltf(ext: &str) -> bool {
+    ext == "gltf" || ext == "glb"
+}
+
+/// What a glTF mesh carries, counted as [`appearance_of`] counts other files' attributes.
+fn gltf_appearance(m: &AttributedMesh) -> Appearance {
+    let a = &m.attributes;
+    let wedges = |present: bool| if present { a.wedge_count() } else { 0 };
+    Appearance {
+        normals: wedges(a.normals.is_some()),
+        uvs: wedges(a.uvs.is_some()),
+        colours: wedges(a.colours.is_some()),
+        materials: a
+            .materials
+            .as_ref()
+            .map_or(0, |m| m.names.iter().filter(|n| !n.is_empty()).count()),
+    }
 }
 
 /// Reads a mesh as [`read_mesh`] does, and counts the appearance attributes (normals, texture
@@ -37,6 +65,12 @@ pub fn read_mesh(path: &Path) -> Result<TriMesh> {
 pub fn read_mesh_and_appearance(path: &Path) -> Result<(TriMesh, Appearance)> {
     let ext = extension(path);
     let bytes = std::fs::read(path)?;
+    if is_gltf(&ext) {
+        let m = gltf::read_attributed(&bytes, path.parent())?;
+        m.mesh.validate()?;
+        let found = gltf_appearance(&m);
+        return Ok((m.mesh, found));
+    }
     let mesh = read_by_extension(&bytes, &ext)?;
     let found = appearance::appearance_of(&bytes, &ext, mesh.positions.len(), mesh.faces.len());
     Ok((mesh, found))
@@ -49,6 +83,7 @@ fn read_by_extension(bytes: &[u8], ext: &str) -> Result<TriMesh> {
         "off" => off::read(bytes)?,
         "stl" => stl::read(bytes)?,
         "m" => m::read(bytes)?,
+        "gltf" | "glb" => gltf::read_attributed(bytes, None)?.mesh,
         _ => {
             return Err(Error::Unsupported(format!(
                 "mesh format '.{ext}' (readers: {})",
@@ -61,11 +96,16 @@ fn read_by_extension(bytes: &[u8], ext: &str) -> Result<TriMesh> {
 }
 
 /// Reads a mesh with its appearance — wedges (normals, texture coordinates, colours) and
-/// materials — by the file's extension. OBJ and PLY carry them; a file of another format that
+/// materials — by the file's extension. OBJ, PLY and glTF carry them; a file of another format that
 /// holds appearance the reader cannot keep yet (OFF colours, `.m` normals) is refused, naming it.
 pub fn read_attributed(path: &Path) -> Result<AttributedMesh> {
     let ext = extension(path);
     let bytes = std::fs::read(path)?;
+    if is_gltf(&ext) {
+        let m = gltf::read_attributed(&bytes, path.parent())?;
+        m.mesh.validate()?;
+        return Ok(m);
+    }
     read_attributed_bytes(&bytes, &ext)
 }
 
@@ -74,6 +114,8 @@ pub fn read_attributed_bytes(bytes: &[u8], format: &str) -> Result<AttributedMes
     let read = match format {
         "obj" => obj::read_attributed(bytes)?,
         "ply" => ply::read_attributed(bytes)?,
+        // Embedded buffers only: from bytes there is no folder to find others in.
+        "gltf" | "glb" => gltf::read_attributed(bytes, None)?,
         _ => {
             let mesh = read_by_extension(bytes, format)?;
             let found = appearance_of(bytes, format, mesh.positions.len(), mesh.faces.len());
@@ -92,19 +134,11 @@ pub fn read_attributed_bytes(bytes: &[u8], format: &str) -> Result<AttributedMes
     Ok(read)
 }
 
-/// Writes a mesh with its appearance as OBJ or PLY by the extension of `path` (each holds what
-/// it can: a file that cannot hold some of the appearance is refused, naming it), atomically.
+/// Writes a mesh with its appearance as OBJ, PLY or glTF (`.gltf`, `.glb`) by the extension of
+/// `path` (each holds what it can: a file that cannot hold some of the appearance is refused,
+/// naming it), atomically.
 pub fn write_attributed(mesh: &AttributedMesh, path: &Path) -> Result<()> {
-    let mut bytes = Vec::new();
-    match extension(path).as_str() {
-        "ply" => ply::write_attributed(mesh, &mut bytes)?,
-        "obj" => obj::write_attributed(mesh, &mut bytes)?,
-        other => {
-            return Err(Error::Unsupported(format!(
-                "output format '.{other}' with attributes (writers: ply, obj)"
-            )))
-        }
-    }
+    let bytes = write_attributed_bytes(mesh, &extension(path))?;
     write_atomically(path, &bytes)
 }
 
@@ -114,9 +148,11 @@ pub fn write_attributed_bytes(mesh: &AttributedMesh, format: &str) -> Result<Vec
     match format {
         "ply" => ply::write_attributed(mesh, &mut bytes)?,
         "obj" => obj::write_attributed(mesh, &mut bytes)?,
+        "glb" => bytes = gltf::write_attributed(mesh, true)?,
+        "gltf" => bytes = gltf::write_attributed(mesh, false)?,
         other => {
             return Err(Error::Unsupported(format!(
-                "output format '.{other}' with attributes (writers: ply, obj)"
+                "output format '.{other}' with attributes (writers: ply, obj, gltf, glb)"
             )))
         }
     }
@@ -128,7 +164,8 @@ pub fn read_mesh_bytes(bytes: &[u8], format: &str) -> Result<TriMesh> {
     read_by_extension(bytes, format)
 }
 
-/// Writes `mesh` as binary PLY (double positions), OBJ or VRML, by the extension of `path`. The file
+/// Writes `mesh` as binary PLY (double positions), OBJ, VRML or glTF (`.gltf` with the buffer
+/// embedded, `.glb`; single-precision positions), by the extension of `path`. The file
 /// appears only when it is complete: it is written beside and renamed into place.
 pub fn write_mesh(mesh: &TriMesh, path: &Path) -> Result<()> {
     let mut bytes = Vec::new();
@@ -136,9 +173,16 @@ pub fn write_mesh(mesh: &TriMesh, path: &Path) -> Result<()> {
         "ply" => write_ply(mesh, &mut bytes)?,
         "obj" => write_obj(mesh, &mut bytes)?,
         "wrl" => vrml::write_vrml(mesh, &mut bytes)?,
+        "gltf" | "glb" => {
+            let plain = AttributedMesh {
+                mesh: mesh.clone(),
+                attributes: Attributes::default(),
+            };
+            bytes = gltf::write_attributed(&plain, extension(path) == "glb")?;
+        }
         other => {
             return Err(Error::Unsupported(format!(
-                "output format '.{other}' (writers: ply, obj, wrl)"
+                "output format '.{other}' (writers: ply, obj, wrl, gltf, glb)"
             )))
         }
     }
@@ -406,6 +450,121 @@ mod tests {
                 assert_round_trips(&mesh, "obj");
             }
         }
+    }
+
+    /// The mesh at single precision, as glTF holds it.
+    fn single(mut m: AttributedMesh) -> AttributedMesh {
+        let f = |x: f64| x as f32 as f64;
+        m.mesh
+            .positions
+            .iter_mut()
+            .for_each(|p| *p = p.to_array().map(f).into());
+        let a = &mut m.attributes;
+        a.normals
+            .iter_mut()
+            .flatten()
+            .for_each(|n| *n = n.to_array().map(f).into());
+        a.uvs
+            .iter_mut()
+            .flatten()
+            .for_each(|t| *t = t.to_array().map(f).into());
+        a.colours.iter_mut().flatten().for_each(|c| *c = c.map(f));
+        m
+    }
+
+    #[test]
+    fn gltf_keeps_seams_materials_normals_and_colours() {
+        for name in [
+            "bunny-10k-textured.obj",
+            "airplane-colored.ply",
+            "dragon-res3.ply",
+        ] {
+            let Some(path) = shared(name) else {
+                continue;
+            };
+            let mut mesh = single(read_attributed(&path).unwrap());
+            if let Some(m) = &mut mesh.attributes.materials {
+                m.library = None; // glTF names materials, it has no library file
+            }
+            for format in ["glb", "gltf"] {
+                let bytes = write_attributed_bytes(&mesh, format).unwrap();
+                let back = read_attributed_bytes(&bytes, format).unwrap();
+                // glTF vertices are wedges: welded again by position, the wedges come back.
+                assert_eq!(
+                    back.attributes.wedge_count(),
+                    mesh.attributes.wedge_count(),
+                    "{name} {format}"
+                );
+                assert_eq!(back.mesh.faces.len(), mesh.mesh.faces.len());
+                if mesh.attributes.wedge_count() > 0 && name != "dragon-res3.ply" {
+                    // Vertices come back in first-use order; compare what every corner holds.
+                    assert_round_trips(&mesh, format);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn gltf_files_with_buffers_beside_them_read_and_bytes_alone_refuse_them() {
+        let dir = tempfile::tempdir().unwrap();
+        let mesh = AttributedMesh {
+            mesh: crate::mesh::generate::icosphere(1),
+            attributes: Attributes::default(),
+        };
+        let mesh = single(mesh);
+        let embedded = write_attributed_bytes(&mesh, "gltf").unwrap();
+        // Move the buffer out into a file of its own, as exporters often write them.
+        let mut json: serde_json::Value = serde_json::from_slice(&embedded).unwrap();
+        let uri = json["buffers"][0]["uri"].as_str().unwrap().to_string();
+        let data = uri.split_once(";base64,").unwrap().1;
+        use base64::Engine as _;
+        let bin = base64::engine::general_purpose::STANDARD
+            .decode(data)
+            .unwrap();
+        std::fs::write(dir.path().join("mesh.bin"), bin).unwrap();
+        json["buffers"][0]["uri"] = "mesh.bin".into();
+        let text = serde_json::to_vec(&json).unwrap();
+        let path = dir.path().join("mesh.gltf");
+        std::fs::write(&path, &text).unwrap();
+        let back = read_mesh(&path).unwrap();
+        assert_eq!(back.faces.len(), mesh.mesh.faces.len());
+        let e = read_attributed_bytes(&text, "gltf")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("file of its own"), "{e}");
+        json["buffers"][0]["uri"] = "../outside.bin".into();
+        std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+        assert!(read_mesh(&path).unwrap_err().to_string().contains("beside"));
+    }
+
+    #[test]
+    fn gltf_split_vertices_weld_into_wedges_placed_by_their_node() {
+        // fuzz/seeds/read_gltf: a torus split at its uv seams, normals, two materials, the node
+        // translated by (0, 0, 1); as .gltf with an embedded buffer and as .glb.
+        let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/read_gltf");
+        let gltf = read_attributed(&seeds.join("torus.gltf")).unwrap();
+        let glb = read_attributed(&seeds.join("torus.glb")).unwrap();
+        assert!(gltf == glb);
+        let (mesh, a) = (&gltf.mesh, &gltf.attributes);
+        // 8 x 5 positions; the seams split the wrap-around rows: 9 x 6 glTF vertices.
+        assert_eq!(mesh.positions.len(), 40);
+        assert_eq!(a.wedge_count(), 54);
+        assert_eq!(mesh.faces.len(), 80);
+        assert!(a.normals.is_some() && a.colours.is_none());
+        let materials = a.materials.as_ref().unwrap();
+        assert_eq!(materials.names, ["inside", "outside"]);
+        assert_eq!(materials.face.iter().filter(|&&m| m == 1).count(), 40);
+        let lowest = mesh
+            .positions
+            .iter()
+            .map(|p| p.z)
+            .fold(f64::INFINITY, f64::min);
+        // The tube's lowest sample, 0.4·sin(4/5 turn) below its centre, lifted by 1.
+        let expected = 1.0 + 0.4 * (std::f64::consts::TAU * 0.8).sin();
+        assert!(
+            (lowest - expected).abs() < 1e-6,
+            "{lowest}: the node's translation"
+        );
     }
 
     #[test]
