@@ -69,6 +69,11 @@ regressions! {
     pm_base_mesh_with_a_non_manifold_vertex_is_refused: "decode_pm" / "non-manifold-base-mesh";
     obj_texture_index_past_the_list_is_refused: "read_obj" / "texture-index-overflows-in-tobj";
     ply_element_with_records_but_no_properties_is_refused: "read_ply" / "element-without-properties";
+    gltf_primitive_naming_an_accessor_past_the_list_is_refused: "read_gltf" / "position-accessor-past-the-list";
+    glb_header_shorter_than_itself_is_refused: "read_gltf" / "glb-length-below-its-header";
+    gltf_accessors_lost_to_a_misspelled_key_are_refused: "read_gltf" / "accessors-key-misspelled-in-a-document-with-stray-bytes";
+    gltf_uvs_of_an_unsigned_int_type_are_refused: "read_gltf" / "texcoords-of-integer-component-type";
+    gltf_indices_of_a_float_type_are_refused: "read_gltf" / "indices-of-float-component-type";
 }
 
 #[test]

@@ -50,7 +50,7 @@ enum Command {
     Decode {
         /// Stream file.
         input: PathBuf,
-        /// Mesh file to write (.ply or .obj).
+        /// Mesh file to write (.ply, .obj, .glb or .gltf).
         output: PathBuf,
         /// Stop after this many levels.
         #[arg(long, conflicts_with = "bytes")]

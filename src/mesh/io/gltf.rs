@@ -26,6 +26,7 @@ fn fault(what: impl std::fmt::Display) -> Error {
 /// Reads glTF from `bytes`; `dir` is where a `.gltf` file's external buffers lie (none for
 /// bytes alone: only embedded buffers then).
 pub fn read_attributed(bytes: &[u8], dir: Option<&Path>) -> Result<AttributedMesh> {
+    check_before_the_crate(bytes)?;
     let gltf = gltf::Gltf::from_slice(bytes).map_err(fault)?;
     let mut buffers = Vec::new();
     for buffer in gltf.document.buffers() {
@@ -65,6 +66,98 @@ pub fn read_attributed(bytes: &[u8], dir: Option<&Path>) -> Result<AttributedMes
         }
     }
     reading.finish(document)
+}
+
+/// What the `gltf` crate (1.4) does not survive, refused before it reads the file
+/// (fuzz/regressions/read_gltf): a GLB header whose length is less than the header itself (the
+/// crate subtracts unchecked); a primitive naming an accessor past the list (gltf-json checks a
+/// primitive's POSITION bounds by indexing the list unchecked); and an accessor whose component
+/// type or shape does not fit the attribute it holds (the crate's readers reach `unreachable!`).
+/// Anything else malformed is left to the crate.
+fn check_before_the_crate(bytes: &[u8]) -> Result<()> {
+    if let Some(length) = bytes.get(8..12).filter(|_| bytes.starts_with(b"glTF")) {
+        let length = u32::from_le_bytes(length.try_into().expect("four bytes"));
+        if length < 12 {
+            return Err(fault(format!(
+                "a GLB header giving a length of {length} bytes"
+            )));
+        }
+    }
+    let json: std::borrow::Cow<[u8]> = if bytes.starts_with(b"glTF") {
+        match gltf::binary::Glb::from_slice(bytes) {
+            Ok(glb) => glb.json,
+            Err(e) => return Err(fault(e)),
+        }
+    } else {
+        std::borrow::Cow::Borrowed(bytes)
+    };
+    // Lossily: serde skips the bytes of keys it ignores without checking that they are UTF-8,
+    // so the crate reads documents a strict parse would refuse.
+    let text = String::from_utf8_lossy(&json);
+    let Ok(root) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return Ok(()); // the crate says what is wrong with it
+    };
+    let accessors = root["accessors"]
+        .as_array()
+        .map(Vec::as_slice)
+        .unwrap_or_default();
+    const BYTE: u64 = 5121;
+    const SHORT: u64 = 5123;
+    const INT: u64 = 5125;
+    const FLOAT: u64 = 5126;
+    // (component types, shapes) an attribute may have, for those this reader reads.
+    let fits = |semantic: &str| -> Option<(&[u64], &[&str])> {
+        Some(match semantic {
+            "POSITION" | "NORMAL" => (&[FLOAT], &["VEC3"]),
+            "TEXCOORD_0" => (&[BYTE, SHORT, FLOAT], &["VEC2"]),
+            "COLOR_0" => (&[BYTE, SHORT, FLOAT], &["VEC3", "VEC4"]),
+            "indices" => (&[BYTE, SHORT, INT], &["SCALAR"]),
+            _ => return None,
+        })
+    };
+    let primitives = root["meshes"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .flat_map(|m| m["primitives"].as_array().into_iter().flatten());
+    for primitive in primitives {
+        let named = primitive["attributes"]
+            .as_object()
+            .into_iter()
+            .flatten()
+            .map(|(k, v)| (k.as_str(), v))
+            .chain(std::iter::once(("indices", &primitive["indices"])))
+            .chain(
+                primitive["targets"]
+                    .as_array()
+                    .into_iter()
+                    .flatten()
+                    .filter_map(|t| t.as_object())
+                    .flatten()
+                    .map(|(_, v)| ("target", v)),
+            );
+        for (semantic, index) in named {
+            let Some(i) = index.as_u64() else {
+                continue; // absent, or not an index: the crate refuses the latter
+            };
+            let Some(accessor) = accessors.get(i as usize) else {
+                return Err(fault(format!(
+                    "a primitive names accessor {i} of {}",
+                    accessors.len()
+                )));
+            };
+            if let Some((components, shapes)) = fits(semantic) {
+                let component = accessor["componentType"].as_u64().unwrap_or(0);
+                let shape = accessor["type"].as_str().unwrap_or("");
+                if !components.contains(&component) || !shapes.contains(&shape) {
+                    return Err(fault(format!(
+                        "{semantic} in accessor {i} of component type {component} and type '{shape}'"
+                    )));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn load_uri(uri: &str, dir: Option<&Path>) -> Result<Vec<u8>> {
