@@ -95,3 +95,43 @@ fn every_seed_and_regression_input_replays_cleanly() {
     }
     assert!(replayed >= 20, "only {replayed} inputs found under fuzz/");
 }
+
+/// The committed corpus (fuzz/corpus.tar.xz, unpacked to a scratch folder) through the same
+/// functions, each input within 4 s: what `bash fuzz/replay.sh` checks under libFuzzer with its
+/// memory limits too, here without building the fuzz targets.
+#[test]
+fn the_committed_corpus_replays_cleanly_and_quickly() {
+    let archive = fuzz_dir().join("corpus.tar.xz");
+    let scratch = tempfile::tempdir().unwrap();
+    let unpacked = std::process::Command::new("tar")
+        .arg("-C")
+        .arg(scratch.path())
+        .arg("-xJf")
+        .arg(&archive)
+        .status()
+        .expect("tar runs");
+    assert!(
+        unpacked.success(),
+        "tar could not unpack {}",
+        archive.display()
+    );
+    let mut replayed = 0;
+    let mut slowest = (0.0, String::new());
+    for target in std::fs::read_dir(scratch.path().join("corpus")).unwrap() {
+        let target = target.unwrap().path();
+        let name = target.file_name().unwrap().to_string_lossy().into_owned();
+        for input in std::fs::read_dir(&target).unwrap() {
+            let path = input.unwrap().path();
+            let bytes = std::fs::read(&path).unwrap();
+            let started = std::time::Instant::now();
+            replay(&name, &bytes);
+            let took = started.elapsed().as_secs_f64();
+            if took > slowest.0 {
+                slowest = (took, format!("{name}/{}", path.display()));
+            }
+            replayed += 1;
+        }
+    }
+    assert!(replayed >= 5000, "only {replayed} corpus inputs");
+    assert!(slowest.0 <= 4.0, "{} took {:.1} s", slowest.1, slowest.0);
+}
