@@ -168,9 +168,10 @@ fn codec(name: &str) -> PyResult<&'static dyn Codec> {
     codecs::by_name(name).map_err(to_py)
 }
 
-fn grid_shape(grid: Option<&str>, codec: &dyn Codec) -> PyResult<GridShape> {
+/// The grid named, `default` when none is.
+fn grid_shape(grid: Option<&str>, default: GridShape) -> PyResult<GridShape> {
     match grid {
-        None => Ok(codec.default_options().grid),
+        None => Ok(default),
         Some("cubic") => Ok(GridShape::Cubic),
         Some("per-axis") => Ok(GridShape::PerAxis),
         Some(other) => Err(refuse(format!("unknown grid '{other}' (cubic, per-axis)"))),
@@ -191,7 +192,7 @@ fn encode<'py>(
     let codec = codec(codec_name)?;
     let options = EncodeOptions {
         quant_bits,
-        grid: grid_shape(grid, codec)?,
+        grid: grid_shape(grid, codec.default_options().grid)?,
     };
     let mesh = mesh_of(&vertices, &faces)?;
     let bytes = py
@@ -216,11 +217,7 @@ fn canonical<'py>(
 ) -> PyResult<MeshArrays<'py>> {
     let options = EncodeOptions {
         quant_bits,
-        grid: match grid {
-            None | Some("cubic") => GridShape::Cubic,
-            Some("per-axis") => GridShape::PerAxis,
-            Some(other) => return Err(refuse(format!("unknown grid '{other}' (cubic, per-axis)"))),
-        },
+        grid: grid_shape(grid, GridShape::Cubic)?,
     };
     let mesh = mesh_of(&vertices, &faces)?;
     let canonical = py
@@ -328,7 +325,6 @@ fn info<'py>(py: Python<'py>, stream: &[u8]) -> PyResult<Bound<'py, PyDict>> {
     let reader = StreamReader::open(stream).map_err(to_py)?;
     let header = reader.header();
     let codec = codecs::by_id(header.codec_id).map_err(to_py)?;
-    let levels = codecs::open(stream).map_err(to_py)?.levels();
     let index = reader.index();
     let start = reader.payload_start() as u64;
     let units = PyList::empty(py);
@@ -353,8 +349,10 @@ fn info<'py>(py: Python<'py>, stream: &[u8]) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("cell", header.grid.cell.to_vec())?;
     d.set_item("vertices", header.vertices)?;
     d.set_item("triangles", header.triangles)?;
-    d.set_item("levels", levels)?;
-    d.set_item("level_ends", codec.level_ends(&reader).map_err(to_py)?)?;
+    // One end a level: the count without opening a decoder.
+    let ends = codec.level_ends(&reader).map_err(to_py)?;
+    d.set_item("levels", ends.len())?;
+    d.set_item("level_ends", ends)?;
     d.set_item("payload_start", start)?;
     d.set_item("layered", index.is_layered())?;
     d.set_item("units", units)?;

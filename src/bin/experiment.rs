@@ -256,6 +256,16 @@ fn run_codec(
     Ok((result, written))
 }
 
+/// One codec on one mesh at one quantization, as a set numbers it.
+struct Job<'a> {
+    number: usize,
+    /// Index of the mesh in the set.
+    mesh: usize,
+    path: &'a Path,
+    codec: &'static dyn Codec,
+    quant: Option<u8>,
+}
+
 /// An experiment set read and resolved: its name, codecs, meshes and quantizations.
 struct Set {
     name: String,
@@ -307,13 +317,20 @@ impl Set {
         })
     }
 
-    /// Every job in order (meshes, then codecs, then quantizations), numbered from 0.
-    fn jobs(&self) -> Vec<(usize, &Path, &'static dyn Codec, Option<u8>)> {
+    /// Every job in order (meshes, then codecs, then quantizations), numbered from 0, with the
+    /// index of its mesh.
+    fn jobs(&self) -> Vec<Job<'_>> {
         let mut jobs = Vec::new();
-        for path in &self.paths {
+        for (mesh, path) in self.paths.iter().enumerate() {
             for &codec in &self.codecs {
                 for &quant in &self.quants {
-                    jobs.push((jobs.len(), path.as_path(), codec, quant));
+                    jobs.push(Job {
+                        number: jobs.len(),
+                        mesh,
+                        path,
+                        codec,
+                        quant,
+                    });
                 }
             }
         }
@@ -331,7 +348,14 @@ fn run_set(file: &Path, shard: Option<Shard>, settings: &Settings) -> Result<()>
     let jobs = set.jobs();
     let mut records = Vec::new();
     let mut runs: Vec<Vec<RunResult>> = vec![Vec::new(); set.paths.len()];
-    for &(job, path, codec, quant) in &jobs {
+    for &Job {
+        number: job,
+        mesh: mesh_index,
+        path,
+        codec,
+        quant,
+    } in &jobs
+    {
         if shard.is_some_and(|s| !s.owns(job)) {
             continue;
         }
@@ -339,7 +363,7 @@ fn run_set(file: &Path, shard: Option<Shard>, settings: &Settings) -> Result<()>
         let mesh = mesh_name(path);
         let (refused, files) = match run_codec(codec, path, &options, out, settings.keep_stream) {
             Ok((run, files)) => {
-                runs[job / (set.codecs.len() * set.quants.len())].push(run);
+                runs[mesh_index].push(run);
                 (false, files)
             }
             // A codec that cannot take a mesh says why; the set goes on, and the reason is
@@ -439,16 +463,20 @@ fn merge(file: &Path, shards: &[PathBuf], out: &Path) -> Result<()> {
     let jobs = set.jobs();
     let found = meshcodec::sweep::collect(&set.name, jobs.len(), shards)?;
     let mut runs: Vec<Vec<RunResult>> = vec![Vec::new(); set.paths.len()];
-    for ((job, path, codec, quant), (record, dir)) in jobs.iter().zip(&found) {
-        if record.codec != codec.name() || record.mesh != mesh_name(path) || record.quant != *quant
+    for (job, (record, dir)) in jobs.iter().zip(&found) {
+        let (path, codec) = (job.path, job.codec);
+        if record.codec != codec.name()
+            || record.mesh != mesh_name(path)
+            || record.quant != job.quant
         {
             anyhow::bail!(
-                "{}: job {job} is {} on {}, but the set's job {job} is {} on {}: the set changed since the shard ran",
+                "{}: job {n} is {} on {}, but the set's job {n} is {} on {}: the set changed since the shard ran",
                 dir.display(),
                 record.codec,
                 record.mesh,
                 codec.name(),
-                mesh_name(path)
+                mesh_name(path),
+                n = job.number
             );
         }
         for relative in &record.files {
@@ -462,7 +490,7 @@ fn merge(file: &Path, shards: &[PathBuf], out: &Path) -> Result<()> {
             if !record.refused && relative.extension().is_some_and(|e| e == "json") {
                 let run: RunResult = serde_json::from_slice(&bytes)
                     .with_context(|| format!("{}: not a result", from.display()))?;
-                runs[job / (set.codecs.len() * set.quants.len())].push(run);
+                runs[job.mesh].push(run);
             }
         }
     }

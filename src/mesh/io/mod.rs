@@ -31,13 +31,10 @@ pub const EXTENSIONS: [&str; 7] = ["ply", "obj", "off", "m", "stl", "gltf", "glb
 /// ([`read_mesh_and_appearance`] says what else the file holds).
 pub fn read_mesh(path: &Path) -> Result<TriMesh> {
     let ext = extension(path);
-    let bytes = std::fs::read(path)?;
     if is_gltf(&ext) {
-        // A .gltf file's buffers may be files beside it.
-        let mesh = gltf::read_attributed(&bytes, path.parent())?.mesh;
-        mesh.validate()?;
-        return Ok(mesh);
+        return Ok(read_attributed(path)?.mesh);
     }
+    let bytes = std::fs::read(path)?;
     read_by_extension(&bytes, &ext)
 }
 
@@ -64,13 +61,12 @@ fn gltf_appearance(m: &AttributedMesh) -> Appearance {
 /// coordinates, colours, materials) the file holds beyond it, which the mesh does not carry.
 pub fn read_mesh_and_appearance(path: &Path) -> Result<(TriMesh, Appearance)> {
     let ext = extension(path);
-    let bytes = std::fs::read(path)?;
     if is_gltf(&ext) {
-        let m = gltf::read_attributed(&bytes, path.parent())?;
-        m.mesh.validate()?;
+        let m = read_attributed(path)?;
         let found = gltf_appearance(&m);
         return Ok((m.mesh, found));
     }
+    let bytes = std::fs::read(path)?;
     let mesh = read_by_extension(&bytes, &ext)?;
     let found = appearance::appearance_of(&bytes, &ext, mesh.positions.len(), mesh.faces.len());
     Ok((mesh, found))
@@ -102,6 +98,7 @@ pub fn read_attributed(path: &Path) -> Result<AttributedMesh> {
     let ext = extension(path);
     let bytes = std::fs::read(path)?;
     if is_gltf(&ext) {
+        // A .gltf file's buffers may be files beside it.
         let m = gltf::read_attributed(&bytes, path.parent())?;
         m.mesh.validate()?;
         return Ok(m);
