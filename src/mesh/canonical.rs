@@ -40,6 +40,12 @@ impl CanonicalMesh {
     /// The canonical mesh of `mesh` on `grid`. Vertices keep the order of their first
     /// appearance in the input's vertex list, faces the order of their first appearance.
     pub fn new(mesh: &TriMesh, grid: Grid) -> Result<CanonicalMesh> {
+        Ok(CanonicalMesh::with_origins(mesh, grid)?.0)
+    }
+
+    /// [`CanonicalMesh::new`], with the input face each canonical face comes from (the first of
+    /// the repeats it stands for), so attributes can follow their faces.
+    pub fn with_origins(mesh: &TriMesh, grid: Grid) -> Result<(CanonicalMesh, Vec<u32>)> {
         mesh.validate()?;
         let used = mesh.referenced();
         let mut cell_vertex: HashMap<[u32; 3], VertexId> = HashMap::new();
@@ -56,14 +62,15 @@ impl CanonicalMesh {
             });
         }
         let mut seen = HashSet::new();
-        let faces = mesh
+        let (faces, origins) = mesh
             .faces
             .iter()
-            .map(|f| f.map(|v| remap[v as usize]))
-            .filter(|[a, b, c]| a != b && b != c && a != c)
-            .filter(|f| seen.insert(rotate_to_smallest(*f)))
-            .collect();
-        Ok(CanonicalMesh { grid, cells, faces })
+            .enumerate()
+            .map(|(i, f)| (f.map(|v| remap[v as usize]), i as u32))
+            .filter(|([a, b, c], _)| a != b && b != c && a != c)
+            .filter(|(f, _)| seen.insert(rotate_to_smallest(*f)))
+            .unzip();
+        Ok((CanonicalMesh { grid, cells, faces }, origins))
     }
 
     /// Number of vertices.

@@ -2,8 +2,10 @@
 //! materials), its file formats, validation, quantization to a grid, the canonical mesh that
 //! "lossless" is judged against, and generators.
 
+pub mod attribute_quantization;
 pub mod attributes;
 pub mod canonical;
+pub mod canonical_attributes;
 pub mod generate;
 pub mod io;
 pub mod quantize;
