@@ -6,6 +6,7 @@
 //! params: varint length + codec-specific bytes
 //! grid: bits (u8), origin 3 × f64 LE, cell 3 × f64 LE
 //! vertices (varint)  triangles (varint)                        -- of the full mesh
+//! version 3 only: appearance block (flags u8, then each attribute's quantization, names)
 //! index: units N (varint), payload bytes P (varint),
 //!        N × { offset (varint), length (varint), parent (varint: 0 = none, k = unit i − k) }
 //! payload: P bytes, every byte in exactly one unit
@@ -20,14 +21,19 @@
 use crate::coding::varint;
 use crate::error::{Error, Result};
 use crate::limits;
+use crate::mesh::attribute_quantization::{UvGrid, NORMAL_BITS_RANGE};
 use crate::mesh::Grid;
 use std::io::Read as _;
 
 /// First bytes of every stream.
 pub const MAGIC: [u8; 4] = *b"MshC";
 /// Version of the stream syntax: bumped on every change to the bytes any codec writes
-/// (docs/FORMAT.md, "History").
-pub const FORMAT_VERSION: u8 = 2;
+/// (docs/FORMAT.md, "History"). Version 3 is version 2 with an appearance block after the
+/// header and an appearance unit after the last; a stream without appearance is written in
+/// version 2, which this build also reads.
+pub const FORMAT_VERSION: u8 = 3;
+/// The version of streams without appearance, and the oldest this build reads.
+pub const GEOMETRY_ONLY_VERSION: u8 = 2;
 /// The fewest bytes an index entry takes (three one-byte varints).
 const MIN_ENTRY_BYTES: u64 = 3;
 
@@ -44,6 +50,141 @@ pub struct Header {
     pub vertices: u64,
     /// Triangles of the full mesh.
     pub triangles: u64,
+    /// What the appearance unit carries, when the stream has one (version 3).
+    pub appearance: Option<AppearanceSpec>,
+}
+
+/// What a stream's appearance unit carries and how it is quantized (docs/FORMAT.md §1.1).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AppearanceSpec {
+    /// Qn of the wedges' octahedral normals, when there are normals.
+    pub normal_bits: Option<u8>,
+    /// The grid of the wedges' uvs, when there are uvs.
+    pub uv_grid: Option<UvGrid>,
+    /// Whether wedges carry 8-bit RGBA colours.
+    pub colours: bool,
+    /// The material names faces' ids index, when faces carry materials.
+    pub materials: Option<MaterialNames>,
+}
+
+/// Material names and the library they come from.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct MaterialNames {
+    /// Names, indexed by material id.
+    pub names: Vec<String>,
+    /// The material library file (OBJ's `mtllib`), if any.
+    pub library: Option<String>,
+}
+
+const FLAG_NORMALS: u8 = 1;
+const FLAG_UVS: u8 = 2;
+const FLAG_COLOURS: u8 = 4;
+const FLAG_MATERIALS: u8 = 8;
+
+impl AppearanceSpec {
+    fn write(&self, out: &mut Vec<u8>) {
+        let flags = self.normal_bits.map_or(0, |_| FLAG_NORMALS)
+            | self.uv_grid.map_or(0, |_| FLAG_UVS)
+            | if self.colours { FLAG_COLOURS } else { 0 }
+            | self.materials.as_ref().map_or(0, |_| FLAG_MATERIALS);
+        out.push(flags);
+        if let Some(bits) = self.normal_bits {
+            out.push(bits);
+        }
+        if let Some(grid) = &self.uv_grid {
+            out.push(grid.bits);
+            for v in grid.origin.iter().chain([&grid.cell]) {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        if let Some(materials) = &self.materials {
+            varint::put(out, materials.names.len() as u64);
+            for name in materials.names.iter().chain(&materials.library) {
+                varint::put(out, name.len() as u64);
+                out.extend_from_slice(name.as_bytes());
+            }
+            if materials.library.is_none() {
+                varint::put(out, 0);
+            }
+        }
+    }
+
+    fn read(bytes: &[u8], pos: &mut usize) -> Result<AppearanceSpec> {
+        let cut = || Error::Truncated("the stream ends inside its header".into());
+        let byte = |pos: &mut usize| -> Result<u8> {
+            let b = *bytes.get(*pos).ok_or_else(cut)?;
+            *pos += 1;
+            Ok(b)
+        };
+        let at = *pos;
+        let flags = byte(pos)?;
+        if flags == 0 || flags & !(FLAG_NORMALS | FLAG_UVS | FLAG_COLOURS | FLAG_MATERIALS) != 0 {
+            return Err(Error::malformed(
+                0,
+                at,
+                format!("appearance flags {flags:#04x}"),
+            ));
+        }
+        let mut spec = AppearanceSpec {
+            colours: flags & FLAG_COLOURS != 0,
+            ..AppearanceSpec::default()
+        };
+        if flags & FLAG_NORMALS != 0 {
+            let bits = byte(pos)?;
+            if !NORMAL_BITS_RANGE.contains(&bits) {
+                return Err(Error::malformed(
+                    0,
+                    *pos - 1,
+                    format!("normals of {bits} bits"),
+                ));
+            }
+            spec.normal_bits = Some(bits);
+        }
+        if flags & FLAG_UVS != 0 {
+            let bits = byte(pos)?;
+            let mut floats = [0f64; 3];
+            for f in &mut floats {
+                let raw = bytes.get(*pos..*pos + 8).ok_or_else(cut)?;
+                *f = f64::from_le_bytes(raw.try_into().expect("8 bytes"));
+                *pos += 8;
+            }
+            let grid = UvGrid {
+                bits,
+                origin: [floats[0], floats[1]],
+                cell: floats[2],
+            };
+            if !grid.is_valid() {
+                return Err(Error::malformed(
+                    0,
+                    *pos - 25,
+                    "uv grid: bits, origin or cell size out of range",
+                ));
+            }
+            spec.uv_grid = Some(grid);
+        }
+        if flags & FLAG_MATERIALS != 0 {
+            let count = read_count(bytes, pos, "materials", limits::MAX_MATERIALS)?;
+            if count == 0 {
+                return Err(Error::malformed(0, *pos, "appearance declares no material"));
+            }
+            let text = |pos: &mut usize| -> Result<String> {
+                let at = *pos;
+                let len = read_count(bytes, pos, "name bytes", limits::MAX_NAME_BYTES)? as usize;
+                let raw = bytes.get(*pos..*pos + len).ok_or_else(cut)?;
+                *pos += len;
+                String::from_utf8(raw.to_vec())
+                    .map_err(|_| Error::malformed(0, at, "a material name is not UTF-8"))
+            };
+            // Names take at least a byte each: no allocation beyond what the bytes hold.
+            if ((bytes.len() - *pos) as u64) < count {
+                return Err(cut());
+            }
+            let names = (0..count).map(|_| text(pos)).collect::<Result<_>>()?;
+            let library = Some(text(pos)?).filter(|l| !l.is_empty());
+            spec.materials = Some(MaterialNames { names, library });
+        }
+        Ok(spec)
+    }
 }
 
 /// Where one unit's payload lies, and what it needs decoded first.
@@ -69,8 +210,10 @@ impl UnitEntry {
 pub struct Index {
     /// Units in decoding order.
     pub units: Vec<UnitEntry>,
-    /// Bytes of the payload (the sum of the units' lengths).
+    /// Bytes of the payload (the sum of the units' lengths, the appearance unit's included).
     pub payload_bytes: u64,
+    /// The appearance unit, last in the stream, when the header declares appearance.
+    pub appearance: Option<UnitEntry>,
 }
 
 impl Index {
@@ -103,6 +246,7 @@ impl Index {
         Index {
             units,
             payload_bytes: offset,
+            appearance: None,
         }
     }
 
@@ -140,9 +284,12 @@ impl Index {
 
     /// Appends the index's bytes to `out`.
     pub fn write(&self, out: &mut Vec<u8>) {
-        varint::put(out, self.units.len() as u64);
+        varint::put(
+            out,
+            (self.units.len() + self.appearance.is_some() as usize) as u64,
+        );
         varint::put(out, self.payload_bytes);
-        for (i, unit) in self.units.iter().enumerate() {
+        for (i, unit) in self.units.iter().chain(&self.appearance).enumerate() {
             varint::put(out, unit.offset);
             varint::put(out, unit.length);
             varint::put(out, unit.parent.map_or(0, |p| (i - p) as u64));
@@ -216,6 +363,7 @@ impl Index {
         Ok(Index {
             units: entries,
             payload_bytes,
+            appearance: None,
         })
     }
 }
@@ -243,7 +391,11 @@ impl Header {
     /// Appends the header's bytes to `out`.
     pub fn write(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(&MAGIC);
-        out.push(FORMAT_VERSION);
+        out.push(if self.appearance.is_some() {
+            FORMAT_VERSION
+        } else {
+            GEOMETRY_ONLY_VERSION
+        });
         out.push(self.codec_id);
         varint::put(out, self.params.len() as u64);
         out.extend_from_slice(&self.params);
@@ -253,6 +405,9 @@ impl Header {
         }
         varint::put(out, self.vertices);
         varint::put(out, self.triangles);
+        if let Some(appearance) = &self.appearance {
+            appearance.write(out);
+        }
     }
 
     /// Reads a header from the start of `bytes`; returns it and the offset of the index.
@@ -266,9 +421,9 @@ impl Header {
             return Err(bad(0, "not a meshcodec stream (bad magic)"));
         }
         let version = *bytes.get(4).ok_or_else(cut)?;
-        if version != FORMAT_VERSION {
+        if !(GEOMETRY_ONLY_VERSION..=FORMAT_VERSION).contains(&version) {
             return Err(Error::Unsupported(format!(
-                "stream format version {version} (this build reads version {FORMAT_VERSION} only)"
+                "stream format version {version} (this build reads versions {GEOMETRY_ONLY_VERSION} and {FORMAT_VERSION})"
             )));
         }
         let codec_id = *bytes.get(5).ok_or_else(cut)?;
@@ -315,21 +470,47 @@ impl Header {
                 &format!("header declares {vertices} vertices and {triangles} triangles"),
             ));
         }
+        let appearance = if version == FORMAT_VERSION {
+            Some(AppearanceSpec::read(bytes, &mut pos)?)
+        } else {
+            None
+        };
         let header = Header {
             codec_id,
             params,
             grid,
             vertices,
             triangles,
+            appearance,
         };
         Ok((header, pos))
     }
 }
 
 /// Reads the header and index at the start of `bytes`; returns them and the payload's offset.
+/// When the header declares appearance, the index's last unit is the appearance unit: it is
+/// taken out of the units into [`Index::appearance`], so a codec sees its own units only.
 pub fn read_header_and_index(bytes: &[u8]) -> Result<(Header, Index, usize)> {
     let (header, mut pos) = Header::read(bytes)?;
-    let index = Index::read(bytes, &mut pos)?;
+    let mut index = Index::read(bytes, &mut pos)?;
+    if header.appearance.is_some() {
+        if index.units.len() < 2 {
+            return Err(Error::malformed(
+                0,
+                pos,
+                "index: a stream with appearance needs a unit of geometry and the appearance unit",
+            ));
+        }
+        let unit = index.units.pop().expect("two units or more");
+        if unit.end() != index.payload_bytes {
+            return Err(Error::malformed(
+                0,
+                pos,
+                "index: the appearance unit is not the payload's last bytes",
+            ));
+        }
+        index.appearance = Some(unit);
+    }
     Ok((header, index, pos))
 }
 
@@ -519,6 +700,17 @@ impl<'a> StreamReader<'a> {
         })
     }
 
+    /// The appearance unit — its bytes, number and first byte — when the stream has one and
+    /// it is wholly present.
+    pub fn appearance_unit(&self) -> Option<(&'a [u8], usize, usize)> {
+        let entry = self.index.appearance?;
+        let start = self.payload_start + entry.offset as usize;
+        let end = self.payload_start + entry.end() as usize;
+        self.bytes
+            .get(start..end)
+            .map(|bytes| (bytes, self.index.units.len(), start))
+    }
+
     /// The next complete level, or `None` when the stream has no more (all levels read, or the
     /// bytes end inside the next one: then [`StreamReader::truncated`] is true).
     pub fn next_level(&mut self) -> Option<LevelPayload<'a>> {
@@ -664,6 +856,7 @@ mod tests {
             },
             vertices: 1000,
             triangles: 2000,
+            appearance: None,
         }
     }
 
@@ -752,18 +945,21 @@ mod tests {
         let past = Index {
             units: vec![entry(0, 4, None), entry(4, 10, Some(0))],
             payload_bytes: 8,
+            appearance: None,
         };
         let e = StreamReader::open(&with_index(&past, &[0; 8])).unwrap_err();
         assert!(e.to_string().contains("runs past"), "{e}");
         let overlapping = Index {
             units: vec![entry(0, 6, None), entry(4, 2, Some(0))],
             payload_bytes: 8,
+            appearance: None,
         };
         let e = StreamReader::open(&with_index(&overlapping, &[0; 8])).unwrap_err();
         assert!(e.to_string().contains("overlap"), "{e}");
         let gap = Index {
             units: vec![entry(0, 2, None), entry(4, 2, Some(0))],
             payload_bytes: 8,
+            appearance: None,
         };
         let e = StreamReader::open(&with_index(&gap, &[0; 8])).unwrap_err();
         assert!(e.to_string().contains("cover 4 of the 8"), "{e}");
@@ -780,6 +976,7 @@ mod tests {
         let swapped = Index {
             units: vec![entry(4, 4, None), entry(0, 4, Some(0))],
             payload_bytes: 8,
+            appearance: None,
         };
         let bytes = with_index(&swapped, &[0; 8]);
         assert!(StreamReader::open(&bytes).is_ok());

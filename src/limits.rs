@@ -9,6 +9,10 @@ pub const MAX_TRIANGLES: u64 = 1 << 29;
 pub const MAX_UNITS: u64 = 1 << 20;
 /// Most bytes of codec parameters in a header.
 pub const MAX_PARAM_BYTES: u64 = 1 << 12;
+/// Most material names a stream may declare.
+pub const MAX_MATERIALS: u64 = 1 << 16;
+/// Most bytes of one material name (or of the material library's name).
+pub const MAX_NAME_BYTES: u64 = 1 << 12;
 
 /// Most triangles an EMC level may show, for a stream whose full mesh has `triangles`: every
 /// level's graph is the full graph with vertices merged, and on real meshes its 3-cliques stay

@@ -400,13 +400,20 @@ fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
 }
 
 #[test]
-fn encode_refuses_a_file_with_appearance_unless_told_to_drop_it() {
+fn a_codec_that_cannot_carry_appearance_refuses_it_unless_told_to_drop_it() {
     let dir = scratch();
     let d = dir.path();
-    // The shared textured bunny: 6,451 texture coordinates and a material.
+    // The shared textured bunny: 6,451 texture coordinates and a material; came-paper's full
+    // level is lossy, so it has no appearance unit.
     let out = run(
         MESHCODEC,
-        &["encode", "--codec", "emc", "bunny-10k-textured", "t.mc"],
+        &[
+            "encode",
+            "--codec",
+            "came-paper",
+            "bunny-10k-textured",
+            "t.mc",
+        ],
         d,
     );
     assert_clean_failure(&out, "bunny-10k-textured.obj");

@@ -1,7 +1,7 @@
 //! Golden streams and rate pins: an accidental change to the bytes a codec writes, or to how
 //! well it compresses, fails here.
 //!
-//! - `tests/golden/v<FORMAT_VERSION>/<codec>-<mesh>.mc` is each codec's stream of a small shared
+//! - `tests/golden/v<GEOMETRY_ONLY_VERSION>/<codec>-<mesh>.mc` is each codec's stream of a small shared
 //!   mesh at its default quantization, and `<mesh>-q<bits>.ply` the canonical mesh it decodes to.
 //!   The encoder must reproduce every stream byte for byte, and each stream must decode exactly
 //!   to that canonical mesh (docs/CONTRACT.md §3: same cells, same oriented faces).
@@ -12,7 +12,7 @@
 //! which a change of syntax must come with (and a new format version: docs/FORMAT.md, History).
 
 use meshcodec::codecs::{self, Codec, Stop};
-use meshcodec::container::FORMAT_VERSION;
+use meshcodec::container::{FORMAT_VERSION, GEOMETRY_ONLY_VERSION};
 use meshcodec::mesh::io::{read_mesh, resolve, write_mesh};
 use meshcodec::mesh::{CanonicalMesh, TriMesh};
 use meshcodec::Error;
@@ -28,7 +28,7 @@ const RATE_MESHES: [&str; 3] = ["eight", "beethoven", "spot"];
 fn golden_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/golden")
-        .join(format!("v{FORMAT_VERSION}"))
+        .join(format!("v{GEOMETRY_ONLY_VERSION}"))
 }
 
 fn rates_file() -> PathBuf {
@@ -134,7 +134,7 @@ fn streams_of_another_format_version_are_refused_in_one_line() {
     let codec = codecs::by_name("raw").unwrap();
     let [(_, eight)] = read_all(["eight"]);
     let mut bytes = codec.encode(&canonical(codec, &eight)).unwrap().bytes;
-    for version in [0, FORMAT_VERSION - 1, FORMAT_VERSION + 1, 255] {
+    for version in [0, GEOMETRY_ONLY_VERSION - 1, FORMAT_VERSION + 1, 255] {
         bytes[4] = version;
         match codecs::decode(&bytes, Stop::All) {
             Err(e @ Error::Unsupported(_)) => {

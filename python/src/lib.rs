@@ -139,7 +139,9 @@ type MeshArrays<'py> = (
 );
 
 fn arrays(py: Python<'_>, level: LevelMesh) -> MeshArrays<'_> {
-    let LevelMesh { mesh, loose_edges } = level;
+    let LevelMesh {
+        mesh, loose_edges, ..
+    } = level;
     let (n, m, k) = (mesh.positions.len(), mesh.faces.len(), loose_edges.len());
     // Reinterpreted in place: a DVec3 is three f64s, a face three u32s.
     let positions: Vec<f64> = bytemuck::allocation::cast_vec(mesh.positions);
@@ -228,6 +230,7 @@ fn canonical<'py>(
         LevelMesh {
             mesh: canonical,
             loose_edges: Vec::new(),
+            attributes: None,
         },
     ))
 }
@@ -392,6 +395,7 @@ fn load(py: Python<'_>, path: PathBuf, drop_attributes: bool) -> PyResult<MeshAr
         LevelMesh {
             mesh,
             loose_edges: Vec::new(),
+            attributes: None,
         },
     ))
 }
@@ -435,7 +439,11 @@ fn distance<'py>(
         )));
     }
     let loose_edges = edges_of(&b_edges, mesh.positions.len())?;
-    let b = LevelMesh { mesh, loose_edges };
+    let b = LevelMesh {
+        mesh,
+        loose_edges,
+        attributes: None,
+    };
     let (measured, diagonal) = py.detach(|| {
         let reference = Reference::new(&a, samples, seed);
         let diagonal = a.referenced_bounds().map_or(0.0, |b| b.diagonal());

@@ -3,10 +3,14 @@
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use meshcodec::codecs::{self, LevelMesh, Stop};
+use meshcodec::codecs::{self, Capability, LevelMesh, Stop};
 use meshcodec::container::StreamReader;
 use meshcodec::harness::{encode_options, RunOptions};
-use meshcodec::mesh::io::{read_mesh, resolve, write_atomically, write_mesh};
+use meshcodec::mesh::attribute_quantization::AttributeBits;
+use meshcodec::mesh::attributes::AttributedMesh;
+use meshcodec::mesh::io::{
+    read_attributed, read_mesh, resolve, write_atomically, write_attributed, write_mesh,
+};
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
 use std::fmt::Write as _;
@@ -36,11 +40,17 @@ enum Command {
         /// Grid shape: cubic or per-axis (default: the codec's).
         #[arg(long, value_parser = meshcodec::cli::parse_grid)]
         grid: Option<GridShape>,
-        /// Encode the geometry of a file that also holds normals, texture coordinates,
-        /// colours or materials, which no codec of this build carries (without it, such a file
-        /// is refused).
+        /// Encode only the geometry of a file that also holds normals, texture coordinates,
+        /// colours or materials (without it, they are carried, or the file is refused by a codec
+        /// that cannot carry them).
         #[arg(long)]
         drop_attributes: bool,
+        /// Bits per texture-coordinate axis (Qt).
+        #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_UV_BITS)]
+        uv_bits: u8,
+        /// Bits per octahedral normal coordinate (Qn).
+        #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS)]
+        normal_bits: u8,
         /// Mesh file or name.
         input: String,
         /// Stream file to write.
@@ -131,9 +141,24 @@ fn main() -> ExitCode {
             quant,
             grid,
             drop_attributes,
+            uv_bits,
+            normal_bits,
             input,
             output,
-        } => encode(&codec, quant, grid, drop_attributes, &input, &output),
+        } => encode(
+            &codec,
+            quant,
+            grid,
+            drop_attributes.then_some(()).map_or(
+                Attributes::Carry(AttributeBits {
+                    uv: uv_bits,
+                    normal: normal_bits,
+                }),
+                |_| Attributes::Drop,
+            ),
+            &input,
+            &output,
+        ),
         Command::Decode {
             input,
             output,
@@ -182,25 +207,27 @@ fn load(name: &str) -> Result<(PathBuf, meshcodec::mesh::TriMesh)> {
     Ok((path, mesh))
 }
 
+/// What `encode` does with a file's appearance.
+enum Attributes {
+    /// Carries it at these bits (a codec that cannot is refused).
+    Carry(AttributeBits),
+    /// Encodes the geometry alone.
+    Drop,
+}
+
 fn encode(
     codec: &str,
     quant: Option<u8>,
     grid: Option<GridShape>,
-    drop_attributes: bool,
+    attributes: Attributes,
     input: &str,
     output: &Path,
 ) -> Result<()> {
     let codec = codecs::by_name(codec)?;
     let path = resolve(input).with_context(|| input.to_string())?;
-    let (mesh, appearance) = meshcodec::mesh::io::read_mesh_and_appearance(&path)
-        .with_context(|| path.display().to_string())?;
-    if !appearance.is_empty() && !drop_attributes {
-        return Err(meshcodec::Error::Unsupported(format!(
-            "holds {appearance}, which {} does not carry (no codec of this build does: positions and triangles only); --drop-attributes encodes the geometry alone",
-            codec.name()
-        )))
-        .with_context(|| path.display().to_string());
-    }
+    let context = || path.display().to_string();
+    let (mesh, appearance) =
+        meshcodec::mesh::io::read_mesh_and_appearance(&path).with_context(context)?;
     let options = encode_options(
         codec,
         &RunOptions {
@@ -209,14 +236,38 @@ fn encode(
             ..RunOptions::default()
         },
     );
-    let canonical =
-        codecs::canonical_for(&mesh, &options).with_context(|| path.display().to_string())?;
-    let encoded = codec
-        .encode(&canonical)
-        .with_context(|| path.display().to_string())?;
+    let carried = match attributes {
+        Attributes::Carry(bits) if !appearance.is_empty() => {
+            if !codec.capabilities().contains(&Capability::Attributes) {
+                return Err(meshcodec::Error::Unsupported(format!(
+                    "holds {appearance}, which {} does not carry (its full level is lossy); --drop-attributes encodes the geometry alone",
+                    codec.name()
+                )))
+                .with_context(context);
+            }
+            let attributed = read_attributed(&path).with_context(context)?;
+            Some(
+                codecs::canonical_attributed_for(&attributed, &options, bits)
+                    .with_context(context)?,
+            )
+        }
+        _ => None,
+    };
+    let (canonical, encoded) = match carried {
+        Some((canonical, appearance)) => {
+            let encoded = codecs::encode_attributed(codec, &canonical, Some(&appearance))
+                .with_context(context)?;
+            (canonical, encoded)
+        }
+        None => {
+            let canonical = codecs::canonical_for(&mesh, &options).with_context(context)?;
+            let encoded = codec.encode(&canonical).with_context(context)?;
+            (canonical, encoded)
+        }
+    };
     write_atomically(output, &encoded.bytes).with_context(|| output.display().to_string())?;
     // Said once the stream is written, so that a failure stays one line.
-    if !appearance.is_empty() {
+    if matches!(attributes, Attributes::Drop) && !appearance.is_empty() {
         eprintln!(
             "note: {}: {appearance} dropped (--drop-attributes)",
             path.display()
@@ -264,7 +315,17 @@ fn decode(
             prefix.len()
         );
     }
-    write_mesh(&decoded.mesh, output).with_context(|| output.display().to_string())?;
+    match decoded.attributes {
+        Some(attributes) => write_attributed(
+            &AttributedMesh {
+                mesh: decoded.mesh.clone(),
+                attributes,
+            },
+            output,
+        ),
+        None => write_mesh(&decoded.mesh, output),
+    }
+    .with_context(|| output.display().to_string())?;
     meshcodec::outln!(
         "{}: level {levels}, {} vertices, {} triangles from {} bytes",
         output.display(),
@@ -352,7 +413,9 @@ fn info(input: &Path, json: bool) -> Result<()> {
     let declared = decoder.levels();
     let mut levels = Vec::new();
     while decoder.advance().with_context(context)? {
-        let LevelMesh { mesh, loose_edges } = decoder.mesh()?;
+        let LevelMesh {
+            mesh, loose_edges, ..
+        } = decoder.mesh()?;
         let level = decoder.levels_decoded();
         let unit = layered.then(|| reader.unit(level - 1)).flatten();
         levels.push(serde_json::json!({
@@ -500,7 +563,7 @@ fn distance(
     let reference = Reference::new(&mesh_a, samples, seed);
     let level = LevelMesh {
         mesh: mesh_b,
-        loose_edges: Vec::new(),
+        ..LevelMesh::default()
     };
     let m = reference
         .measure(&level)

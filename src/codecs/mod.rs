@@ -6,6 +6,7 @@
 //! (docs/CONTRACT.md §3). What only some codecs do is a [`Capability`] a caller asks for, and a
 //! request for one a codec lacks is refused, never ignored.
 
+pub mod appearance;
 pub mod came;
 pub mod emc;
 pub mod names;
@@ -16,6 +17,8 @@ pub mod stats;
 use crate::container::{Header, StreamReader};
 pub use crate::container::{LevelCost, LevelRecord};
 use crate::error::{Error, Result};
+use crate::mesh::attributes::Attributes;
+use crate::mesh::canonical_attributes::CanonicalAttributes;
 use crate::mesh::quantize::GridShape;
 use crate::mesh::{CanonicalMesh, Grid, TriMesh, VertexId};
 pub use stats::{CameField, Stat, Stats};
@@ -51,6 +54,9 @@ pub struct LevelMesh {
     pub mesh: TriMesh,
     /// Edges not on any face.
     pub loose_edges: Vec<[VertexId; 2]>,
+    /// Wedges and materials over `mesh`'s faces: at the full level of a stream with an
+    /// appearance unit, once that unit is decoded (levels before it have none).
+    pub attributes: Option<Attributes>,
 }
 
 /// What only some codecs do. A caller asks [`Codec::capabilities`]; decoding with a stop that
@@ -66,8 +72,9 @@ pub enum Capability {
     /// Refines parts of the mesh view-dependently, units fetched by byte range (no codec of
     /// this build).
     SelectiveRefinement,
-    /// Carries appearance attributes: normals, texture coordinates, colours, materials (no
-    /// codec of this build: the readers keep positions and faces only).
+    /// Carries appearance attributes — normals, texture coordinates, colours, materials — in
+    /// an appearance unit decoded with the full level ([`encode_attributed`]; every codec whose
+    /// full decode is the canonical mesh).
     Attributes,
 }
 
@@ -206,17 +213,105 @@ pub fn canonical_for(mesh: &TriMesh, options: &EncodeOptions) -> Result<Canonica
     Ok(canonical)
 }
 
-/// A decoder for any stream, chosen by the codec id in its header.
+/// Encodes `canonical` with `codec` and, when `appearance` has anything to carry, appends the
+/// appearance unit coded against the stream's own full decode (docs/FORMAT.md §8). A codec
+/// without [`Capability::Attributes`] refuses appearance.
+pub fn encode_attributed(
+    codec: &dyn Codec,
+    canonical: &CanonicalMesh,
+    appearance: Option<&CanonicalAttributes>,
+) -> Result<Encoded> {
+    let mut encoded = codec.encode(canonical)?;
+    let Some(appearance) = appearance.filter(|a| !a.is_empty()) else {
+        return Ok(encoded);
+    };
+    if !codec.capabilities().contains(&Capability::Attributes) {
+        return Err(Error::Unsupported(format!(
+            "{} cannot carry normals, uvs, colours or materials (its full level is lossy)",
+            codec.name()
+        )));
+    }
+    let (full, _) = decode(&encoded.bytes, Stop::All)?;
+    let (unit, fields) = appearance::encode(&full.mesh, canonical, appearance)?;
+    let (mut header, mut index, start) = crate::container::read_header_and_index(&encoded.bytes)?;
+    header.appearance = Some(appearance::spec_of(appearance));
+    index.appearance = Some(crate::container::UnitEntry {
+        offset: index.payload_bytes,
+        length: unit.len() as u64,
+        parent: index.units.len().checked_sub(1),
+    });
+    index.payload_bytes += unit.len() as u64;
+    let mut bytes = Vec::with_capacity(encoded.bytes.len() + unit.len() + 256);
+    header.write(&mut bytes);
+    index.write(&mut bytes);
+    let shift = bytes.len() as isize - start as isize;
+    bytes.extend_from_slice(&encoded.bytes[start..]);
+    bytes.extend_from_slice(&unit);
+    for level in &mut encoded.levels {
+        level.end_byte = (level.end_byte as isize + shift) as usize;
+    }
+    // The full level is what a reader needs for the mesh and its appearance.
+    if let Some(last) = encoded.levels.last_mut() {
+        last.end_byte = bytes.len();
+    }
+    encoded
+        .stats
+        .add_named("appearance_bytes", unit.len() as f64);
+    for (field, bits) in fields {
+        encoded
+            .stats
+            .add_named(&format!("appearance_bits_{field}"), bits);
+    }
+    encoded.bytes = bytes;
+    Ok(encoded)
+}
+
+/// The canonical mesh and appearance that a codec encodes for `mesh` with its attributes,
+/// quantized by `options` and `bits` (docs/CONTRACT.md §2.1).
+pub fn canonical_attributed_for(
+    mesh: &crate::mesh::attributes::AttributedMesh,
+    options: &EncodeOptions,
+    bits: crate::mesh::attribute_quantization::AttributeBits,
+) -> Result<(CanonicalMesh, CanonicalAttributes)> {
+    let grid = Grid::fit(&mesh.mesh, options.quant_bits, options.grid)?;
+    let (canonical, appearance) = crate::mesh::canonical_attributes::canonical_with_attributes(
+        &mesh.mesh,
+        &mesh.attributes,
+        grid,
+        bits,
+    )?;
+    if canonical.faces.is_empty() {
+        return Err(Error::mesh(format!(
+            "empty mesh: every face is degenerate at {} bits",
+            options.quant_bits
+        )));
+    }
+    Ok((canonical, appearance))
+}
+
+/// A decoder for any stream, chosen by the codec id in its header; a stream with an appearance
+/// unit decodes it after its last level.
 pub fn open(bytes: &[u8]) -> Result<Box<dyn LevelDecoder + '_>> {
     let reader = StreamReader::open(bytes)?;
-    by_id(reader.header().codec_id)?.decoder(reader)
+    let appearance = reader.header().appearance.clone();
+    let unit = reader.appearance_unit();
+    let inner = by_id(reader.header().codec_id)?.decoder(reader)?;
+    Ok(match appearance {
+        Some(spec) => Box::new(appearance::decoder::WithAppearance::new(inner, spec, unit)),
+        None => inner,
+    })
 }
 
 /// The bytes each level of a stream needs ([`Codec::level_ends`]), from a prefix holding at
-/// least its header and index ([`Error::Truncated`] when it does not yet).
+/// least its header and index ([`Error::Truncated`] when it does not yet). The full level of a
+/// stream with appearance ends with its appearance unit.
 pub fn level_ends(bytes: &[u8]) -> Result<Vec<u64>> {
     let reader = StreamReader::open(bytes)?;
-    by_id(reader.header().codec_id)?.level_ends(&reader)
+    let mut ends = by_id(reader.header().codec_id)?.level_ends(&reader)?;
+    if let (Some(unit), Some(last)) = (reader.index().appearance, ends.last_mut()) {
+        *last = reader.payload_start() as u64 + unit.end();
+    }
+    Ok(ends)
 }
 
 /// Where to stop decoding.

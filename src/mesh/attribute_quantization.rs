@@ -216,7 +216,14 @@ mod tests {
     #[test]
     fn octahedral_codes_are_close_and_axes_exact() {
         let bits = 10;
-        for n in [DVec3::X, DVec3::NEG_X, DVec3::Y, DVec3::NEG_Y, DVec3::Z, DVec3::NEG_Z] {
+        for n in [
+            DVec3::X,
+            DVec3::NEG_X,
+            DVec3::Y,
+            DVec3::NEG_Y,
+            DVec3::Z,
+            DVec3::NEG_Z,
+        ] {
             let back = octahedral_normal(octahedral_code(n, bits), bits);
             assert!((back - n).length() < 1e-12, "{n} came back as {back}");
         }
@@ -231,12 +238,19 @@ mod tests {
             worst = worst.max(n.angle_between(back));
         }
         assert!(worst.to_degrees() < 0.5, "{}", worst.to_degrees());
-        assert_eq!(octahedral_code(DVec3::ZERO, bits), octahedral_code(DVec3::Z, bits));
+        assert_eq!(
+            octahedral_code(DVec3::ZERO, bits),
+            octahedral_code(DVec3::Z, bits)
+        );
     }
 
     #[test]
     fn uv_cells_and_colours_requantize_exactly() {
-        let uvs = [DVec2::new(0.1, 0.2), DVec2::new(0.9, 0.4), DVec2::new(0.5, 0.25)];
+        let uvs = [
+            DVec2::new(0.1, 0.2),
+            DVec2::new(0.9, 0.4),
+            DVec2::new(0.5, 0.25),
+        ];
         let grid = UvGrid::fit(uvs, 12).unwrap().unwrap();
         assert!(grid.is_valid());
         for t in uvs {

@@ -56,11 +56,7 @@ impl CanonicalAttributes {
         bits: AttributeBits,
     ) -> Result<CanonicalAttributes> {
         bits.check()?;
-        let corner_wedges = || {
-            origins
-                .iter()
-                .flat_map(|&f| attributes.corners[f as usize])
-        };
+        let corner_wedges = || origins.iter().flat_map(|&f| attributes.corners[f as usize]);
         let uv_grid = match &attributes.uvs {
             Some(uvs) => UvGrid::fit(corner_wedges().map(|w| uvs[w as usize]), bits.uv)?,
             None => None,
@@ -180,9 +176,17 @@ impl CanonicalAttributes {
             (false, true) => Err(format!("decoded mesh has {what} the input has not")),
             _ => Ok(()),
         };
-        presence(self.normals.is_some(), appearance.normals.is_some(), "normals")?;
+        presence(
+            self.normals.is_some(),
+            appearance.normals.is_some(),
+            "normals",
+        )?;
         presence(self.uvs.is_some(), appearance.uvs.is_some(), "uvs")?;
-        presence(self.colours.is_some(), appearance.colours.is_some(), "colours")?;
+        presence(
+            self.colours.is_some(),
+            appearance.colours.is_some(),
+            "colours",
+        )?;
         presence(
             self.materials.is_some(),
             appearance.materials.is_some(),
@@ -207,13 +211,16 @@ impl CanonicalAttributes {
                 .and_then(|m| m.names.get(m.face[f] as usize).cloned())
         };
         // Each canonical face by its cells, rotated so the smallest cell leads.
-        let mut expected: HashMap<[[u32; 3]; 3], ([CornerCode; 3], Option<String>)> =
+        let mut expected: HashMap<[[u32; 3]; 3], FaceAppearance> =
             HashMap::with_capacity(canonical.faces.len());
         for (f, face) in canonical.faces.iter().enumerate() {
             let cells = face.map(|v| canonical.cells[v as usize]);
             let codes = self.corners[f].map(|w| self.code(w));
             let r = smallest(&cells);
-            expected.insert(rotate(cells, r), (rotate(codes, r), name(&self.materials, f)));
+            expected.insert(
+                rotate(cells, r),
+                (rotate(codes, r), name(&self.materials, f)),
+            );
         }
         let grid = canonical.grid;
         for (f, face) in decoded.faces.iter().enumerate() {
@@ -233,6 +240,9 @@ impl CanonicalAttributes {
         Ok(())
     }
 }
+
+/// A face's corners' quantized values and its material's name.
+type FaceAppearance = ([CornerCode; 3], Option<String>);
 
 fn smallest(cells: &[[u32; 3]; 3]) -> usize {
     (0..3).min_by_key(|&k| cells[k]).expect("three corners")
@@ -289,7 +299,10 @@ mod tests {
             [c(0.6, 0.0), c(1.0, 0.5), c(0.6, 0.5)],
             [c(0.9, 0.9), c(0.9, 0.9), c(0.9, 0.9)],
         ];
-        (mesh.clone(), Attributes::weld(&mesh.faces, &corners).unwrap())
+        (
+            mesh.clone(),
+            Attributes::weld(&mesh.faces, &corners).unwrap(),
+        )
     }
 
     #[test]
@@ -297,15 +310,17 @@ mod tests {
         let (mesh, attributes) = seamed();
         let grid = crate::mesh::Grid::fit(&mesh, 8, GridShape::Cubic).unwrap();
         let (canonical, appearance) =
-            canonical_with_attributes(&mesh, &attributes, grid, AttributeBits::default())
-                .unwrap();
+            canonical_with_attributes(&mesh, &attributes, grid, AttributeBits::default()).unwrap();
         // Face [1,4,2] welds onto [1,3,2] and repeats it; the last face repeats the first.
         assert_eq!(canonical.faces.len(), 2);
         // Vertices 1 and 2 each have two wedges (the seam), 0 and 3 one: 6 wedges.
         assert_eq!(appearance.wedge_vertex.len(), 6);
         let decoded = canonical.to_mesh();
         let back = appearance.to_attributes();
-        assert_eq!(appearance.check_lossless(&canonical, &decoded, &back), Ok(()));
+        assert_eq!(
+            appearance.check_lossless(&canonical, &decoded, &back),
+            Ok(())
+        );
         // A uv moved by one cell is found.
         let mut moved = back.clone();
         moved.uvs.as_mut().unwrap()[3].x += appearance.uv_grid.unwrap().cell;

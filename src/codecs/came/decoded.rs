@@ -662,6 +662,7 @@ impl<U: UnitDecoder + Send> LevelDecoder for CameDecoder<'_, U> {
         Ok(LevelMesh {
             mesh,
             loose_edges: Vec::new(),
+            attributes: None,
         })
     }
 }

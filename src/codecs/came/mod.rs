@@ -325,6 +325,7 @@ fn header(id: u8, mesh: &CanonicalMesh, params: Params) -> Header {
         grid: mesh.grid,
         vertices: mesh.vertex_count() as u64,
         triangles: mesh.face_count() as u64,
+        appearance: None,
     }
 }
 

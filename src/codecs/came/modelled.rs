@@ -133,7 +133,7 @@ impl Codec for Came {
     }
 
     fn capabilities(&self) -> &'static [Capability] {
-        &[]
+        &[Capability::Attributes]
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {

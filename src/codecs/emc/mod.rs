@@ -84,6 +84,7 @@ impl EmcParams {
             grid: mesh.grid,
             vertices: mesh.vertex_count() as u64,
             triangles: mesh.face_count() as u64,
+            appearance: None,
         }
     }
 

@@ -225,6 +225,7 @@ impl EmcState {
         Ok(LevelMesh {
             loose_edges: loose_edges(&self.adjacency, cliques, Some(&is_false)),
             mesh: TriMesh::new(positions, faces),
+            attributes: None,
         })
     }
 
@@ -246,6 +247,7 @@ impl EmcState {
         Ok(LevelMesh {
             loose_edges: loose_edges(&self.adjacency, &cliques, None),
             mesh: TriMesh::new(positions, faces),
+            attributes: None,
         })
     }
 }

@@ -282,6 +282,7 @@ impl<'a> PMeshIter<'a> {
         LevelMesh {
             mesh: to_trimesh(&self.mesh, &self.header.grid),
             loose_edges: Vec::new(),
+            attributes: None,
         }
     }
 

@@ -204,7 +204,7 @@ impl Codec for Pm {
     }
 
     fn capabilities(&self) -> &'static [Capability] {
-        &[]
+        &[Capability::Attributes]
     }
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
@@ -289,6 +289,7 @@ fn encode_pm(
         grid: mesh.grid,
         vertices: mesh.vertex_count() as u64,
         triangles: mesh.face_count() as u64,
+        appearance: None,
     };
     let mut writer = StreamWriter::new(&header);
     let mut stats = Stats::default();

@@ -37,7 +37,7 @@ impl Codec for Raw {
     }
 
     fn capabilities(&self) -> &'static [Capability] {
-        &[]
+        &[Capability::Attributes]
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {
@@ -51,6 +51,7 @@ impl Codec for Raw {
             grid: mesh.grid,
             vertices: mesh.vertex_count() as u64,
             triangles: mesh.face_count() as u64,
+            appearance: None,
         };
         let mut sink = BitSink::default();
         let q = mesh.grid.bits as u32;
@@ -180,6 +181,7 @@ impl LevelDecoder for RawDecoder<'_> {
         Ok(LevelMesh {
             mesh: self.mesh.clone(),
             loose_edges: Vec::new(),
+            attributes: None,
         })
     }
 }

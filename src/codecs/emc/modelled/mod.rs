@@ -128,7 +128,7 @@ impl Codec for Emc {
     }
 
     fn capabilities(&self) -> &'static [Capability] {
-        &[Capability::PassStops]
+        &[Capability::PassStops, Capability::Attributes]
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {

@@ -81,7 +81,11 @@ impl Codec for EmcPaper {
     }
 
     fn capabilities(&self) -> &'static [Capability] {
-        &[Capability::PassStops, Capability::PartialLevels]
+        &[
+            Capability::PassStops,
+            Capability::PartialLevels,
+            Capability::Attributes,
+        ]
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {
