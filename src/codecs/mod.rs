@@ -214,7 +214,7 @@ pub fn canonical_for(mesh: &TriMesh, options: &EncodeOptions) -> Result<Canonica
 }
 
 /// Encodes `canonical` with `codec` and, when `appearance` has anything to carry, appends the
-/// appearance unit coded against the stream's own full decode (docs/FORMAT.md §8). A codec
+/// appearance unit coded against the stream's own full decode (docs/FORMAT.md §9). A codec
 /// without [`Capability::Attributes`] refuses appearance.
 pub fn encode_attributed(
     codec: &dyn Codec,

@@ -233,7 +233,11 @@ mod tests {
             let t = i as f64 * 0.618_033_988_7;
             let z = 1.0 - 2.0 * (i as f64 + 0.5) / 2000.0;
             let r = (1.0 - z * z).sqrt();
-            let n = DVec3::new(r * (t * std::f64::consts::TAU).cos(), r * (t * std::f64::consts::TAU).sin(), z);
+            let n = DVec3::new(
+                r * (t * std::f64::consts::TAU).cos(),
+                r * (t * std::f64::consts::TAU).sin(),
+                z,
+            );
             let back = octahedral_normal(octahedral_code(n, bits), bits);
             worst = worst.max(n.angle_between(back));
         }

@@ -1,4 +1,4 @@
-//! The appearance unit's syntax, written once for both directions (docs/FORMAT.md §8): the
+//! The appearance unit's syntax, written once for both directions (docs/FORMAT.md §9): the
 //! encoder passes the true value of every decision, the decoder reads it, and both then update
 //! the same state.
 

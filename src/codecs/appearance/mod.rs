@@ -1,6 +1,6 @@
 //! Appearance (normals, texture coordinates, colours, materials) carried by any codec whose full
 //! decode is the canonical mesh: one **appearance unit** after the stream's last unit, coded
-//! against the decoded full mesh (docs/FORMAT.md §8, docs/CONTRACT.md §2.1).
+//! against the decoded full mesh (docs/FORMAT.md §9, docs/CONTRACT.md §2.1).
 //!
 //! Based on: H. Hoppe, *Efficient implementation of progressive meshes*, Computers & Graphics
 //! 22(1), 1998, §3 (../shared/papers/000_54780623804685d2.txt) for the model — faces point to
