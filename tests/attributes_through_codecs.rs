@@ -82,3 +82,30 @@ fn a_damaged_appearance_unit_is_an_error_or_another_appearance_never_a_panic() {
         let _ = codecs::decode(&bad, Stop::All);
     }
 }
+
+#[test]
+fn a_mesh_with_materials_alone_keeps_them_through_every_codec_that_carries_appearance() {
+    let obj = b"mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 2 1 0\nusemtl red\nf 1 2 3\nusemtl blue\nf 2 4 3\nf 2 5 4\n";
+    let mesh = meshcodec::mesh::io::read_attributed_bytes(obj, "obj").unwrap();
+    assert!(mesh.attributes.corners.is_empty() && mesh.attributes.materials.is_some());
+    for codec in codecs::registry() {
+        if !codec.capabilities().contains(&Capability::Attributes) {
+            continue;
+        }
+        let (canonical, appearance) = codecs::canonical_attributed_for(
+            &mesh,
+            &codec.default_options(),
+            AttributeBits::default(),
+        )
+        .unwrap();
+        let encoded = codecs::encode_attributed(codec, &canonical, Some(&appearance)).unwrap();
+        let (full, _) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
+        let decoded = full.attributes.as_ref().expect("appearance decoded");
+        assert_eq!(
+            appearance.check_lossless(&canonical, &full.mesh, decoded),
+            Ok(()),
+            "{}",
+            codec.name()
+        );
+    }
+}

@@ -149,13 +149,14 @@ fn main() -> ExitCode {
             &codec,
             quant,
             grid,
-            drop_attributes.then_some(()).map_or(
+            if drop_attributes {
+                Attributes::Drop
+            } else {
                 Attributes::Carry(AttributeBits {
                     uv: uv_bits,
                     normal: normal_bits,
-                }),
-                |_| Attributes::Drop,
-            ),
+                })
+            },
             &input,
             &output,
         ),
@@ -226,8 +227,6 @@ fn encode(
     let codec = codecs::by_name(codec)?;
     let path = resolve(input).with_context(|| input.to_string())?;
     let context = || path.display().to_string();
-    let (mesh, appearance) =
-        meshcodec::mesh::io::read_mesh_and_appearance(&path).with_context(context)?;
     let options = encode_options(
         codec,
         &RunOptions {
@@ -236,38 +235,46 @@ fn encode(
             ..RunOptions::default()
         },
     );
-    let carried = match attributes {
-        Attributes::Carry(bits) if !appearance.is_empty() => {
-            if !codec.capabilities().contains(&Capability::Attributes) {
-                return Err(meshcodec::Error::Unsupported(format!(
-                    "holds {appearance}, which {} does not carry (its full level is lossy); --drop-attributes encodes the geometry alone",
-                    codec.name()
-                )))
-                .with_context(context);
-            }
-            let attributed = read_attributed(&path).with_context(context)?;
-            Some(
-                codecs::canonical_attributed_for(&attributed, &options, bits)
-                    .with_context(context)?,
-            )
-        }
-        _ => None,
+    let geometry = |mesh: &meshcodec::mesh::TriMesh| -> Result<_> {
+        let canonical = codecs::canonical_for(mesh, &options).with_context(context)?;
+        let encoded = codec.encode(&canonical).with_context(context)?;
+        Ok((canonical, encoded))
     };
-    let (canonical, encoded) = match carried {
-        Some((canonical, appearance)) => {
-            let encoded = codecs::encode_attributed(codec, &canonical, Some(&appearance))
-                .with_context(context)?;
-            (canonical, encoded)
+    // The file is read once: with its appearance when the codec carries it.
+    let mut dropped = None;
+    let (canonical, encoded) = match attributes {
+        Attributes::Carry(bits) if codec.capabilities().contains(&Capability::Attributes) => {
+            let attributed = read_attributed(&path).with_context(context)?;
+            if attributed.attributes.is_empty() {
+                geometry(&attributed.mesh)?
+            } else {
+                let (canonical, appearance) =
+                    codecs::canonical_attributed_for(&attributed, &options, bits)
+                        .with_context(context)?;
+                let encoded = codecs::encode_attributed(codec, &canonical, Some(&appearance))
+                    .with_context(context)?;
+                (canonical, encoded)
+            }
         }
-        None => {
-            let canonical = codecs::canonical_for(&mesh, &options).with_context(context)?;
-            let encoded = codec.encode(&canonical).with_context(context)?;
-            (canonical, encoded)
+        _ => {
+            let (mesh, appearance) =
+                meshcodec::mesh::io::read_mesh_and_appearance(&path).with_context(context)?;
+            if !appearance.is_empty() {
+                if matches!(attributes, Attributes::Carry(_)) {
+                    return Err(meshcodec::Error::Unsupported(format!(
+                        "holds {appearance}, which {} does not carry (its full level is lossy); --drop-attributes encodes the geometry alone",
+                        codec.name()
+                    )))
+                    .with_context(context);
+                }
+                dropped = Some(appearance);
+            }
+            geometry(&mesh)?
         }
     };
     write_atomically(output, &encoded.bytes).with_context(|| output.display().to_string())?;
     // Said once the stream is written, so that a failure stays one line.
-    if matches!(attributes, Attributes::Drop) && !appearance.is_empty() {
+    if let Some(appearance) = dropped {
         eprintln!(
             "note: {}: {appearance} dropped (--drop-attributes)",
             path.display()

@@ -11,7 +11,7 @@ use super::attribute_quantization::{
 };
 use super::attributes::{Attributes, Materials, WedgeId};
 use super::{CanonicalMesh, TriMesh, VertexId};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use std::collections::HashMap;
 
 /// Quantized appearance of a canonical mesh: wedges over its faces and vertices.
@@ -56,24 +56,15 @@ impl CanonicalAttributes {
         bits: AttributeBits,
     ) -> Result<CanonicalAttributes> {
         bits.check()?;
-        let corner_wedges = || origins.iter().flat_map(|&f| attributes.corners[f as usize]);
         let uv_grid = match &attributes.uvs {
-            Some(uvs) => UvGrid::fit(corner_wedges().map(|w| uvs[w as usize]), bits.uv)?,
+            Some(uvs) => UvGrid::fit(
+                origins
+                    .iter()
+                    .flat_map(|&f| attributes.corners[f as usize])
+                    .map(|w| uvs[w as usize]),
+                bits.uv,
+            )?,
             None => None,
-        };
-        let code_of = |w: WedgeId| CornerCode {
-            normal: attributes
-                .normals
-                .as_ref()
-                .map(|n| octahedral_code(n[w as usize], bits.normal)),
-            uv: match (&attributes.uvs, &uv_grid) {
-                (Some(t), Some(grid)) => Some(grid.quantize(t[w as usize])),
-                _ => None,
-            },
-            colour: attributes
-                .colours
-                .as_ref()
-                .map(|c| colour_code(c[w as usize])),
         };
         let mut wedge_of: HashMap<(VertexId, CornerCode), WedgeId> = HashMap::new();
         let mut codes = Vec::new();
@@ -83,9 +74,12 @@ impl CanonicalAttributes {
             .iter()
             .zip(origins)
             .map(|(face, &origin)| {
-                let input = attributes.corners[origin as usize];
+                // A mesh with materials alone has no wedges: one a vertex, with no values.
+                let input = attributes.corners.get(origin as usize);
                 std::array::from_fn(|k| {
-                    let code = code_of(input[k]);
+                    let code = input.map_or(CornerCode::default(), |c| {
+                        quantize_wedge(attributes, c[k], bits, uv_grid.as_ref())
+                    });
                     *wedge_of.entry((face[k], code)).or_insert_with(|| {
                         codes.push(code);
                         wedge_vertex.push(face[k]);
@@ -192,20 +186,7 @@ impl CanonicalAttributes {
             appearance.materials.is_some(),
             "materials",
         )?;
-        let theirs = |w: WedgeId| CornerCode {
-            normal: appearance
-                .normals
-                .as_ref()
-                .map(|n| octahedral_code(n[w as usize], self.bits.normal)),
-            uv: match (&appearance.uvs, &self.uv_grid) {
-                (Some(t), Some(grid)) => Some(grid.quantize(t[w as usize])),
-                _ => None,
-            },
-            colour: appearance
-                .colours
-                .as_ref()
-                .map(|c| colour_code(c[w as usize])),
-        };
+        let theirs = |w| quantize_wedge(appearance, w, self.bits, self.uv_grid.as_ref());
         let name = |m: &Option<Materials>, f: usize| {
             m.as_ref()
                 .and_then(|m| m.names.get(m.face[f] as usize).cloned())
@@ -225,7 +206,10 @@ impl CanonicalAttributes {
         let grid = canonical.grid;
         for (f, face) in decoded.faces.iter().enumerate() {
             let cells = face.map(|v| grid.quantize(decoded.positions[v as usize]));
-            let codes = appearance.corners[f].map(theirs);
+            let codes = appearance
+                .corners
+                .get(f)
+                .map_or([CornerCode::default(); 3], |c| c.map(theirs));
             let r = smallest(&cells);
             let Some((want, material)) = expected.get(&rotate(cells, r)) else {
                 return Err(format!("decoded face {f} is not a canonical face"));
@@ -238,6 +222,27 @@ impl CanonicalAttributes {
             }
         }
         Ok(())
+    }
+}
+
+/// The quantized values of wedge `w` of `attributes`.
+fn quantize_wedge(
+    attributes: &Attributes,
+    w: WedgeId,
+    bits: AttributeBits,
+    uv_grid: Option<&UvGrid>,
+) -> CornerCode {
+    let w = w as usize;
+    CornerCode {
+        normal: attributes
+            .normals
+            .as_ref()
+            .map(|n| octahedral_code(n[w], bits.normal)),
+        uv: match (&attributes.uvs, uv_grid) {
+            (Some(t), Some(grid)) => Some(grid.quantize(t[w])),
+            _ => None,
+        },
+        colour: attributes.colours.as_ref().map(|c| colour_code(c[w])),
     }
 }
 
@@ -260,9 +265,6 @@ pub fn canonical_with_attributes(
     bits: AttributeBits,
 ) -> Result<(CanonicalMesh, CanonicalAttributes)> {
     attributes.validate(mesh)?;
-    if attributes.corners.len() != mesh.faces.len() {
-        return Err(Error::mesh("attributes do not cover every face"));
-    }
     let (canonical, origins) = CanonicalMesh::with_origins(mesh, grid)?;
     let appearance = CanonicalAttributes::new(&canonical, &origins, attributes, bits)?;
     Ok((canonical, appearance))
