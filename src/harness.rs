@@ -4,11 +4,16 @@
 
 use crate::codecs::{self, Codec, EncodeOptions, LevelDecoder};
 use crate::error::{Error, Result};
-use crate::mesh::io::{mesh_name, read_mesh_and_appearance};
+use crate::mesh::attribute_quantization::AttributeBits;
+use crate::mesh::attributes::AttributedMesh;
+use crate::mesh::canonical::CanonicalMesh;
+use crate::mesh::canonical_attributes::CanonicalAttributes;
+use crate::mesh::io::{mesh_name, read_attributed, read_mesh_and_appearance, Appearance};
 use crate::mesh::quantize::GridShape;
+use crate::metrics::appearance::AppearanceReference;
 use crate::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
 use crate::plot;
-use crate::results::{self, levels_csv, LevelRow, RunResult};
+use crate::results::{self, levels_csv, AppearanceRun, LevelRow, RunResult};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -23,6 +28,9 @@ pub struct RunOptions {
     pub samples_per_triangle: usize,
     /// Show a progress bar.
     pub progress: bool,
+    /// Code the file's appearance at these bits when the codec carries appearance
+    /// (`None`: positions and triangles only, whatever the file holds).
+    pub appearance: Option<AttributeBits>,
 }
 
 impl Default for RunOptions {
@@ -32,6 +40,7 @@ impl Default for RunOptions {
             grid: None,
             samples_per_triangle: DEFAULT_SAMPLES_PER_TRIANGLE,
             progress: false,
+            appearance: None,
         }
     }
 }
@@ -58,14 +67,57 @@ pub struct RunOutput {
     pub appearance: crate::mesh::io::Appearance,
 }
 
+/// The mesh a run measures, and the appearance it codes when it codes one.
+struct Input {
+    /// The file's mesh.
+    original: AttributedMesh,
+    /// What the file holds that the run does not code.
+    uncoded: Appearance,
+    canonical: CanonicalMesh,
+    /// The canonical appearance the stream carries.
+    appearance: Option<CanonicalAttributes>,
+}
+
+fn read_input(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<Input> {
+    let encode = encode_options(codec, options);
+    let carries = codec
+        .capabilities()
+        .contains(&codecs::Capability::Attributes);
+    if let (Some(bits), true) = (options.appearance, carries) {
+        let original = read_attributed(path)?;
+        let (canonical, appearance) = codecs::canonical_attributed_for(&original, &encode, bits)?;
+        return Ok(Input {
+            original,
+            uncoded: Appearance::default(),
+            canonical,
+            appearance: Some(appearance).filter(|a| !a.is_empty()),
+        });
+    }
+    let (mesh, uncoded) = read_mesh_and_appearance(path)?;
+    let canonical = codecs::canonical_for(&mesh, &encode)?;
+    Ok(Input {
+        original: AttributedMesh {
+            mesh,
+            attributes: Default::default(),
+        },
+        uncoded,
+        canonical,
+        appearance: None,
+    })
+}
+
 /// Runs `codec` on the mesh file at `path`.
 pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOutput> {
-    let (original, appearance) = read_mesh_and_appearance(path)?;
+    let Input {
+        original,
+        uncoded,
+        canonical,
+        appearance,
+    } = read_input(codec, path, options)?;
     let encode = encode_options(codec, options);
-    let canonical = codecs::canonical_for(&original, &encode)?;
 
     let started = Instant::now();
-    let encoded = codec.encode(&canonical)?;
+    let encoded = codecs::encode_attributed(codec, &canonical, appearance.as_ref())?;
     let encode_seconds = started.elapsed().as_secs_f64();
 
     // Time the bare decode (no metrics); repeat short ones so the figure is not timer noise.
@@ -84,7 +136,23 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
         }
     }
     let final_mesh = final_mesh.expect("decoded at least once");
-    let lossless_error = canonical.check_lossless(&final_mesh.mesh).err();
+    let lossless_error = match &appearance {
+        None => canonical.check_lossless(&final_mesh.mesh).err(),
+        Some(a) => match &final_mesh.attributes {
+            Some(decoded) => a
+                .check_lossless(&canonical, &final_mesh.mesh, decoded)
+                .err(),
+            None => Some("the full decode has no appearance".into()),
+        },
+    };
+    let original_appearance = appearance.as_ref().and_then(|_| {
+        AppearanceReference::new(
+            &original,
+            options.samples_per_triangle * original.mesh.faces.len(),
+            DEFAULT_SEED ^ 2,
+        )
+    });
+    let original = original.mesh;
 
     let reference = Reference::new(&original, options.samples_per_triangle, DEFAULT_SEED);
     let bar = progress_bar(options.progress, encoded.levels.len(), codec.name(), path);
@@ -103,7 +171,12 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
                 encoded.levels.len()
             )));
         }
-        levels.push(measure_level(decoder.as_ref(), record, &reference, v, t)?);
+        let mut row = measure_level(decoder.as_ref(), record, &reference, v, t)?;
+        if let Some(reference) = &original_appearance {
+            let level = decoder.mesh()?;
+            row.appearance = reference.compare(&level.mesh, level.attributes.as_ref());
+        }
+        levels.push(row);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -125,13 +198,31 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
         lossless_error,
         grid: encode.grid,
         samples_per_triangle: options.samples_per_triangle,
+        appearance: appearance.as_ref().map(|a| AppearanceRun {
+            uv_bits: a.bits.uv,
+            normal_bits: a.bits.normal,
+            wedges: a.wedge_vertex.len(),
+            fields: [
+                ("normals", a.normals.is_some()),
+                ("uvs", a.uvs.is_some()),
+                ("colours", a.colours.is_some()),
+                ("materials", a.materials.is_some()),
+            ]
+            .iter()
+            .filter(|(_, present)| *present)
+            .map(|(name, _)| name.to_string())
+            .collect(),
+            bits: codec_stats
+                .get_named("appearance_bytes")
+                .map_or(0, |b| b as u64 * 8),
+        }),
         codec_stats,
         levels,
     };
     Ok(RunOutput {
         result,
         stream: encoded.bytes,
-        appearance,
+        appearance: uncoded,
     })
 }
 
@@ -157,6 +248,7 @@ fn measure_level(
         hausdorff: distance.map(|d| d.hausdorff),
         rms: distance.map(|d| d.rms),
         hausdorff_paper: distance.map(|d| d.hausdorff_paper),
+        appearance: Default::default(),
     })
 }
 

@@ -5,6 +5,7 @@
 use crate::codecs::{EncodeOptions, Stats};
 use crate::error::{Error, Result};
 use crate::mesh::quantize::GridShape;
+use crate::metrics::appearance::AppearanceError;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -33,6 +34,9 @@ pub struct LevelRow {
     pub rms: Option<f64>,
     /// Largest original-vertex-to-level distance, over the diagonal (EMC's measure).
     pub hausdorff_paper: Option<f64>,
+    /// Appearance error (§5.1) of a run that codes appearance, at the levels that carry it.
+    #[serde(flatten, default)]
+    pub appearance: AppearanceError,
 }
 
 /// One codec on one mesh (docs/CONTRACT.md §6), as stored in `results/<codec>/<mesh>.json`.
@@ -70,8 +74,26 @@ pub struct RunResult {
     /// Codec-specific counts: bits per syntax element, operation counts.
     #[serde(default, skip_serializing_if = "Stats::is_empty")]
     pub codec_stats: Stats,
+    /// What appearance the stream carries, when the run coded it (§2.1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub appearance: Option<AppearanceRun>,
     /// Per-level rows.
     pub levels: Vec<LevelRow>,
+}
+
+/// The appearance a run coded: its quantization and what the canonical mesh holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AppearanceRun {
+    /// Qt, bits per uv axis.
+    pub uv_bits: u8,
+    /// Qn, bits per octahedral normal coordinate.
+    pub normal_bits: u8,
+    /// Wedges of the canonical mesh (corners with equal quantized attributes at one vertex).
+    pub wedges: usize,
+    /// The attributes carried, of normals, uvs, colours, materials.
+    pub fields: Vec<String>,
+    /// Bits of the appearance unit.
+    pub bits: u64,
 }
 
 impl RunResult {
@@ -102,14 +124,21 @@ pub fn stem(defaults: &EncodeOptions, mesh: &str, quantization: &EncodeOptions) 
     stem
 }
 
-/// [`stem`] of a run's result.
+/// [`stem`] of a run's result, with `-appearance` when the run coded appearance.
 pub fn result_stem(defaults: &EncodeOptions, result: &RunResult) -> String {
     let quantization = EncodeOptions {
         quant_bits: result.quant_bits,
         grid: result.grid,
     };
-    stem(defaults, &result.mesh, &quantization)
+    let mut stem = stem(defaults, &result.mesh, &quantization);
+    if result.appearance.is_some() {
+        stem.push_str(APPEARANCE_SUFFIX);
+    }
+    stem
 }
+
+/// What [`result_stem`] appends for a run that coded appearance.
+pub const APPEARANCE_SUFFIX: &str = "-appearance";
 
 /// `<results>/<codec>/<stem><suffix>`: where every file of a run lives (`.json`, `.csv`, `.mc`,
 /// `-rate-resolution.png`, …).
@@ -129,9 +158,14 @@ pub fn levels_csv(result: &RunResult) -> String {
         "level,bits,connectivity_bits,geometry_bits,vertices,triangles,bits_per_vertex,\
          bits_per_triangle,hausdorff,rms,hausdorff_paper\n",
     );
+    let appearance = result.appearance.is_some();
+    if appearance {
+        csv.pop();
+        csv.push_str(",uv_texels,normal_degrees,colour_steps,wrong_material\n");
+    }
     for r in &result.levels {
         csv.push_str(&format!(
-            "{},{},{},{},{},{},{:.4},{:.4},{},{},{}\n",
+            "{},{},{},{},{},{},{:.4},{:.4},{},{},{}",
             r.level,
             r.bits,
             r.connectivity_bits,
@@ -144,6 +178,17 @@ pub fn levels_csv(result: &RunResult) -> String {
             opt(r.rms),
             opt(r.hausdorff_paper)
         ));
+        if appearance {
+            let a = &r.appearance;
+            csv.push_str(&format!(
+                ",{},{},{},{}",
+                opt(a.uv_texels),
+                opt(a.normal_degrees),
+                opt(a.colour_steps),
+                opt(a.wrong_material)
+            ));
+        }
+        csv.push('\n');
     }
     csv
 }
@@ -165,10 +210,18 @@ pub fn level_table(result: &RunResult) -> String {
         "rms",
         "paper"
     );
+    let appearance = result.appearance.is_some();
+    if appearance {
+        out.pop();
+        out.push_str(&format!(
+            " {:>9} {:>9} {:>9} {:>9}\n",
+            "uv texel", "normal °", "colour", "wrong mat"
+        ));
+    }
     let v = result.vertices as f64;
     for r in &result.levels {
         out.push_str(&format!(
-            "{:>5} {:>9} {:>9} {:>11} {:>8.3} {:>8.3} {:>9.3} {:>9.3} {:>10} {:>10} {:>10}\n",
+            "{:>5} {:>9} {:>9} {:>11} {:>8.3} {:>8.3} {:>9.3} {:>9.3} {:>10} {:>10} {:>10}",
             r.level,
             r.vertices,
             r.triangles,
@@ -181,6 +234,18 @@ pub fn level_table(result: &RunResult) -> String {
             opt(r.rms),
             opt(r.hausdorff_paper)
         ));
+        if appearance {
+            let fixed = |v: Option<f64>| v.map(|x| format!("{x:.3}")).unwrap_or_else(|| "-".into());
+            let a = &r.appearance;
+            out.push_str(&format!(
+                " {:>9} {:>9} {:>9} {:>9}",
+                fixed(a.uv_texels),
+                fixed(a.normal_degrees),
+                fixed(a.colour_steps),
+                fixed(a.wrong_material)
+            ));
+        }
+        out.push('\n');
     }
     out
 }

@@ -46,6 +46,16 @@ struct Settings {
     /// Also write the stream as results/CODEC/STEM.mc (figures decode it).
     #[arg(long)]
     keep_stream: bool,
+    /// Code the file's normals, uvs, colours and materials too, with codecs that carry them
+    /// (results as STEM-appearance, with the appearance error per level).
+    #[arg(long)]
+    appearance: bool,
+    /// Qt: bits per uv axis when coding appearance.
+    #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_UV_BITS)]
+    uv_bits: u8,
+    /// Qn: bits per octahedral normal coordinate when coding appearance.
+    #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS)]
+    normal_bits: u8,
 }
 
 impl Settings {
@@ -57,6 +67,9 @@ impl Settings {
             samples: meshcodec::metrics::DEFAULT_SAMPLES_PER_TRIANGLE,
             out: out.to_path_buf(),
             keep_stream: false,
+            appearance: false,
+            uv_bits: meshcodec::mesh::attribute_quantization::DEFAULT_UV_BITS,
+            normal_bits: meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS,
         }
     }
 }
@@ -140,6 +153,13 @@ struct ExperimentSet {
     /// Keep the streams beside the results.
     #[serde(default)]
     keep_streams: bool,
+    /// Code appearance with the codecs that carry it.
+    #[serde(default)]
+    appearance: bool,
+    /// Qt when coding appearance; absent: the default.
+    uv_bits: Option<u8>,
+    /// Qn when coding appearance; absent: the default.
+    normal_bits: Option<u8>,
 }
 
 fn main() -> ExitCode {
@@ -171,6 +191,12 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
         grid: settings.grid,
         samples_per_triangle: settings.samples,
         progress: std::io::stderr().is_terminal(),
+        appearance: settings.appearance.then_some(
+            meshcodec::mesh::attribute_quantization::AttributeBits {
+                uv: settings.uv_bits,
+                normal: settings.normal_bits,
+            },
+        ),
     }
 }
 
@@ -199,13 +225,14 @@ fn run_codec(
         stream,
         appearance,
     } = harness::run(codec, path, options).with_context(|| path.display().to_string())?;
-    // The harness measures geometry; what else the file holds is said, not dropped unseen.
+    // What the file holds beyond what the run coded is said, not dropped unseen.
     if !appearance.is_empty() {
-        eprintln!(
-            "note: {}: {appearance} not coded ({} carries positions and triangles only)",
-            path.display(),
-            codec.name()
-        );
+        let why = if options.appearance.is_none() {
+            "--appearance codes it".to_string()
+        } else {
+            format!("{} carries positions and triangles only", codec.name())
+        };
+        eprintln!("note: {}: {appearance} not coded ({why})", path.display());
     }
     meshcodec::outln!(
         "{} on {} ({}): {} vertices, {} triangles at {} bits; {} bytes = {:.3} bits/vertex, \
@@ -305,6 +332,9 @@ impl Set {
             samples: set.samples.unwrap_or(settings.samples),
             grid,
             keep_stream: settings.keep_stream || set.keep_streams,
+            appearance: settings.appearance || set.appearance,
+            uv_bits: set.uv_bits.unwrap_or(settings.uv_bits),
+            normal_bits: set.normal_bits.unwrap_or(settings.normal_bits),
             ..settings.clone()
         };
         Ok(Set {

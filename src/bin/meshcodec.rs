@@ -113,7 +113,16 @@ enum Command {
         #[arg(long)]
         png: Option<PathBuf>,
     },
-    /// Distance between two meshes' surfaces: one-sided both ways, Hausdorff, RMS.
+    /// Convert a mesh file to another format (.ply, .obj, .glb or .gltf), keeping its normals,
+    /// texture coordinates, colours and materials where the output format holds them.
+    Convert {
+        /// Mesh file to read.
+        input: String,
+        /// Mesh file to write.
+        output: PathBuf,
+    },
+    /// Distance between two meshes' surfaces: one-sided both ways, Hausdorff, RMS; and, when
+    /// both have appearance, its error (uv texels, normal degrees, colour steps, materials).
     Distance {
         /// Reference mesh.
         a: String,
@@ -190,6 +199,7 @@ fn main() -> ExitCode {
             };
             view(&input, &output, &camera, tolerance, faces, png.as_deref())
         }
+        Command::Convert { input, output } => convert(&input, &output),
         Command::Distance {
             a,
             b,
@@ -202,10 +212,39 @@ fn main() -> ExitCode {
     meshcodec::cli::exit_code(outcome)
 }
 
-fn load(name: &str) -> Result<(PathBuf, meshcodec::mesh::TriMesh)> {
+fn convert(input: &str, output: &Path) -> Result<()> {
+    let path = resolve(input).with_context(|| input.to_string())?;
+    let mesh =
+        meshcodec::mesh::io::read_attributed(&path).with_context(|| path.display().to_string())?;
+    meshcodec::mesh::io::write_attributed(&mesh, output)
+        .with_context(|| output.display().to_string())?;
+    meshcodec::outln!(
+        "wrote {}: {} vertices, {} triangles, {} wedges",
+        output.display(),
+        mesh.mesh.vertex_count(),
+        mesh.mesh.face_count(),
+        mesh.attributes.wedge_vertex.len()
+    );
+    Ok(())
+}
+
+/// A mesh file with its appearance, or without it where the reader cannot keep what the file
+/// holds (distances need the geometry alone).
+fn load_attributed(name: &str) -> Result<(PathBuf, meshcodec::mesh::attributes::AttributedMesh)> {
     let path = resolve(name).with_context(|| name.to_string())?;
-    let mesh = read_mesh(&path).with_context(|| path.display().to_string())?;
-    Ok((path, mesh))
+    match meshcodec::mesh::io::read_attributed(&path) {
+        Ok(mesh) => Ok((path, mesh)),
+        Err(_) => {
+            let mesh = read_mesh(&path).with_context(|| path.display().to_string())?;
+            Ok((
+                path,
+                meshcodec::mesh::attributes::AttributedMesh {
+                    mesh,
+                    attributes: Default::default(),
+                },
+            ))
+        }
+    }
 }
 
 /// What `encode` does with a file's appearance.
@@ -565,11 +604,19 @@ fn distance(
     json: bool,
     dump: Option<&Path>,
 ) -> Result<()> {
-    let (path_a, mesh_a) = load(a)?;
-    let (path_b, mesh_b) = load(b)?;
-    let reference = Reference::new(&mesh_a, samples, seed);
+    let (path_a, attributed_a) = load_attributed(a)?;
+    let (path_b, attributed_b) = load_attributed(b)?;
+    let mesh_a = &attributed_a.mesh;
+    let reference = Reference::new(mesh_a, samples, seed);
+    let appearance = meshcodec::metrics::appearance::AppearanceReference::new(
+        &attributed_a,
+        samples * mesh_a.face_count(),
+        seed ^ 2,
+    )
+    .map(|r| r.compare(&attributed_b.mesh, Some(&attributed_b.attributes)))
+    .filter(|e| *e != Default::default());
     let level = LevelMesh {
-        mesh: mesh_b,
+        mesh: attributed_b.mesh,
         ..LevelMesh::default()
     };
     let m = reference
@@ -603,6 +650,7 @@ fn distance(
         "hausdorff_relative": hausdorff / diag,
         "rms_relative": rms / diag,
         "hausdorff_paper": m.paper,
+        "appearance": appearance,
     });
     if json {
         meshcodec::outln!("{}", serde_json::to_string_pretty(&report)?);
@@ -636,5 +684,16 @@ fn distance(
         hausdorff / diag,
         rms / diag
     );
+    if let Some(e) = appearance {
+        let show =
+            |v: Option<f64>, unit: &str| v.map_or("-".to_string(), |x| format!("{x:.4}{unit}"));
+        meshcodec::outln!(
+            "appearance (mean over A's samples): uv {} , normal {} , colour {} , wrong material {}",
+            show(e.uv_texels, " texels of 1024²"),
+            show(e.normal_degrees, "°"),
+            show(e.colour_steps, " /255"),
+            show(e.wrong_material, "")
+        );
+    }
     Ok(())
 }

@@ -189,6 +189,11 @@ impl Stats {
         self.0.get(&stat.key()).copied()
     }
 
+    /// The statistic called `key`, if recorded.
+    pub fn get_named(&self, key: &str) -> Option<f64> {
+        self.0.get(key).copied()
+    }
+
     /// `stat`, or an error naming it when the codec did not record it.
     pub fn require(&self, stat: Stat) -> Result<f64> {
         self.get(stat).ok_or_else(|| {

@@ -82,6 +82,19 @@ impl SurfaceIndex {
         self.distance_within(p, f32::MAX)
     }
 
+    /// The face of the surface nearest to `p` and the corners' weights of the nearest point on
+    /// it; `None` for a surface without triangles.
+    pub fn nearest_face(&self, p: DVec3) -> Option<(u32, [f64; 3])> {
+        let Shape::Triangles(m) = &self.shape else {
+            return None;
+        };
+        let local = (p - self.centre).as_vec3();
+        let (face, _, location) =
+            CompositeShapeRef(m).project_local_point_and_get_location(local, f32::MAX, false)?;
+        let w = location.barycentric_coordinates()?;
+        Some((face, w.map(f64::from)))
+    }
+
     /// Distances from each of `points` to the surface, in parallel.
     pub fn distances(&self, points: &[DVec3]) -> Vec<f64> {
         let mut out = vec![0.0; points.len()];

@@ -1,11 +1,12 @@
 //! Metrics of docs/CONTRACT.md §5: surface sampling, exact point-to-surface distance through a BVH, and
 //! the symmetric Hausdorff / RMS / paper measures of a decoded level against the original.
 
+pub mod appearance;
 pub mod distance;
 pub mod sampling;
 
 pub use distance::SurfaceIndex;
-pub use sampling::{sample_surface, Samples};
+pub use sampling::{sample_faces, sample_surface, FacePoint, Samples};
 
 use crate::codecs::LevelMesh;
 use crate::mesh::TriMesh;

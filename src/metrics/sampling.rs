@@ -32,6 +32,41 @@ pub fn sample_surface(mesh: &TriMesh, count: usize, seed: u64) -> Samples {
         .map(|(p, _)| *p)
         .collect();
     let vertices = points.len();
+    points.extend(
+        sample_faces(mesh, count, seed)
+            .into_iter()
+            .map(|s| s.position(mesh)),
+    );
+    Samples { points, vertices }
+}
+
+/// A point on one face: `a + (b − a)·u + (c − a)·v` of the face's corners a, b, c.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FacePoint {
+    /// The face.
+    pub face: u32,
+    /// Weight of the second corner.
+    pub u: f64,
+    /// Weight of the third corner.
+    pub v: f64,
+}
+
+impl FacePoint {
+    /// The corners' weights (barycentric coordinates).
+    pub fn weights(&self) -> [f64; 3] {
+        [1.0 - self.u - self.v, self.u, self.v]
+    }
+
+    /// Where the point lies on `mesh`.
+    pub fn position(&self, mesh: &TriMesh) -> DVec3 {
+        let [a, b, c] = mesh.corners(mesh.faces[self.face as usize]);
+        a + (b - a) * self.u + (c - a) * self.v
+    }
+}
+
+/// `count` area-weighted random points on the triangles of `mesh` (none if it has no area),
+/// stratified along the cumulative area, in face order.
+pub fn sample_faces(mesh: &TriMesh, count: usize, seed: u64) -> Vec<FacePoint> {
     let mut cumulative = Vec::with_capacity(mesh.faces.len());
     let mut total = 0.0;
     for f in &mesh.faces {
@@ -39,6 +74,7 @@ pub fn sample_surface(mesh: &TriMesh, count: usize, seed: u64) -> Samples {
         total += 0.5 * (b - a).cross(c - a).length();
         cumulative.push(total);
     }
+    let mut points = Vec::new();
     if total > 0.0 && count > 0 {
         let mut rng = Pcg64::seed_from_u64(seed);
         points.reserve(count);
@@ -49,15 +85,18 @@ pub fn sample_surface(mesh: &TriMesh, count: usize, seed: u64) -> Samples {
             while face + 1 < cumulative.len() && cumulative[face] < target {
                 face += 1;
             }
-            let [a, b, c] = mesh.corners(mesh.faces[face]);
             let (mut u, mut v): (f64, f64) = (rng.gen(), rng.gen());
             if u + v > 1.0 {
                 (u, v) = (1.0 - u, 1.0 - v);
             }
-            points.push(a + (b - a) * u + (c - a) * v);
+            points.push(FacePoint {
+                face: face as u32,
+                u,
+                v,
+            });
         }
     }
-    Samples { points, vertices }
+    points
 }
 
 #[cfg(test)]

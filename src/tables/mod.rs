@@ -15,7 +15,10 @@ use plotters::prelude::*;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+mod attributes;
 mod came;
+
+pub use attributes::{ATTRIBUTES_COMMAND, ATTRIBUTE_MESHES};
 
 /// One row of EMC's Table 1 as printed in the paper.
 struct PaperRow {
@@ -339,6 +342,10 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
     match came::rate_distortion(results, out) {
         Ok(p) => written.extend(p),
         Err(e) => missing.push(format!("came-rate-distortion: {e}")),
+    }
+    match attributes::attributes_table(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("attributes: {e}")),
     }
     (written, missing)
 }

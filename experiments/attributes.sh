@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Regenerates paper-tables/attributes.md (and its checker renders): our lossless codecs with
+# appearance on the shared meshes that have it, Draco (DracoPy) on the same meshes in the same
+# run, then the tables.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tests/libusb.sh
+cargo build --release --bins
+cargo run --release --bin experiment -- run experiments/attributes.toml
+if [ ! -x .venv/bin/python ]; then
+    python3 -m venv .venv
+fi
+.venv/bin/pip install --quiet -r experiments/requirements.txt
+.venv/bin/python experiments/draco_attributes.py bunny-10k-textured spot airplane-colored dragon-res3
+cargo run --release --bin experiment -- tables

@@ -1,0 +1,175 @@
+//! paper-tables/attributes.md: whole meshes with their appearance — our lossless codecs against
+//! Draco's single-rate files measured in the same run (`bash experiments/attributes.sh`).
+
+use crate::error::{Error, Result};
+use crate::results::{self, read_result, RunResult, APPEARANCE_SUFFIX};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The command that makes the results this table reads, and the table.
+pub const ATTRIBUTES_COMMAND: &str = "bash experiments/attributes.sh";
+
+/// The shared meshes with appearance, and what each carries.
+pub const ATTRIBUTE_MESHES: [(&str, &str); 4] = [
+    ("bunny-10k-textured", "uvs with seams, one material"),
+    ("spot", "uvs with seams"),
+    ("airplane-colored", "per-vertex colours"),
+    ("dragon-res3", "per-vertex normals; non-manifold"),
+];
+
+/// Our codecs in the table, and the stem suffix of their 12-bit results (`pm`'s default is
+/// 16 bits, so its stem names the quantization).
+const OURS: [(&str, &str); 5] = [
+    ("emc", ""),
+    ("pm", "-q12"),
+    ("pm-reordered", "-q12"),
+    ("came", ""),
+    ("raw", ""),
+];
+
+/// Draco's figures that its result file keeps beyond the common schema.
+struct DracoExtras {
+    geometry_bytes: f64,
+    split_vertices: f64,
+}
+
+fn draco_extras(path: &Path) -> Result<DracoExtras> {
+    let text = std::fs::read_to_string(path)?;
+    let value: serde_json::Value = serde_json::from_str(&text)
+        .map_err(|e| Error::Unsupported(format!("{}: {e}", path.display())))?;
+    let get = |key: &str| {
+        value["draco"][key]
+            .as_f64()
+            .ok_or_else(|| Error::Unsupported(format!("{}: no draco.{key}", path.display())))
+    };
+    Ok(DracoExtras {
+        geometry_bytes: get("geometry_bytes")?,
+        split_vertices: get("split_vertices")?,
+    })
+}
+
+fn missing(path: &Path, e: impl std::fmt::Display) -> Error {
+    Error::Unsupported(format!(
+        "{}: {e} (make it with: {ATTRIBUTES_COMMAND})",
+        path.display()
+    ))
+}
+
+/// The appearance error of a full level, as the table prints it.
+fn error_cell(row: &crate::results::LevelRow) -> String {
+    let a = &row.appearance;
+    let mut parts = Vec::new();
+    if let Some(t) = a.uv_texels {
+        parts.push(format!("uv {t:.3} texel"));
+    }
+    if let Some(n) = a.normal_degrees {
+        parts.push(format!("normal {n:.3}°"));
+    }
+    if let Some(c) = a.colour_steps {
+        parts.push(format!("colour {c:.3}/255"));
+    }
+    if let Some(m) = a.wrong_material.filter(|m| *m > 0.0) {
+        parts.push(format!("material {:.2}%", m * 100.0));
+    }
+    if parts.is_empty() {
+        "—".into()
+    } else {
+        parts.join(", ")
+    }
+}
+
+/// Writes paper-tables/attributes.md.
+pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
+    let mut md = String::new();
+    let _ = writeln!(md, "# Appearance: whole meshes against Draco\n");
+    let _ = writeln!(md, "Regenerate: `{ATTRIBUTES_COMMAND}` (our codecs with `--appearance`, then Draco through DracoPy in the same run, then this table).\n");
+    let _ = writeln!(md, "Positions at 12 bits (docs/CONTRACT.md §1), uvs at Qt = 12 bits over their bounding box, normals octahedral at Qn = 10 bits a coordinate, colours 8 bits a channel (§2.1), for us and for Draco (DracoPy, compression_level 10, quantization_bits 12, tex_coord_quantization_bits 12, normal_quantization_bits 10; colours as 8-bit channels). Bits per vertex are over the canonical mesh's vertex count. Our streams are progressive and their full decode is checked lossless, appearance included (§3); the appearance unit follows the last level. Draco is single-rate, fed the mesh with its vertices split at every seam (one vertex per wedge, as Draco needs; written by `meshcodec convert` as glTF), and its decode is not checked for losslessness. Draco's geometry column is a second file of the welded geometry alone; its appearance column is the difference. Appearance error (§5.1) is the mean over sample points of the original surface: uv distance in texels of a 1024² texture, normal angle, colour steps; it is the cost of quantization, since both full decodes keep every wedge. Draco carries no material ids here (DracoPy has no per-face attribute).\n");
+    for (mesh, what) in ATTRIBUTE_MESHES {
+        let draco_path = results::path(
+            results_dir,
+            "draco",
+            &format!("{mesh}{APPEARANCE_SUFFIX}"),
+            ".json",
+        );
+        let draco = read_result(&draco_path).map_err(|e| missing(&draco_path, e))?;
+        let extras = draco_extras(&draco_path)?;
+        let _ = writeln!(md, "## {mesh} ({what})\n");
+        let _ = writeln!(
+            md,
+            "| coder | progressive | geometry bits/vertex | appearance bits/wedge | total bits/vertex | vs Draco | appearance error | lossless | decode ms |"
+        );
+        let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---|---|---:|");
+        let draco_total = draco.bits_per_vertex();
+        let mut rows: Vec<(String, RunResult)> = Vec::new();
+        for (codec, suffix) in OURS {
+            let stem = format!("{mesh}{suffix}{APPEARANCE_SUFFIX}");
+            let path = results::path(results_dir, codec, &stem, ".json");
+            let Ok(r) = read_result(&path) else {
+                let reason = super::refused(results_dir, codec, mesh)
+                    .ok_or_else(|| missing(&path, "no result and no refusal"))?;
+                let _ = writeln!(md, "| `{codec}` | refused: {reason} | | | | | | | |");
+                continue;
+            };
+            rows.push((codec.to_string(), r.clone()));
+            let codec = &codec.to_string();
+            let Some(appearance) = &r.appearance else {
+                return Err(Error::Unsupported(format!(
+                    "{codec} on {mesh}: the result coded no appearance"
+                )));
+            };
+            let v = r.vertices as f64;
+            let total = r.bits_per_vertex();
+            let last = r.levels.last().ok_or_else(|| {
+                Error::Unsupported(format!("{codec} on {mesh}: a result without levels"))
+            })?;
+            let _ = writeln!(
+                md,
+                "| `{codec}` | {} | {:.2} | {:.2} | {} | {:+.1}% | {} | {} | {:.1} |",
+                if *codec == "raw" { "no" } else { "yes" },
+                (r.bytes as f64 * 8.0 - appearance.bits as f64) / v,
+                appearance.bits as f64 / appearance.wedges.max(1) as f64,
+                if total < draco_total {
+                    format!("**{total:.2}**")
+                } else {
+                    format!("{total:.2}")
+                },
+                (total / draco_total - 1.0) * 100.0,
+                error_cell(last),
+                if r.lossless { "yes" } else { "**no**" },
+                r.decode_seconds * 1e3,
+            );
+        }
+        let v = draco.vertices as f64;
+        let last = draco
+            .levels
+            .last()
+            .ok_or_else(|| missing(&draco_path, "no level"))?;
+        let _ = writeln!(
+            md,
+            "| Draco (single-rate) | no | {:.2} | {:.2} | {draco_total:.2} | | {} | not checked | {:.1} |\n",
+            extras.geometry_bytes * 8.0 / v,
+            (draco.bytes as f64 - extras.geometry_bytes) * 8.0 / extras.split_vertices.max(1.0),
+            error_cell(last),
+            draco.decode_seconds * 1e3,
+        );
+        let best = rows
+            .iter()
+            .filter(|(c, _)| c != "raw")
+            .min_by(|a, b| a.1.bytes.cmp(&b.1.bytes));
+        if let Some((codec, r)) = best {
+            let _ = writeln!(
+                md,
+                "Smallest progressive stream: `{codec}`, {} bytes against Draco's {} ({:+.1}%); {} wedges on {} vertices.\n",
+                r.bytes,
+                draco.bytes,
+                (r.bytes as f64 / draco.bytes as f64 - 1.0) * 100.0,
+                r.appearance.as_ref().map_or(0, |a| a.wedges),
+                r.vertices
+            );
+        }
+    }
+    std::fs::create_dir_all(out)?;
+    let path = out.join("attributes.md");
+    crate::mesh::io::write_atomically(&path, md.as_bytes())?;
+    Ok(path)
+}
