@@ -132,6 +132,17 @@ for codec in raw emc emc-paper pm pm-reordered came came-paper; do
     tail -c +7 "$stream" > "$dir/$name.body"
   done
 done
+# Streams with appearance (every codec that carries it, on the seeds with uvs, normals,
+# materials or colours), with the magic and version cut off: decode_appearance's input.
+mkdir -p $seeds/decode_appearance
+for codec in raw emc pm came; do
+  for mesh in $seeds/read_obj/torus.obj $seeds/read_gltf/torus.glb $seeds/read_ply/torus-ascii.ply; do
+    name=$(basename "$mesh"); name=${name%.*}-${mesh##*.}
+    if target/release/meshcodec encode --codec "$codec" --quant 10 --uv-bits 8 --normal-bits 6 "$mesh" "$stream" >/dev/null 2>&1; then
+      tail -c +6 "$stream" > "$seeds/decode_appearance/$codec-$name.body"
+    fi
+  done
+done
 # One meta-node alone takes the CAME codecs' streams too.
 for codec in came came_paper; do
   mkdir -p $seeds/decode_${codec}_unit

@@ -6,7 +6,7 @@
 //! params: varint length + codec-specific bytes
 //! grid: bits (u8), origin 3 × f64 LE, cell 3 × f64 LE
 //! vertices (varint)  triangles (varint)                        -- of the full mesh
-//! version 3 only: appearance block (flags u8, then each attribute's quantization, names)
+//! version 4 only: appearance block (flags u8, then each attribute's quantization, names)
 //! index: units N (varint), payload bytes P (varint),
 //!        N × { offset (varint), length (varint), parent (varint: 0 = none, k = unit i − k) }
 //! payload: P bytes, every byte in exactly one unit
@@ -28,10 +28,11 @@ use std::io::Read as _;
 /// First bytes of every stream.
 pub const MAGIC: [u8; 4] = *b"MshC";
 /// Version of the stream syntax: bumped on every change to the bytes any codec writes
-/// (docs/FORMAT.md, "History"). Version 3 is version 2 with an appearance block after the
-/// header and an appearance unit after the last; a stream without appearance is written in
-/// version 2, which this build also reads.
-pub const FORMAT_VERSION: u8 = 3;
+/// (docs/FORMAT.md, "History"). Versions 3 and 4 are version 2 with an appearance block after
+/// the header and an appearance unit after the last (4 predicts uvs better, so version 3's
+/// units no longer decode); a stream without appearance is written in version 2, which this
+/// build also reads.
+pub const FORMAT_VERSION: u8 = 4;
 /// The version of streams without appearance, and the oldest this build reads.
 pub const GEOMETRY_ONLY_VERSION: u8 = 2;
 /// The fewest bytes an index entry takes (three one-byte varints).
@@ -50,8 +51,20 @@ pub struct Header {
     pub vertices: u64,
     /// Triangles of the full mesh.
     pub triangles: u64,
-    /// What the appearance unit carries, when the stream has one (version 3).
+    /// What the appearance unit carries, when the stream has one (version 4).
     pub appearance: Option<AppearanceSpec>,
+}
+
+impl Header {
+    /// The format version this header is written in: [`FORMAT_VERSION`] with appearance,
+    /// [`GEOMETRY_ONLY_VERSION`] without.
+    pub fn version(&self) -> u8 {
+        if self.appearance.is_some() {
+            FORMAT_VERSION
+        } else {
+            GEOMETRY_ONLY_VERSION
+        }
+    }
 }
 
 /// What a stream's appearance unit carries and how it is quantized (docs/FORMAT.md §1.1).
@@ -391,11 +404,7 @@ impl Header {
     /// Appends the header's bytes to `out`.
     pub fn write(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(&MAGIC);
-        out.push(if self.appearance.is_some() {
-            FORMAT_VERSION
-        } else {
-            GEOMETRY_ONLY_VERSION
-        });
+        out.push(self.version());
         out.push(self.codec_id);
         varint::put(out, self.params.len() as u64);
         out.extend_from_slice(&self.params);
@@ -421,7 +430,7 @@ impl Header {
             return Err(bad(0, "not a meshcodec stream (bad magic)"));
         }
         let version = *bytes.get(4).ok_or_else(cut)?;
-        if !(GEOMETRY_ONLY_VERSION..=FORMAT_VERSION).contains(&version) {
+        if version != GEOMETRY_ONLY_VERSION && version != FORMAT_VERSION {
             return Err(Error::Unsupported(format!(
                 "stream format version {version} (this build reads versions {GEOMETRY_ONLY_VERSION} and {FORMAT_VERSION})"
             )));
@@ -933,6 +942,10 @@ mod tests {
         bytes[4] = 1;
         let e = StreamReader::open(&bytes).unwrap_err();
         assert!(e.to_string().contains("format version 1"), "{e}");
+        // Version 3's appearance units are not version 4's.
+        bytes[4] = 3;
+        let e = StreamReader::open(&bytes).unwrap_err();
+        assert!(e.to_string().contains("format version 3"), "{e}");
     }
 
     #[test]

@@ -6,7 +6,7 @@
 //! are not yet consistently oriented still reads correctly.
 
 use crate::mesh::{Aabb, TriMesh};
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 
 /// Where the camera looks from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,8 +41,62 @@ pub struct Picture {
 
 /// Draws `mesh` flat-shaded into a `width` × `height` picture framed on `frame`.
 pub fn render(mesh: &TriMesh, frame: &Aabb, view: View, width: u32, height: u32) -> Picture {
-    let centre = (frame.min + frame.max) * 0.5;
     // Model → camera: bring `up` to +y, then yaw, then pitch; the camera looks down −z.
+    let (rotation, project) = orthographic(frame, view, width, height);
+    let screen: Vec<DVec3> = mesh.positions.iter().map(|&p| project(p)).collect();
+    rasterize(mesh, &screen, |p| rotation * p, width, height, flat)
+}
+
+/// Checker squares across the unit uv square in [`render_textured`].
+pub const CHECKER_SQUARES: f64 = 32.0;
+
+/// Draws `mesh` as [`render`] does, textured with a checker through `corner_uvs` (one uv per
+/// face corner, face by face): each uv chart shows its squares, and a seam pulled apart or a
+/// chart distorted breaks them.
+pub fn render_textured(
+    mesh: &TriMesh,
+    corner_uvs: &[[DVec2; 3]],
+    frame: &Aabb,
+    view: View,
+    width: u32,
+    height: u32,
+) -> Picture {
+    let (rotation, project) = orthographic(frame, view, width, height);
+    let screen: Vec<DVec3> = mesh.positions.iter().map(|&p| project(p)).collect();
+    let checker = |face: usize, w: [f64; 3], shade: f64| {
+        let Some(t) = corner_uvs.get(face) else {
+            return flat(face, w, shade);
+        };
+        let uv = t[0] * w[0] + t[1] * w[1] + t[2] * w[2];
+        let square = (uv * CHECKER_SQUARES).floor();
+        let dark = (square.x + square.y).rem_euclid(2.0) >= 1.0;
+        let base = if dark {
+            [60.0, 70.0, 150.0]
+        } else {
+            [245.0, 225.0, 150.0]
+        };
+        base.map(|c| (c * shade) as u8)
+    };
+    rasterize(mesh, &screen, |p| rotation * p, width, height, checker)
+}
+
+/// The flat colour of a face lit by `shade`.
+fn flat(_face: usize, _weights: [f64; 3], shade: f64) -> [u8; 3] {
+    [
+        (shade * 200.0) as u8,
+        (shade * 210.0) as u8,
+        (shade * 235.0) as u8,
+    ]
+}
+
+/// The camera of [`render`]: model → camera rotation and model → screen projection.
+fn orthographic(
+    frame: &Aabb,
+    view: View,
+    width: u32,
+    height: u32,
+) -> (DMat3, impl Fn(DVec3) -> DVec3) {
+    let centre = (frame.min + frame.max) * 0.5;
     let to_y_up = if view.up == 2 {
         DMat3::from_rotation_x(-std::f64::consts::FRAC_PI_2)
     } else {
@@ -53,7 +107,7 @@ pub fn render(mesh: &TriMesh, frame: &Aabb, view: View, width: u32, height: u32)
         * to_y_up;
     let radius = frame.diagonal() * 0.5;
     let scale = 0.96 * width.min(height) as f64 / (2.0 * radius.max(f64::MIN_POSITIVE));
-    let project = |p: DVec3| {
+    let project = move |p: DVec3| {
         let q = rotation * (p - centre);
         DVec3::new(
             width as f64 * 0.5 + q.x * scale,
@@ -61,8 +115,7 @@ pub fn render(mesh: &TriMesh, frame: &Aabb, view: View, width: u32, height: u32)
             q.z,
         )
     };
-    let screen: Vec<DVec3> = mesh.positions.iter().map(|&p| project(p)).collect();
-    rasterize(mesh, &screen, |p| rotation * p, width, height)
+    (rotation, project)
 }
 
 /// A pinhole camera for [`render_perspective`].
@@ -108,22 +161,24 @@ pub fn render_perspective(
             )
         })
         .collect();
-    rasterize(mesh, &screen, to_camera, width, height)
+    rasterize(mesh, &screen, to_camera, width, height, flat)
 }
 
 /// Fills the faces of `mesh` at their `screen` corners (x, y in pixels, z larger nearer),
-/// shaded by their normals in the camera's frame (`to_camera`).
+/// shaded by their normals in the camera's frame (`to_camera`); `paint` gives a pixel's colour
+/// from its face, its corner weights and the face's shade.
 fn rasterize(
     mesh: &TriMesh,
     screen: &[DVec3],
     to_camera: impl Fn(DVec3) -> DVec3,
     width: u32,
     height: u32,
+    paint: impl Fn(usize, [f64; 3], f64) -> [u8; 3],
 ) -> Picture {
     let mut depth = vec![f64::NEG_INFINITY; (width * height) as usize];
     let mut pixels = vec![[255u8; 3]; (width * height) as usize];
     let light = DVec3::new(-0.35, 0.45, 1.0).normalize();
-    for f in &mesh.faces {
+    for (face, f) in mesh.faces.iter().enumerate() {
         let [a, b, c] = f.map(|v| screen[v as usize]);
         if !(a.is_finite() && b.is_finite() && c.is_finite()) {
             continue;
@@ -134,11 +189,6 @@ fn rasterize(
             continue;
         }
         let shade = 0.18 + 0.82 * normal.normalize().dot(light).abs();
-        let colour = [
-            (shade * 200.0) as u8,
-            (shade * 210.0) as u8,
-            (shade * 235.0) as u8,
-        ];
         let area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
         if area.abs() < 1e-12 {
             continue;
@@ -160,7 +210,7 @@ fn rasterize(
                 let i = (y * width + x) as usize;
                 if z > depth[i] {
                     depth[i] = z;
-                    pixels[i] = colour;
+                    pixels[i] = paint(face, [w0, w1, w2], shade);
                 }
             }
         }
@@ -191,5 +241,43 @@ impl Picture {
                 .map_err(|e| fail(&e))?;
         }
         backend.present().map_err(|e| fail(&e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_checker_shows_its_squares_through_the_uvs() {
+        // One square face, seen face-on, whose uvs span two squares a side.
+        let mesh = TriMesh::new(
+            vec![
+                DVec3::new(-1.0, -1.0, 0.0),
+                DVec3::new(1.0, -1.0, 0.0),
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(-1.0, 1.0, 0.0),
+            ],
+            vec![[0, 1, 2], [0, 2, 3]],
+        );
+        let s = 2.0 / CHECKER_SQUARES;
+        let uv = [
+            DVec2::ZERO,
+            DVec2::new(s, 0.0),
+            DVec2::new(s, s),
+            DVec2::new(0.0, s),
+        ];
+        let corners = [[uv[0], uv[1], uv[2]], [uv[0], uv[2], uv[3]]];
+        let frame = mesh.referenced_bounds().unwrap();
+        let picture = render_textured(&mesh, &corners, &frame, View::default(), 64, 64);
+        let at = |x: u32, y: u32| picture.pixels[(y * 64 + x) as usize];
+        // Diagonal quarters share a colour, neighbouring quarters differ.
+        assert_eq!(at(16, 16), at(48, 48));
+        assert_eq!(at(48, 16), at(16, 48));
+        assert_ne!(at(16, 16), at(48, 16));
+        // Without uvs the same mesh is flat-shaded, one colour.
+        let flat = render(&mesh, &frame, View::default(), 64, 64);
+        assert_eq!(flat.pixels[16 * 64 + 16], flat.pixels[48 * 64 + 48]);
+        assert_eq!(flat.pixels[16 * 64 + 16], flat.pixels[16 * 64 + 48]);
     }
 }

@@ -109,3 +109,48 @@ fn a_mesh_with_materials_alone_keeps_them_through_every_codec_that_carries_appea
         );
     }
 }
+
+#[test]
+fn the_harness_codes_appearance_when_asked_and_measures_it_at_the_level_that_carries_it() {
+    use meshcodec::harness::{run, RunOptions};
+    let path = resolve("spot").unwrap();
+    let options = RunOptions {
+        quant_bits: Some(12),
+        samples_per_triangle: 2,
+        appearance: Some(AttributeBits::default()),
+        ..RunOptions::default()
+    };
+    let emc = codecs::by_name("emc").unwrap();
+    let out = run(emc, &path, &options).unwrap();
+    let r = &out.result;
+    assert!(r.lossless, "{:?}", r.lossless_error);
+    assert!(out.appearance.is_empty(), "nothing left uncoded");
+    let appearance = r.appearance.as_ref().unwrap();
+    assert_eq!(appearance.fields, ["uvs"]);
+    assert!(appearance.wedges > r.vertices);
+    assert!(appearance.bits > 0 && appearance.bits < r.bytes as u64 * 8);
+    let (last, earlier) = r.levels.split_last().unwrap();
+    // 12-bit uvs are off by a fraction of a texel of a 1024² texture.
+    let uv = last.appearance.uv_texels.unwrap();
+    assert!(uv > 0.0 && uv < 1.0, "{uv}");
+    assert!(earlier.iter().all(|l| l.appearance.uv_texels.is_none()));
+    assert_eq!(last.bits, r.bytes as u64 * 8);
+    let csv = meshcodec::results::levels_csv(r);
+    assert!(csv.lines().next().unwrap().ends_with("wrong_material"));
+    // Without appearance the same run is geometry alone, and says what it left.
+    let plain = run(
+        emc,
+        &path,
+        &RunOptions {
+            appearance: None,
+            ..options.clone()
+        },
+    )
+    .unwrap();
+    assert!(plain.result.appearance.is_none());
+    assert!(!plain.appearance.is_empty());
+    assert!(plain.result.bytes < r.bytes);
+    // A codec that cannot carry it codes the geometry and leaves the appearance uncoded.
+    let lossy = run(codecs::by_name("came-paper").unwrap(), &path, &options).unwrap();
+    assert!(lossy.result.appearance.is_none() && !lossy.appearance.is_empty());
+}

@@ -446,3 +446,35 @@ fn a_codec_that_cannot_carry_appearance_refuses_it_unless_told_to_drop_it() {
     let out = run(MESHCODEC, &["encode", "--codec", "emc", "bunny", "b.mc"], d);
     assert_eq!((out.code, out.stderr.as_str()), (Some(0), ""));
 }
+
+#[test]
+fn convert_keeps_appearance_and_distance_measures_it() {
+    let dir = scratch();
+    let d = dir.path();
+    // OBJ with seams → glTF (vertices split at every seam) → welded back into the same wedges.
+    let out = run(MESHCODEC, &["convert", "bunny-10k-textured", "b.glb"], d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    assert!(out.stdout.contains("6451 wedges"), "{}", out.stdout);
+    let out = run(
+        MESHCODEC,
+        &["distance", "bunny-10k-textured", "b.glb", "--json"],
+        d,
+    );
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let report: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let uv = report["appearance"]["uv_texels"].as_f64().unwrap();
+    assert!(uv < 1e-3, "{uv}");
+    // A decode of 12-bit uvs is measured off by a fraction of a texel, not zero.
+    let out = run(MESHCODEC, &["encode", "--codec", "emc", "spot", "s.mc"], d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let out = run(MESHCODEC, &["decode", "s.mc", "s.obj"], d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let out = run(MESHCODEC, &["distance", "spot", "s.obj", "--json"], d);
+    let report: serde_json::Value = serde_json::from_str(&out.stdout).unwrap();
+    let uv = report["appearance"]["uv_texels"].as_f64().unwrap();
+    assert!(uv > 0.0 && uv < 1.0, "{uv}");
+    // A format that cannot be written is one line, and no file.
+    let out = run(MESHCODEC, &["convert", "spot", "s.xyz"], d);
+    assert_clean_failure(&out, "s.xyz");
+    assert!(!d.join("s.xyz").exists());
+}

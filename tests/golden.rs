@@ -8,6 +8,10 @@
 //! - `tests/golden/rates.txt` pins each codec's bits per vertex on three meshes; a codec that
 //!   codes any of them in more bits fails.
 //!
+//! - `tests/golden/v<FORMAT_VERSION>/emc-spot-appearance.mc` is `emc`'s stream of spot.obj with
+//!   its uvs (12-bit positions and uvs): the appearance unit's bytes are pinned too, and the
+//!   stream must decode to the canonical mesh with its appearance exactly.
+//!
 //! Both are regenerated on purpose with `UPDATE_GOLDEN=1 cargo test --release --test golden`,
 //! which a change of syntax must come with (and a new format version: docs/FORMAT.md, History).
 
@@ -134,7 +138,7 @@ fn streams_of_another_format_version_are_refused_in_one_line() {
     let codec = codecs::by_name("raw").unwrap();
     let [(_, eight)] = read_all(["eight"]);
     let mut bytes = codec.encode(&canonical(codec, &eight)).unwrap().bytes;
-    for version in [0, GEOMETRY_ONLY_VERSION - 1, FORMAT_VERSION + 1, 255] {
+    for version in [0, GEOMETRY_ONLY_VERSION - 1, 3, FORMAT_VERSION + 1, 255] {
         bytes[4] = version;
         match codecs::decode(&bytes, Stop::All) {
             Err(e @ Error::Unsupported(_)) => {
@@ -145,6 +149,51 @@ fn streams_of_another_format_version_are_refused_in_one_line() {
             other => panic!("version {version}: {:?}", other.map(|(_, n)| n)),
         }
     }
+}
+
+#[test]
+fn the_appearance_golden_stream_is_reproduced_and_decodes_exactly() {
+    let codec = codecs::by_name("emc").unwrap();
+    let path = resolve("spot").unwrap();
+    let original = meshcodec::mesh::io::read_attributed(&path).unwrap();
+    let (canonical, appearance) = codecs::canonical_attributed_for(
+        &original,
+        &codec.default_options(),
+        meshcodec::mesh::attribute_quantization::AttributeBits::default(),
+    )
+    .unwrap();
+    let bytes = codecs::encode_attributed(codec, &canonical, Some(&appearance))
+        .unwrap()
+        .bytes;
+    assert_eq!(bytes[4], FORMAT_VERSION);
+    let golden = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/golden")
+        .join(format!("v{FORMAT_VERSION}"))
+        .join("emc-spot-appearance.mc");
+    if updating() {
+        std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
+        std::fs::write(&golden, &bytes).unwrap();
+    }
+    let pinned = std::fs::read(&golden).unwrap_or_else(|e| {
+        panic!(
+            "{}: {e} (UPDATE_GOLDEN=1 cargo test --release --test golden)",
+            golden.display()
+        )
+    });
+    assert!(
+        pinned == bytes,
+        "emc's appearance stream of spot changed ({} bytes, pinned {}): a syntax change needs a new format version and UPDATE_GOLDEN=1",
+        bytes.len(),
+        pinned.len()
+    );
+    let (decoded, _) = codecs::decode(&pinned, Stop::All).unwrap();
+    appearance
+        .check_lossless(
+            &canonical,
+            &decoded.mesh,
+            decoded.attributes.as_ref().unwrap(),
+        )
+        .unwrap();
 }
 
 /// (codec, mesh, bits per vertex) rows of the pin file.

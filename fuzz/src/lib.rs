@@ -8,7 +8,7 @@
 use arbitrary::{Arbitrary, Result as ArbitraryResult, Unstructured};
 use meshcodec::codecs::pm::iter::PMeshIter;
 use meshcodec::codecs::{self, EncodeOptions, LevelMesh, Stop};
-use meshcodec::container::{Header, FORMAT_VERSION, MAGIC};
+use meshcodec::container::{Header, FORMAT_VERSION, GEOMETRY_ONLY_VERSION, MAGIC};
 use meshcodec::limits;
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::{generate, io, TriMesh};
@@ -31,13 +31,24 @@ pub fn decode_as(name: &str, body: &[u8]) {
     decode_every_way(&stream_of(name, body));
 }
 
-/// A stream of codec `name` whose bytes after the first six (magic, version, codec id) are
-/// `body`.
+/// Decodes `body` as everything after the first five bytes (magic, version) of a stream with
+/// appearance: its first byte picks the codec, then the header with its appearance block, the
+/// index with the appearance unit last, the levels and the unit.
+pub fn decode_with_appearance(body: &[u8]) {
+    let mut bytes = Vec::with_capacity(body.len() + 5);
+    bytes.extend_from_slice(&MAGIC);
+    bytes.push(FORMAT_VERSION);
+    bytes.extend_from_slice(body);
+    decode_every_way(&bytes);
+}
+
+/// A geometry-only stream (format version 2) of codec `name` whose bytes after the first six
+/// (magic, version, codec id) are `body`.
 fn stream_of(name: &str, body: &[u8]) -> Vec<u8> {
     let id = codecs::by_name(name).expect("a registered codec").id();
     let mut bytes = Vec::with_capacity(body.len() + 6);
     bytes.extend_from_slice(&MAGIC);
-    bytes.push(FORMAT_VERSION);
+    bytes.push(GEOMETRY_ONLY_VERSION);
     bytes.push(id);
     bytes.extend_from_slice(body);
     bytes
@@ -208,6 +219,15 @@ pub fn check_level_mesh(level: &LevelMesh, header: &Header) {
     }
     for edge in &level.loose_edges {
         assert!(edge.iter().all(|&v| (v as usize) < n) && edge[0] != edge[1]);
+    }
+    if let Some(attributes) = &level.attributes {
+        assert!(
+            header.appearance.is_some(),
+            "appearance from a stream without"
+        );
+        if let Err(e) = attributes.validate(mesh) {
+            panic!("decoded appearance fails validation: {e}");
+        }
     }
 }
 

@@ -499,7 +499,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
     let report = serde_json::json!({
         "file": input.display().to_string(),
         "bytes": stream.len(),
-        "format_version": meshcodec::container::FORMAT_VERSION,
+        "format_version": header.version(),
         "codec": codec.name(),
         "origin": header.grid.origin,
         "cell": header.grid.cell,
@@ -525,7 +525,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "{}: {} bytes, format version {}, codec {}",
         input.display(),
         stream.len(),
-        meshcodec::container::FORMAT_VERSION,
+        header.version(),
         codec.name()
     );
     let _ = writeln!(

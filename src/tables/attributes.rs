@@ -173,3 +173,78 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
     crate::mesh::io::write_atomically(&path, md.as_bytes())?;
     Ok(path)
 }
+
+/// The meshes of the checker figure.
+const CHECKER_MESHES: [&str; 2] = ["bunny-10k-textured", "spot"];
+
+/// Each face corner's uv, face by face; `None` without uvs.
+fn corner_uvs(a: &crate::mesh::attributes::Attributes) -> Option<Vec<[glam::DVec2; 3]>> {
+    let uvs = a.uvs.as_ref()?;
+    Some(
+        a.corners
+            .iter()
+            .map(|c| c.map(|w| uvs[w as usize]))
+            .collect(),
+    )
+}
+
+/// Writes paper-tables/attributes-checker.png: the textured meshes with a checker through their
+/// uvs, as the file holds them and as `emc`'s kept stream decodes them (uvs at 12 bits).
+pub fn attributes_checker(results_dir: &Path, out: &Path) -> Result<PathBuf> {
+    use crate::render::{render_textured, View};
+    use plotters::prelude::*;
+    const PANEL: u32 = 420;
+    const CAPTION: u32 = 30;
+    let width = PANEL * 2;
+    let height = (PANEL + CAPTION) * CHECKER_MESHES.len() as u32;
+    std::fs::create_dir_all(out)?;
+    let path = out.join("attributes-checker.png");
+    let root = BitMapBackend::new(&path, (width, height)).into_drawing_area();
+    let fail = |e: &dyn std::fmt::Display| Error::Io(std::io::Error::other(format!("plot: {e}")));
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    let view = View {
+        up: 1,
+        yaw: 30.0,
+        pitch: 20.0,
+    };
+    for (row, mesh) in CHECKER_MESHES.iter().enumerate() {
+        let stem = format!("{mesh}{APPEARANCE_SUFFIX}");
+        let result_path = results::path(results_dir, "emc", &stem, ".json");
+        let result = read_result(&result_path).map_err(|e| missing(&result_path, e))?;
+        let stream_path = results::path(results_dir, "emc", &stem, ".mc");
+        let stream = std::fs::read(&stream_path).map_err(|e| missing(&stream_path, e))?;
+        let original = crate::mesh::io::read_attributed(Path::new(&result.source))?;
+        let (decoded, _) = crate::codecs::decode(&stream, crate::codecs::Stop::All)?;
+        let frame = original
+            .mesh
+            .referenced_bounds()
+            .ok_or_else(|| Error::mesh("empty mesh"))?;
+        let panels = [
+            (
+                &original.mesh,
+                corner_uvs(&original.attributes),
+                format!("{mesh}: the file's uvs"),
+            ),
+            (
+                &decoded.mesh,
+                decoded.attributes.as_ref().and_then(corner_uvs),
+                format!("emc, full decode: {} bytes", stream.len()),
+            ),
+        ];
+        for (col, (m, uvs, caption)) in panels.into_iter().enumerate() {
+            let uvs = uvs.ok_or_else(|| Error::Unsupported(format!("{mesh}: no uvs")))?;
+            let picture = render_textured(m, &uvs, &frame, view, PANEL, PANEL);
+            let (x0, y0) = (col as u32 * PANEL, row as u32 * (PANEL + CAPTION));
+            super::draw_panel(&root, &picture.pixels, PANEL, (x0, y0))?;
+            root.draw_text(
+                &caption,
+                &("sans-serif", 20).into_font().color(&BLACK),
+                (x0 as i32 + 12, (y0 + PANEL + 2) as i32),
+            )
+            .map_err(|e| fail(&e))?;
+        }
+    }
+    root.present().map_err(|e| fail(&e))?;
+    drop(root);
+    Ok(path)
+}

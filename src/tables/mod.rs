@@ -347,6 +347,10 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
         Ok(p) => written.push(p),
         Err(e) => missing.push(format!("attributes: {e}")),
     }
+    match attributes::attributes_checker(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("attributes-checker: {e}")),
+    }
     (written, missing)
 }
 

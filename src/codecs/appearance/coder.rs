@@ -2,7 +2,7 @@
 //! encoder passes the true value of every decision, the decoder reads it, and both then update
 //! the same state.
 
-use super::predict::{face_normal, uv_by_unfolding, uv_from_triangle, winding};
+use super::predict::{face_normal, uv_by_fit, uv_by_unfolding, uv_from_triangle, winding};
 use super::traversal::Traversal;
 use crate::codecs::appearance::Appearance;
 use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext, IntContext, UintContext};
@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::mesh::attribute_quantization::{octahedral_code, octahedral_max};
 use crate::mesh::canonical_attributes::CornerCode;
 use crate::mesh::TriMesh;
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 /// One decision at a time, both ways.
 pub trait Symbols {
@@ -80,6 +80,10 @@ pub struct Truth<'a> {
 }
 
 const NONE: u32 = u32::MAX;
+/// The uv predictions scored against each other: unfolded, similar, their mean, fitted, the mean
+/// of unfolded and fitted.
+const UV_PREDICTIONS: usize = 5;
+
 /// Context sets for uv residuals by the predicting edge's length in cells (log2 buckets).
 const UV_SCALES: usize = 10;
 
@@ -131,8 +135,8 @@ pub fn run(
     let mut previous_uv = [0u32; 2];
     let mut previous_colour = [0u8; 4];
     let mut last_winding = 1.0;
-    // Recent errors of the unfolded, similar and mean uv predictions.
-    let mut uv_scores = [0.0f64; 3];
+    // Recent errors of the uv predictions (see `UV_PREDICTIONS`).
+    let mut uv_scores = [0.0f64; UV_PREDICTIONS];
     let mut previous_material = 0u32;
     let normal_max = spec.normal_bits.map(octahedral_max);
     let uv_cells = spec.uv_grid.map(|g| 1u64 << g.bits);
@@ -297,6 +301,8 @@ pub fn run(
                 let uv = |j: usize| known_code(j).and_then(|c| c.uv);
                 let at = |q: [u32; 2]| DVec2::new(q[0] as f64, q[1] as f64);
                 let mut scored = None;
+                // How far the predictions fall apart: when they disagree the residual is large.
+                let mut disagreement: Option<f64> = None;
                 let (basis, predicted) = match (uv(others[0]), uv(others[1])) {
                     (Some(ta), Some(tb)) => {
                         let p = |i: usize| mesh.positions[face[i] as usize];
@@ -327,16 +333,47 @@ pub fn run(
                             at(tb),
                             last_winding,
                         );
-                        // Of the unfolded, the similar and their mean, the prediction that
-                        // has erred least lately (both sides score all three once the value is
-                        // known).
+                        // The chart's corners around the known edge: every corner of the
+                        // faces visited so far at either end that continue its wedge there.
+                        let mut pairs: Vec<(DVec3, DVec2)> = Vec::new();
+                        let mut seen: Vec<u32> = Vec::new();
+                        let mut plane_normal = face_normal(p(0), p(1), p(2));
+                        for (end, wedge) in [(face[others[0]], ea), (face[others[1]], eb)] {
+                            for &g in traversal.faces_at(end) {
+                                let gw = out.corners[g as usize];
+                                if g == f || gw[0] == NONE || !gw.contains(&wedge) {
+                                    continue;
+                                }
+                                let gf = faces[g as usize];
+                                let q = |i: usize| mesh.positions[gf[i] as usize];
+                                plane_normal += face_normal(q(0), q(1), q(2));
+                                for (i, &w) in gw.iter().enumerate() {
+                                    if seen.contains(&w) {
+                                        continue;
+                                    }
+                                    if let Some(t) = out.codes[w as usize].uv {
+                                        seen.push(w);
+                                        pairs.push((q(i), at(t)));
+                                    }
+                                }
+                            }
+                        }
+                        let fitted = uv_by_fit(p(k), plane_normal, &pairs);
+                        // Of these predictions, the one that has erred least lately (both
+                        // sides score them all once the value is known).
                         let t = match unfolded {
                             Some(u) => {
-                                let choices = [u, similar, (u + similar) * 0.5];
-                                let best = (0..3)
+                                let fit = fitted.unwrap_or(u);
+                                let choices =
+                                    [u, similar, (u + similar) * 0.5, fit, (u + fit) * 0.5];
+                                let best = (0..UV_PREDICTIONS)
                                     .min_by(|&i, &j| uv_scores[i].total_cmp(&uv_scores[j]))
-                                    .expect("three choices");
+                                    .expect("choices");
                                 scored = Some(choices);
+                                disagreement = Some(
+                                    (u - fit).abs().element_sum()
+                                        + (u - similar).abs().element_sum(),
+                                );
                                 choices[best]
                             }
                             None => similar,
@@ -351,9 +388,15 @@ pub fn run(
                     (Some(t), None) | (None, Some(t)) => (UvBasis::Corner, t),
                     (None, None) => (UvBasis::Previous, previous_uv),
                 };
-                // Residuals grow with the triangle's size in uv: its known edge picks the
+                // Residuals grow with the triangle's size in uv (its known edge) and with how
+                // far the predictions fall apart: the geometric mean of the two picks the
                 // contexts.
                 let scale = match (uv(others[0]), uv(others[1])) {
+                    (Some(ta), Some(tb)) if disagreement.is_some() => {
+                        let d = disagreement.unwrap_or(0.0).max(1.0);
+                        let span = (at(ta) - at(tb)).abs().max_element().max(1.0);
+                        (((d * span).log2() * 0.5).round().max(0.0) as usize).min(UV_SCALES - 1)
+                    }
                     (Some(ta), Some(tb)) => {
                         let span = (at(ta) - at(tb)).abs().max_element() as u64;
                         (64 - span.leading_zeros() as usize).min(UV_SCALES - 1)

@@ -66,3 +66,79 @@ pub fn uv_by_unfolding(p: DVec3, [a, b, c]: [DVec3; 3], [ta, tb, tc]: [DVec2; 3]
     let per_height = (tc - ta - per_along * along_c) / height_c;
     Some(ta + per_along * along(p) - per_height * height(p))
 }
+
+/// The uv of `p` by the affine map from the tangent plane of `normal` to uv space that fits
+/// `pairs` — known (position, uv) corners of the chart around `p` — in the least-squares sense.
+/// Where one neighbour triangle's unfolding follows that triangle's distortion alone, the fit
+/// averages the chart's local stretch over the whole neighbourhood. `None` with fewer than four
+/// pairs or when they do not span the plane.
+pub fn uv_by_fit(p: DVec3, normal: DVec3, pairs: &[(DVec3, DVec2)]) -> Option<DVec2> {
+    if pairs.len() < 4 {
+        return None;
+    }
+    let n = normal.try_normalize()?;
+    let e1 = n.any_orthonormal_vector();
+    let e2 = n.cross(e1);
+    let centre = pairs.iter().map(|(q, _)| *q).sum::<DVec3>() / pairs.len() as f64;
+    let plane = |q: DVec3| DVec2::new((q - centre).dot(e1), (q - centre).dot(e2));
+    // Normal equations of t = t0 + J·x over the pairs, x centred so t0 is the mean uv.
+    let mean_t = pairs.iter().map(|(_, t)| *t).sum::<DVec2>() / pairs.len() as f64;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    let (mut sxt, mut syt) = (DVec2::ZERO, DVec2::ZERO);
+    let mean_x = pairs.iter().map(|(q, _)| plane(*q)).sum::<DVec2>() / pairs.len() as f64;
+    for (q, t) in pairs {
+        let x = plane(*q) - mean_x;
+        let d = *t - mean_t;
+        sxx += x.x * x.x;
+        sxy += x.x * x.y;
+        syy += x.y * x.y;
+        sxt += d * x.x;
+        syt += d * x.y;
+    }
+    let det = sxx * syy - sxy * sxy;
+    if det <= 1e-12 * (sxx + syy) * (sxx + syy) {
+        return None;
+    }
+    // J's columns: the uv change per unit along e1 and along e2.
+    let j1 = (sxt * syy - syt * sxy) / det;
+    let j2 = (syt * sxx - sxt * sxy) / det;
+    let x = plane(p) - mean_x;
+    let t = mean_t + j1 * x.x + j2 * x.y;
+    t.is_finite().then_some(t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fit_recovers_an_affine_chart_exactly() {
+        // A tilted plane whose uvs are an affine function of position.
+        let chart = |p: DVec3| DVec2::new(0.3 * p.x - 0.2 * p.y + 5.0, 0.1 * p.x + 0.7 * p.y - 1.0);
+        let tilt = |x: f64, y: f64| DVec3::new(x, y, 0.5 * x - 0.25 * y);
+        let pairs: Vec<(DVec3, DVec2)> =
+            [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.5), (-0.5, 0.7)]
+                .iter()
+                .map(|&(x, y)| (tilt(x, y), chart(tilt(x, y))))
+                .collect();
+        let normal = DVec3::new(-0.5, 0.25, 1.0);
+        let p = tilt(0.6, -0.4);
+        let t = uv_by_fit(p, normal, &pairs).unwrap();
+        assert!((t - chart(p)).length() < 1e-9, "{t} {}", chart(p));
+        // Too few corners, or corners on a line, fit nothing.
+        assert!(uv_by_fit(p, normal, &pairs[..3]).is_none());
+        let line: Vec<_> = (0..5)
+            .map(|i| (tilt(i as f64, 0.0), DVec2::splat(i as f64)))
+            .collect();
+        assert!(uv_by_fit(p, normal, &line).is_none());
+    }
+
+    #[test]
+    fn unfolding_follows_a_flat_chart() {
+        let chart = |p: DVec3| DVec2::new(2.0 * p.x + 1.0, -p.y);
+        let [a, b, c] = [DVec3::ZERO, DVec3::X, DVec3::new(0.3, 1.0, 0.0)];
+        let p = DVec3::new(0.6, -0.8, 0.0);
+        let t = uv_by_unfolding(p, [a, b, c], [a, b, c].map(chart)).unwrap();
+        assert!((t - chart(p)).length() < 1e-12);
+    }
+}
