@@ -495,6 +495,23 @@ fn info(input: &Path, json: bool) -> Result<()> {
             })
             .collect()
     };
+    // The appearance block and where its unit lies.
+    let appearance = header.appearance.as_ref().map(|spec| {
+        let entry = reader.index().appearance;
+        serde_json::json!({
+            "normal_bits": spec.normal_bits,
+            "uv_bits": spec.uv_grid.map(|g| g.bits),
+            "uv_origin": spec.uv_grid.map(|g| g.origin),
+            "uv_cell": spec.uv_grid.map(|g| g.cell),
+            "colours": spec.colours,
+            "materials": spec.materials.as_ref().map(|m| &m.names),
+            "material_library": spec.materials.as_ref().and_then(|m| m.library.as_ref()),
+            "unit_first_byte": entry.map(|u| payload_start + u.offset),
+            "unit_end_byte": entry.map(|u| payload_start + u.end()),
+            "unit_bytes": entry.map(|u| u.length),
+            "unit_present": reader.appearance_unit().is_some(),
+        })
+    });
     let sizes = &levels;
     let report = serde_json::json!({
         "file": input.display().to_string(),
@@ -514,6 +531,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "truncated": reader.truncated(),
         "levels": levels,
         "meta_nodes": meta_nodes,
+        "appearance": appearance,
     });
     if json {
         meshcodec::outln!("{}", serde_json::to_string_pretty(&report)?);
@@ -551,6 +569,45 @@ fn info(input: &Path, json: bool) -> Result<()> {
             ""
         }
     );
+    if let Some(spec) = &header.appearance {
+        let mut carried = Vec::new();
+        if let Some(bits) = spec.normal_bits {
+            carried.push(format!("normals (octahedral, {bits} bits a coordinate)"));
+        }
+        if let Some(g) = spec.uv_grid {
+            carried.push(format!(
+                "uvs ({} bits, origin {:?}, cell {})",
+                g.bits, g.origin, g.cell
+            ));
+        }
+        if spec.colours {
+            carried.push("colours (8 bits a channel)".into());
+        }
+        if let Some(m) = &spec.materials {
+            carried.push(format!(
+                "{} material(s) {:?}{}",
+                m.names.len(),
+                m.names,
+                m.library
+                    .as_ref()
+                    .map_or(String::new(), |l| format!(" from {l}"))
+            ));
+        }
+        let unit = reader.index().appearance.map_or(String::new(), |u| {
+            format!(
+                "; unit at bytes {}..{} ({} bytes{})",
+                payload_start + u.offset,
+                payload_start + u.end(),
+                u.length,
+                if reader.appearance_unit().is_some() {
+                    ""
+                } else {
+                    ", not present"
+                }
+            )
+        });
+        let _ = writeln!(text, "appearance: {}{unit}", carried.join(", "));
+    }
     let _ = writeln!(
         text,
         "{:>5} {:>10} {:>10} {:>10} {:>10}",
