@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import bisect
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import IO, Any, Dict, Iterator, List, Optional, Union
 
 import numpy as np
@@ -35,6 +35,7 @@ from ._core import FORMAT_VERSION, MeshcodecError, TruncatedStreamError
 
 __all__ = [
     "FORMAT_VERSION",
+    "Appearance",
     "Mesh",
     "canonical",
     "MeshcodecError",
@@ -54,9 +55,73 @@ Bytes = Union[bytes, bytearray, memoryview]
 PathLike = Union[str, "os.PathLike[str]"]
 
 # What `encode` accepts beyond the arrays, codec and quantization.
-_CODEC_OPTIONS = ("grid",)
-# Appearance arrays no codec of this build carries.
-_ATTRIBUTES = ("normals", "uvs", "colors", "colours", "materials")
+_CODEC_OPTIONS = ("grid", "uv_bits", "normal_bits")
+
+
+@dataclass
+class Appearance:
+    """A mesh's appearance in Hoppe's wedges: each face corner names a wedge, each wedge a vertex
+    and the attributes its corners share; a seam is several wedges at one vertex.
+
+    Attributes:
+        corners: uint32 array (m, 3): the wedge of each corner, face by face.
+        wedge_vertex: uint32 array (w,): the vertex of each wedge.
+        normals: float64 array (w, 3), or None.
+        uvs: float64 array (w, 2), or None.
+        colours: float64 array (w, 4), RGBA in [0, 1], or None.
+        face_material: uint32 array (m,): each face's index into ``material_names``, or None.
+        material_names: the materials' names.
+        material_library: the material library the file named (OBJ's ``mtllib``), or None.
+    """
+
+    corners: np.ndarray
+    wedge_vertex: np.ndarray
+    normals: Optional[np.ndarray] = None
+    uvs: Optional[np.ndarray] = None
+    colours: Optional[np.ndarray] = None
+    face_material: Optional[np.ndarray] = None
+    material_names: List[str] = field(default_factory=list)
+    material_library: Optional[str] = None
+
+    @property
+    def wedge_count(self) -> int:
+        return int(self.wedge_vertex.shape[0])
+
+    def _dict(self) -> Dict[str, Any]:
+        def floats(a: Optional[np.ndarray], cols: int, name: str) -> Optional[np.ndarray]:
+            if a is None:
+                return None
+            array = np.asarray(a)
+            if array.ndim != 2 or array.shape[1] != cols:
+                raise MeshcodecError(f"appearance {name} must be an (n, {cols}) array, not {array.shape}")
+            return np.ascontiguousarray(array, dtype=np.float64)
+
+        def uints(a: Any, name: str) -> np.ndarray:
+            array = np.asarray(a)
+            if array.dtype.kind not in "iu" or (array.size and array.min() < 0):
+                raise MeshcodecError(f"appearance {name} must be non-negative integers")
+            return np.ascontiguousarray(array, dtype=np.uint32)
+
+        return {
+            "corners": uints(self.corners, "corners"),
+            "wedge_vertex": uints(self.wedge_vertex, "wedge_vertex"),
+            "normals": floats(self.normals, 3, "normals"),
+            "uvs": floats(self.uvs, 2, "uvs"),
+            "colours": floats(self.colours, 4, "colours"),
+            "face_material": None if self.face_material is None else uints(self.face_material, "face_material"),
+            "material_names": list(self.material_names),
+            "material_library": self.material_library,
+        }
+
+    def __repr__(self) -> str:
+        held = [k for k in ("normals", "uvs", "colours") if getattr(self, k) is not None]
+        if self.face_material is not None:
+            held.append(f"{len(self.material_names)} material(s)")
+        return f"Appearance({self.wedge_count} wedges: {', '.join(held)})"
+
+
+def _appearance(d: Optional[Dict[str, Any]]) -> Optional[Appearance]:
+    return None if d is None else Appearance(**d)
 
 
 @dataclass
@@ -70,6 +135,9 @@ class Mesh:
             embedded coder's coarse levels may have edges before triangles); empty otherwise.
         level: the levels decoded (None for a mesh not decoded from a stream).
         levels: the levels the whole stream holds (None likewise).
+        appearance: normals, uvs, colours and materials (:class:`Appearance`), or None: as a
+            file holds them, or as a stream's full level decodes them (levels before the
+            appearance unit have none).
     """
 
     vertices: np.ndarray
@@ -77,6 +145,7 @@ class Mesh:
     loose_edges: Optional[np.ndarray] = None
     level: Optional[int] = None
     levels: Optional[int] = None
+    appearance: Optional[Appearance] = None
 
     def __post_init__(self) -> None:
         if self.loose_edges is None:
@@ -92,12 +161,18 @@ class Mesh:
 
     def __repr__(self) -> str:
         at = "" if self.level is None else f", level {self.level} of {self.levels}"
-        return f"Mesh({self.vertex_count} vertices, {self.face_count} faces{at})"
+        wedges = "" if self.appearance is None else f", {self.appearance.wedge_count} wedges"
+        return f"Mesh({self.vertex_count} vertices, {self.face_count} faces{wedges}{at})"
 
 
-def _mesh(arrays: Any, level: Optional[int] = None, levels: Optional[int] = None) -> Mesh:
+def _mesh(
+    arrays: Any,
+    level: Optional[int] = None,
+    levels: Optional[int] = None,
+    appearance: Optional[Dict[str, Any]] = None,
+) -> Mesh:
     vertices, faces, loose_edges = arrays
-    return Mesh(vertices, faces, loose_edges, level, levels)
+    return Mesh(vertices, faces, loose_edges, level, levels, _appearance(appearance))
 
 
 def _vertices(vertices: Any, name: str = "vertices") -> np.ndarray:
@@ -161,22 +236,19 @@ def encode(
             "came-paper", "raw").
         quant_bits: bits per axis of the quantization grid (1 to 24 as the codec allows).
         grid: "cubic" (one cell size on every axis, the default) or "per-axis".
-        drop_attributes: must be True to pass appearance arrays (normals=, uvs=, colors=,
-            materials=) the codec does not carry; they are then left out, never coded.
+        appearance: an :class:`Appearance` over these faces (e.g. ``load(path).appearance``),
+            coded in the stream's appearance unit and decoded with its full level; every
+            lossless codec carries it, ``came-paper`` refuses it.
+        uv_bits: bits per uv axis over the uvs' bounding box (default 12).
+        normal_bits: bits per octahedral normal coordinate (default 10).
 
     Raises:
         MeshcodecError: bad arrays, an unknown codec or option, a mesh the codec refuses
-            (``pm`` takes oriented manifolds only), or attributes it would drop.
+            (``pm`` takes oriented manifolds only), or appearance it cannot carry.
     """
-    drop = bool(codec_options.pop("drop_attributes", False))
-    given = [k for k in _ATTRIBUTES if codec_options.get(k) is not None]
-    for key in _ATTRIBUTES:
-        codec_options.pop(key, None)
-    if given and not drop:
-        raise MeshcodecError(
-            f"codec {codec} does not carry {', '.join(given)}; "
-            "pass drop_attributes=True to encode positions and faces only"
-        )
+    appearance = codec_options.pop("appearance", None)
+    if appearance is not None and not isinstance(appearance, Appearance):
+        raise MeshcodecError(f"appearance must be an Appearance, not {type(appearance).__name__}")
     unknown = sorted(set(codec_options) - set(_CODEC_OPTIONS))
     if unknown:
         raise MeshcodecError(
@@ -188,6 +260,9 @@ def encode(
         codec,
         _bits(quant_bits),
         codec_options.get("grid"),
+        None if appearance is None else appearance._dict(),
+        _bits(codec_options.get("uv_bits", 12)),
+        _bits(codec_options.get("normal_bits", 10)),
     )
 
 
@@ -215,8 +290,8 @@ def decode(stream: Bytes, level: Optional[int] = None, nbytes: Optional[int] = N
         raise MeshcodecError(f"level must be a count of levels, not {level!r}")
     if nbytes is not None and (isinstance(nbytes, bool) or nbytes < 0):
         raise MeshcodecError(f"nbytes must be a count of bytes, not {nbytes!r}")
-    arrays, decoded, total = _core.decode(_stream(stream), level, nbytes)
-    return _mesh(arrays, decoded, total)
+    arrays, appearance, decoded, total = _core.decode(_stream(stream), level, nbytes)
+    return _mesh(arrays, decoded, total, appearance)
 
 
 def levels(stream: Union[Bytes, IO[bytes]], chunk_size: int = 1 << 16) -> Iterator[Mesh]:
@@ -237,8 +312,8 @@ def levels(stream: Union[Bytes, IO[bytes]], chunk_size: int = 1 << 16) -> Iterat
 
 def _levels_of_bytes(stream: bytes) -> Iterator[Mesh]:
     it = _core.LevelIterator(stream)
-    for arrays, level in it:
-        yield _mesh(arrays, level, it.levels)
+    for arrays, appearance, level in it:
+        yield _mesh(arrays, level, it.levels, appearance)
 
 
 def _levels_arriving(source: IO[bytes], chunk_size: int) -> Iterator[Mesh]:
@@ -263,9 +338,9 @@ def _levels_arriving(source: IO[bytes], chunk_size: int) -> Iterator[Mesh]:
             # A decoder over what has arrived walks up to the last level it completes (the
             # levels before are decoded again: a decoder cannot follow a growing buffer).
             it = _core.LevelIterator(bytes(buffer))
-            for arrays, level in it:
+            for arrays, appearance, level in it:
                 if level > done:
-                    yield _mesh(arrays, level, it.levels)
+                    yield _mesh(arrays, level, it.levels, appearance)
                     done = level
                 if level >= ready:
                     break
@@ -287,20 +362,24 @@ def info(stream: Bytes) -> Dict[str, Any]:
 
 
 def load(path: PathLike, drop_attributes: bool = False) -> Mesh:
-    """Reads a mesh file (PLY, OBJ, OFF, .m, STL) as positions and faces.
+    """Reads a mesh file (PLY, OBJ, OFF, .m, STL, glTF) with its normals, texture coordinates,
+    colours and materials as :attr:`Mesh.appearance` (None when it has none).
 
-    A file that also holds normals, texture coordinates, colours or materials is refused,
-    naming them, unless ``drop_attributes=True``: meshcodec does not carry them yet, and
-    never drops them unasked.
+    ``drop_attributes=True`` reads positions and faces only. A file holding appearance its
+    reader cannot keep (OFF colours, ``.m`` normals) is refused, naming it, unless dropped.
     """
-    return _mesh(_core.load(os.fspath(path), bool(drop_attributes)))
+    arrays, appearance = _core.load(os.fspath(path), bool(drop_attributes))
+    return _mesh(arrays, appearance=appearance)
 
 
 def save(mesh: Union[Mesh, tuple], path: PathLike) -> None:
-    """Writes a mesh (a :class:`Mesh` or a (vertices, faces) pair) as binary PLY, OBJ or VRML
-    by the extension of ``path``; the file appears only when complete."""
+    """Writes a mesh (a :class:`Mesh` or a (vertices, faces) pair) by the extension of
+    ``path``: binary PLY, OBJ, glTF (``.glb``, ``.gltf``) with the mesh's appearance, or VRML
+    without; a format that cannot hold the appearance is refused. The file appears only when
+    complete."""
     vertices, faces = _arrays_of(mesh, "mesh")
-    _core.save(vertices, faces, os.fspath(path))
+    appearance = mesh.appearance if isinstance(mesh, Mesh) else None
+    _core.save(vertices, faces, os.fspath(path), None if appearance is None else appearance._dict())
 
 
 def distance(

@@ -10,12 +10,14 @@
 
 use meshcodec::codecs::{self, Capability, Codec, EncodeOptions, LevelDecoder, LevelMesh, Stop};
 use meshcodec::container::{StreamReader, FORMAT_VERSION};
+use meshcodec::mesh::attribute_quantization::AttributeBits;
+use meshcodec::mesh::attributes::{AttributedMesh, Attributes, Materials};
 use meshcodec::mesh::io;
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::TriMesh;
 use meshcodec::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyValueError};
 use pyo3::prelude::*;
@@ -166,6 +168,138 @@ fn shaped<T: numpy::Element>(
         .into_pyarray(py)
 }
 
+/// A mesh's appearance as a dict of numpy arrays (Hoppe's wedges): `corners` (m, 3) uint32
+/// wedge ids, `wedge_vertex` (w,) uint32, `normals` (w, 3), `uvs` (w, 2) and `colours` (w, 4)
+/// float64 or None, `face_material` (m,) uint32 or None, `material_names`, `material_library`.
+/// `None` for a mesh without appearance.
+fn appearance_dict(py: Python<'_>, a: Option<Attributes>) -> PyResult<Option<Bound<'_, PyDict>>> {
+    let Some(a) = a.filter(|a| !a.is_empty()) else {
+        return Ok(None);
+    };
+    let d = PyDict::new(py);
+    let m = a.corners.len();
+    let w = a.wedge_vertex.len();
+    d.set_item(
+        "corners",
+        shaped(
+            py,
+            m,
+            3,
+            bytemuck::allocation::cast_vec::<[u32; 3], u32>(a.corners),
+        ),
+    )?;
+    d.set_item("wedge_vertex", a.wedge_vertex.into_pyarray(py))?;
+    let flat3 = |v: Vec<glam::DVec3>| {
+        v.into_iter()
+            .flat_map(|x| x.to_array())
+            .collect::<Vec<f64>>()
+    };
+    let flat2 = |v: Vec<glam::DVec2>| {
+        v.into_iter()
+            .flat_map(|x| x.to_array())
+            .collect::<Vec<f64>>()
+    };
+    d.set_item("normals", a.normals.map(|n| shaped(py, w, 3, flat3(n))))?;
+    d.set_item("uvs", a.uvs.map(|t| shaped(py, w, 2, flat2(t))))?;
+    d.set_item(
+        "colours",
+        a.colours
+            .map(|c| shaped(py, w, 4, c.into_iter().flatten().collect())),
+    )?;
+    match a.materials {
+        Some(materials) => {
+            d.set_item("face_material", materials.face.into_pyarray(py))?;
+            d.set_item("material_names", materials.names)?;
+            d.set_item("material_library", materials.library)?;
+        }
+        None => {
+            d.set_item("face_material", py.None())?;
+            d.set_item("material_names", Vec::<String>::new())?;
+            d.set_item("material_library", py.None())?;
+        }
+    }
+    Ok(Some(d))
+}
+
+/// An (n, cols) float64 array of a dict entry as rows, `None` when absent or None.
+fn rows<const N: usize>(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Option<Vec<[f64; N]>>> {
+    let Some(item) = d.get_item(key)?.filter(|i| !i.is_none()) else {
+        return Ok(None);
+    };
+    let array: PyReadonlyArray2<f64> = item.extract().map_err(|_| {
+        refuse(format!(
+            "appearance['{key}'] must be a float64 (n, {N}) array"
+        ))
+    })?;
+    let view = array.as_array();
+    if view.ncols() != N {
+        return Err(refuse(format!(
+            "appearance['{key}'] must be an (n, {N}) array, not {:?}",
+            view.shape()
+        )));
+    }
+    Ok(Some(
+        view.rows()
+            .into_iter()
+            .map(|r| std::array::from_fn(|k| r[k]))
+            .collect(),
+    ))
+}
+
+/// A dict of [`appearance_dict`]'s shape as the library's wedges, checked against `mesh`.
+fn attributes_of(d: &Bound<'_, PyDict>, mesh: &TriMesh) -> PyResult<Attributes> {
+    let uint = |key: &str| -> PyResult<Vec<u32>> {
+        let item = d
+            .get_item(key)?
+            .ok_or_else(|| refuse(format!("appearance has no '{key}'")))?;
+        let array: PyReadonlyArray1<u32> = item
+            .extract()
+            .map_err(|_| refuse(format!("appearance['{key}'] must be a uint32 (n,) array")))?;
+        Ok(array.as_array().to_vec())
+    };
+    let corners_item = d
+        .get_item("corners")?
+        .ok_or_else(|| refuse("appearance has no 'corners'"))?;
+    let corners: PyReadonlyArray2<u32> = corners_item
+        .extract()
+        .map_err(|_| refuse("appearance['corners'] must be a uint32 (m, 3) array"))?;
+    let view = corners.as_array();
+    if view.ncols() != 3 {
+        return Err(refuse("appearance['corners'] must be an (m, 3) array"));
+    }
+    let corners: Vec<[u32; 3]> = view
+        .rows()
+        .into_iter()
+        .map(|r| [r[0], r[1], r[2]])
+        .collect();
+    let materials = match d.get_item("face_material")?.filter(|i| !i.is_none()) {
+        None => None,
+        Some(_) => Some(Materials {
+            face: uint("face_material")?,
+            names: d
+                .get_item("material_names")?
+                .map(|n| n.extract())
+                .transpose()?
+                .unwrap_or_default(),
+            library: d
+                .get_item("material_library")?
+                .filter(|l| !l.is_none())
+                .map(|l| l.extract())
+                .transpose()?,
+        }),
+    };
+    let attributes = Attributes {
+        corners,
+        wedge_vertex: uint("wedge_vertex")?,
+        normals: rows::<3>(d, "normals")?.map(|n| n.into_iter().map(glam::DVec3::from).collect()),
+        uvs: rows::<2>(d, "uvs")?.map(|t| t.into_iter().map(glam::DVec2::from).collect()),
+        colours: rows::<4>(d, "colours")?,
+        materials,
+    };
+    attributes.validate(mesh).map_err(to_py)?;
+    Ok(attributes)
+}
+
 fn codec(name: &str) -> PyResult<&'static dyn Codec> {
     codecs::by_name(name).map_err(to_py)
 }
@@ -180,9 +314,11 @@ fn grid_shape(grid: Option<&str>, default: GridShape) -> PyResult<GridShape> {
     }
 }
 
-/// Encodes a mesh; returns the stream.
+/// Encodes a mesh, with its appearance when given (uvs on `uv_bits`, normals octahedral on
+/// `normal_bits`); returns the stream.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, codec_name, quant_bits, grid=None))]
+#[pyo3(signature = (vertices, faces, codec_name, quant_bits, grid=None, appearance=None, uv_bits=12, normal_bits=10))]
+#[allow(clippy::too_many_arguments)]
 fn encode<'py>(
     py: Python<'py>,
     vertices: PyReadonlyArray2<'py, f64>,
@@ -190,6 +326,9 @@ fn encode<'py>(
     codec_name: &str,
     quant_bits: u8,
     grid: Option<&str>,
+    appearance: Option<Bound<'py, PyDict>>,
+    uv_bits: u8,
+    normal_bits: u8,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let codec = codec(codec_name)?;
     let options = EncodeOptions {
@@ -197,10 +336,28 @@ fn encode<'py>(
         grid: grid_shape(grid, codec.default_options().grid)?,
     };
     let mesh = mesh_of(&vertices, &faces)?;
+    let attributes = appearance
+        .as_ref()
+        .map(|d| attributes_of(d, &mesh))
+        .transpose()?
+        .filter(|a| !a.is_empty());
+    let bits = AttributeBits {
+        uv: uv_bits,
+        normal: normal_bits,
+    };
     let bytes = py
-        .detach(|| {
-            let canonical = codecs::canonical_for(&mesh, &options)?;
-            codec.encode(&canonical).map(|e| e.bytes)
+        .detach(|| match attributes {
+            None => {
+                let canonical = codecs::canonical_for(&mesh, &options)?;
+                codec.encode(&canonical).map(|e| e.bytes)
+            }
+            Some(attributes) => {
+                bits.check()?;
+                let attributed = AttributedMesh { mesh, attributes };
+                let (canonical, appearance) =
+                    codecs::canonical_attributed_for(&attributed, &options, bits)?;
+                codecs::encode_attributed(codec, &canonical, Some(&appearance)).map(|e| e.bytes)
+            }
         })
         .map_err(to_py)?;
     Ok(PyBytes::new(py, &bytes))
@@ -236,7 +393,7 @@ fn canonical<'py>(
 }
 
 /// Decodes a stream (or its first `nbytes`) up to `level` levels (all present when `None`);
-/// returns the arrays, the levels decoded and the levels the whole stream holds.
+/// returns the arrays, the appearance, the levels decoded and the levels the whole stream holds.
 #[pyfunction]
 #[pyo3(signature = (stream, level=None, nbytes=None))]
 fn decode<'py>(
@@ -244,7 +401,7 @@ fn decode<'py>(
     stream: &[u8],
     level: Option<usize>,
     nbytes: Option<usize>,
-) -> PyResult<(MeshArrays<'py>, usize, usize)> {
+) -> PyResult<DecodedLevel<'py>> {
     let bytes = &stream[..nbytes.unwrap_or(stream.len()).min(stream.len())];
     let stop = level.map_or(Stop::All, Stop::Levels);
     let (mesh, decoded, total) = py
@@ -255,8 +412,13 @@ fn decode<'py>(
             Ok::<_, meshcodec::Error>((mesh, decoded, total))
         })
         .map_err(to_py)?;
-    Ok((arrays(py, mesh), decoded, total))
+    let appearance = appearance_dict(py, mesh.attributes.clone())?;
+    Ok((arrays(py, mesh), appearance, decoded, total))
 }
+
+/// A decoded level: its arrays, its appearance (at the full level of a stream with an
+/// appearance unit), the levels decoded and the levels the stream holds.
+type DecodedLevel<'py> = (MeshArrays<'py>, Option<Bound<'py, PyDict>>, usize, usize);
 
 type Decoder<'a> = Box<dyn LevelDecoder + 'a>;
 
@@ -300,7 +462,11 @@ impl LevelIterator {
         slf
     }
 
-    fn __next__<'py>(&self, py: Python<'py>) -> PyResult<Option<(MeshArrays<'py>, usize)>> {
+    #[allow(clippy::type_complexity)]
+    fn __next__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<Option<(MeshArrays<'py>, Option<Bound<'py, PyDict>>, usize)>> {
         let next = py
             .detach(|| {
                 let mut decoder = self.decoder.lock().unwrap_or_else(|e| e.into_inner());
@@ -312,7 +478,13 @@ impl LevelIterator {
                 })
             })
             .map_err(to_py)?;
-        Ok(next.map(|(mesh, level)| (arrays(py, mesh), level)))
+        match next {
+            None => Ok(None),
+            Some((mesh, level)) => {
+                let appearance = appearance_dict(py, mesh.attributes.clone())?;
+                Ok(Some((arrays(py, mesh), appearance, level)))
+            }
+        }
     }
 }
 
@@ -343,7 +515,7 @@ fn info<'py>(py: Python<'py>, stream: &[u8]) -> PyResult<Bound<'py, PyDict>> {
     }
     let d = PyDict::new(py);
     d.set_item("codec", codec.name())?;
-    d.set_item("format_version", FORMAT_VERSION)?;
+    d.set_item("format_version", header.version())?;
     d.set_item("bytes", stream.len())?;
     d.set_item("stream_bytes", start + index.payload_bytes)?;
     d.set_item("truncated", reader.truncated())?;
@@ -375,42 +547,63 @@ fn about_file(e: meshcodec::Error, path: &std::path::Path) -> PyErr {
     }
 }
 
-/// Reads a mesh file (PLY, OBJ, OFF, .m, STL); refuses one holding normals, texture
-/// coordinates, colours or materials unless `drop_attributes`.
+/// Reads a mesh file (PLY, OBJ, OFF, .m, STL, glTF) with its appearance; with
+/// `drop_attributes`, positions and faces only.
 #[pyfunction]
 #[pyo3(signature = (path, drop_attributes=false))]
-fn load(py: Python<'_>, path: PathBuf, drop_attributes: bool) -> PyResult<MeshArrays<'_>> {
-    let (mesh, appearance) = py
-        .detach(|| io::read_mesh_and_appearance(&path))
+#[allow(clippy::type_complexity)]
+fn load(
+    py: Python<'_>,
+    path: PathBuf,
+    drop_attributes: bool,
+) -> PyResult<(MeshArrays<'_>, Option<Bound<'_, PyDict>>)> {
+    let read = py
+        .detach(|| {
+            if drop_attributes {
+                io::read_mesh(&path).map(|mesh| AttributedMesh {
+                    mesh,
+                    attributes: Attributes::default(),
+                })
+            } else {
+                io::read_attributed(&path)
+            }
+        })
         .map_err(|e| about_file(e, &path))?;
-    if !appearance.is_empty() && !drop_attributes {
-        return Err(refuse(format!(
-            "{}: holds {appearance}, which meshcodec does not carry; \
-             load(..., drop_attributes=True) reads positions and faces only",
-            path.display()
-        )));
-    }
-    Ok(arrays(
-        py,
-        LevelMesh {
-            mesh,
-            loose_edges: Vec::new(),
-            attributes: None,
-        },
+    let appearance = appearance_dict(py, Some(read.attributes))?;
+    Ok((
+        arrays(
+            py,
+            LevelMesh {
+                mesh: read.mesh,
+                loose_edges: Vec::new(),
+                attributes: None,
+            },
+        ),
+        appearance,
     ))
 }
 
-/// Writes a mesh as PLY, OBJ or VRML by the path's extension.
+/// Writes a mesh, with its appearance when given, by the path's extension (PLY, OBJ, glTF;
+/// VRML without appearance); a format that cannot hold the appearance is refused.
 #[pyfunction]
+#[pyo3(signature = (vertices, faces, path, appearance=None))]
 fn save<'py>(
     py: Python<'py>,
     vertices: PyReadonlyArray2<'py, f64>,
     faces: PyReadonlyArray2<'py, i64>,
     path: PathBuf,
+    appearance: Option<Bound<'py, PyDict>>,
 ) -> PyResult<()> {
     let mesh = mesh_of(&vertices, &faces)?;
-    py.detach(|| io::write_mesh(&mesh, &path))
-        .map_err(|e| about_file(e, &path))
+    let attributes = appearance
+        .as_ref()
+        .map(|d| attributes_of(d, &mesh))
+        .transpose()?;
+    py.detach(|| match attributes {
+        None => io::write_mesh(&mesh, &path),
+        Some(attributes) => io::write_attributed(&AttributedMesh { mesh, attributes }, &path),
+    })
+    .map_err(|e| about_file(e, &path))
 }
 
 /// Distances both ways between mesh `a` (the reference) and mesh `b` — a decoded level, which

@@ -170,7 +170,7 @@ def test_info_reads_the_header_and_index():
     stream = meshcodec.encode(mesh.vertices, mesh.faces, codec="came", quant_bits=14)
     about = meshcodec.info(stream)
     assert about["codec"] == "came" and about["quant_bits"] == 14
-    assert about["format_version"] == meshcodec.FORMAT_VERSION
+    assert about["format_version"] == 2  # geometry alone; a stream with appearance is FORMAT_VERSION
     assert about["bytes"] == about["stream_bytes"] == len(stream)
     assert not about["layered"] and not about["truncated"]
     units = about["units"]
@@ -196,14 +196,40 @@ def test_load_and_save_round_trip(tmp_path):
     assert meshcodec.load(tmp_path / "lists.ply").face_count == mesh.face_count
 
 
-def test_load_refuses_appearance_unless_told_to_drop_it():
-    with pytest.raises(meshcodec.MeshcodecError, match="texture coordinates"):
-        meshcodec.load(MESHES / "bunny-10k-textured.obj")
-    assert meshcodec.load(MESHES / "bunny-10k-textured.obj", drop_attributes=True).face_count > 0
-    v, f = np.eye(3), np.array([[0, 1, 2]])
-    with pytest.raises(ValueError, match="drop_attributes"):
-        meshcodec.encode(v, f, uvs=np.zeros((3, 2)))
-    assert meshcodec.encode(v, f, uvs=np.zeros((3, 2)), drop_attributes=True)
+def test_appearance_is_loaded_coded_decoded_and_saved(tmp_path):
+    mesh = meshcodec.load(MESHES / "bunny-10k-textured.obj")
+    a = mesh.appearance
+    assert a is not None and a.wedge_count == 6451 and a.uvs.shape == (6451, 2)
+    assert a.corners.shape == (mesh.face_count, 3) and a.material_names == ["01_-_Default"]
+    assert meshcodec.load(MESHES / "bunny-10k-textured.obj", drop_attributes=True).appearance is None
+    stream = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc", appearance=a)
+    assert meshcodec.info(stream)["format_version"] == meshcodec.FORMAT_VERSION
+    plain = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc")
+    assert len(plain) < len(stream) and meshcodec.info(plain)["format_version"] == 2
+    levels = list(meshcodec.levels(stream))
+    assert all(l.appearance is None for l in levels[:-1])
+    full = meshcodec.decode(stream)
+    assert full.appearance is not None and full.appearance.wedge_count == 6451
+    # Each decoded corner's uv is the original's to within half a cell of the 12-bit grid.
+    span = (a.uvs.max(0) - a.uvs.min(0)).max()
+    decoded_corner_uvs = full.appearance.uvs[full.appearance.corners]
+    assert decoded_corner_uvs.shape == (full.face_count, 3, 2)
+    assert np.all(decoded_corner_uvs >= a.uvs.min(0) - span / 4096)
+    # Written as glTF and read back: the same wedges.
+    meshcodec.save(full, tmp_path / "bunny.glb")
+    again = meshcodec.load(tmp_path / "bunny.glb")
+    assert again.appearance.wedge_count == 6451
+    assert np.allclose(again.appearance.uvs[again.appearance.corners],
+                       decoded_corner_uvs, atol=1e-6)
+    # came-paper's full level is lossy: it refuses appearance.
+    with pytest.raises(meshcodec.MeshcodecError, match="cannot carry"):
+        meshcodec.encode(mesh.vertices, mesh.faces, codec="came-paper", appearance=a)
+    with pytest.raises(meshcodec.MeshcodecError, match="Appearance"):
+        meshcodec.encode(mesh.vertices, mesh.faces, appearance={"uvs": a.uvs})
+    # Wedges that do not fit the faces are refused in one line.
+    bad = meshcodec.Appearance(a.corners[:-1], a.wedge_vertex, uvs=a.uvs)
+    with pytest.raises(meshcodec.MeshcodecError):
+        meshcodec.encode(mesh.vertices, mesh.faces, appearance=bad)
 
 
 def test_distance_is_zero_to_itself_and_grows_as_levels_coarsen():
