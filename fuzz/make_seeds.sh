@@ -38,6 +38,10 @@ with open('read_ply/torus-ascii.ply', 'wb') as f:
     f.write(ply_header('ascii', 'property uchar red\n'))
     for p in pts: f.write(b'%f %f %f 200\n' % p)
     for t in tris: f.write(b'3 %d %d %d\n' % t)
+with open('read_ply/torus-colours.ply', 'wb') as f:
+    f.write(ply_header('ascii', 'property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n'))
+    for k, p in enumerate(pts): f.write(b'%f %f %f %d %d %d 255\n' % (p + (k * 6 % 256, 128 + k % 64, 200 - k)))
+    for t in tris: f.write(b'3 %d %d %d\n' % t)
 for name, end in (('le', '<'), ('be', '>')):
     with open('read_ply/torus-binary-%s.ply' % name, 'wb') as f:
         f.write(ply_header('binary_little_endian' if end == '<' else 'binary_big_endian'))
@@ -136,7 +140,7 @@ done
 # materials or colours), with the magic and version cut off: decode_appearance's input.
 mkdir -p $seeds/decode_appearance
 for codec in raw emc pm came; do
-  for mesh in $seeds/read_obj/torus.obj $seeds/read_gltf/torus.glb $seeds/read_ply/torus-ascii.ply; do
+  for mesh in $seeds/read_obj/torus.obj $seeds/read_gltf/torus.glb $seeds/read_ply/torus-colours.ply; do
     name=$(basename "$mesh"); name=${name%.*}-${mesh##*.}
     if target/release/meshcodec encode --codec "$codec" --quant 10 --uv-bits 8 --normal-bits 6 "$mesh" "$stream" >/dev/null 2>&1; then
       tail -c +6 "$stream" > "$seeds/decode_appearance/$codec-$name.body"

@@ -29,7 +29,7 @@ use std::io::Read as _;
 pub const MAGIC: [u8; 4] = *b"MshC";
 /// Version of the stream syntax: bumped on every change to the bytes any codec writes
 /// (docs/FORMAT.md, "History"). Versions 3 and 4 are version 2 with an appearance block after
-/// the header and an appearance unit after the last (4 predicts uvs better, so version 3's
+/// the header and an appearance unit after the last (4 predicts uvs and colours better, so version 3's
 /// units no longer decode); a stream without appearance is written in version 2, which this
 /// build also reads.
 pub const FORMAT_VERSION: u8 = 4;

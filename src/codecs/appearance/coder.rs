@@ -110,7 +110,8 @@ struct Contexts {
     uv: [[[IntContext; 2]; UV_SCALES]; 4],
     /// [first wedge at its vertex][axis]
     normal: [[IntContext; 2]; 2],
-    colour: [IntContext; 4],
+    /// [spread of the known corners' colours][channel]
+    colour: [[IntContext; 4]; 5],
 }
 
 /// Runs the unit's syntax over `mesh` (the decoded full level), coding `truth` when given.
@@ -423,15 +424,36 @@ pub fn run(
                 previous_uv = t;
             }
             if spec.colours {
-                let predicted = others
+                let known_colours: Vec<[u8; 4]> = others
                     .iter()
-                    .find_map(|&j| known_code(j).and_then(|c| c.colour))
-                    .unwrap_or(previous_colour);
+                    .filter_map(|&j| known_code(j).and_then(|c| c.colour))
+                    .collect();
+                // The mean of the face's known corners; the spread between them picks the
+                // contexts (a smooth region predicts well, an edge in the colours does not).
+                let (predicted, spread): ([u8; 4], u32) = match known_colours[..] {
+                    [a, b] => (
+                        std::array::from_fn(|i| ((a[i] as u16 + b[i] as u16 + 1) / 2) as u8),
+                        a.iter()
+                            .zip(b)
+                            .map(|(x, y)| x.abs_diff(y) as u32)
+                            .max()
+                            .unwrap_or(0),
+                    ),
+                    [a] => (a, 256),
+                    _ => (previous_colour, 256),
+                };
+                let spread_context = match spread {
+                    0 => 0,
+                    1..=3 => 1,
+                    4..=15 => 2,
+                    16..=255 => 3,
+                    _ => 4,
+                };
                 let value = truth_code.colour.unwrap_or_default();
                 let mut rgba = [0u8; 4];
                 for channel in 0..4 {
                     let d = symbols.int(
-                        &mut c.colour[channel],
+                        &mut c.colour[spread_context][channel],
                         value[channel].wrapping_sub(predicted[channel]) as i8 as i64,
                         "colour",
                     )?;
