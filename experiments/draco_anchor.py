@@ -15,33 +15,13 @@ import argparse
 import json
 import subprocess
 import tempfile
-import time
 from pathlib import Path
 
 import DracoPy
 import numpy as np
 import open3d as o3d
 
-ROOT = Path(__file__).resolve().parent.parent
-BIN = ROOT / "target" / "release" / "meshcodec"
-MESHES = ROOT.parent / "shared" / "meshes"
-
-
-def resolve(name):
-    for ext in ("ply", "obj", "off", "m", "stl"):
-        path = MESHES / f"{name}.{ext}"
-        if path.is_file():
-            return path
-    raise SystemExit(f"unknown mesh {name}")
-
-
-def canonical_counts(path, quant, tmp):
-    stream = tmp / "raw.mc"
-    subprocess.run([str(BIN), "encode", "--codec", "raw", "--quant", str(quant), "--drop-attributes", str(path), str(stream)],
-                   check=True, capture_output=True)
-    info = json.loads(subprocess.run([str(BIN), "info", str(stream), "--json"], check=True,
-                                     capture_output=True, text=True).stdout)
-    return info["vertices"], info["triangles"]
+from anchor_common import BIN, ROOT, best_of, canonical_counts, resolve
 
 
 def write_ply(path, points, faces):
@@ -55,15 +35,6 @@ def write_ply(path, points, faces):
     tri[:, 1:] = np.asarray(faces, dtype="<i4").view(np.uint8).reshape(len(faces), 12)
     body += tri.tobytes()
     path.write_bytes(header.encode() + bytes(body))
-
-
-def best_of(fn, runs=5):
-    best, out = float("inf"), None
-    for _ in range(runs):
-        start = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, out
 
 
 def main():

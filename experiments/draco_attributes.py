@@ -19,39 +19,17 @@ Run (after the release build, with the venv of experiments/requirements.txt):
 import argparse
 import json
 import struct
-import subprocess
 import tempfile
-import time
 from pathlib import Path
 
 import DracoPy
 import numpy as np
 
-ROOT = Path(__file__).resolve().parent.parent
-BIN = ROOT / "target" / "release" / "meshcodec"
-MESHES = ROOT.parent / "shared" / "meshes"
+from anchor_common import ROOT, best_of, canonical_counts, meshcodec, resolve
+
 
 COMPONENT = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
 WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
-
-
-def resolve(name):
-    for ext in ("ply", "obj", "off", "m", "stl", "glb", "gltf"):
-        path = MESHES / f"{name}.{ext}"
-        if path.is_file():
-            return path
-    raise SystemExit(f"unknown mesh {name}")
-
-
-def run(*args):
-    return subprocess.run([str(BIN), *map(str, args)], check=True, capture_output=True, text=True).stdout
-
-
-def canonical_counts(path, quant, tmp):
-    stream = tmp / "raw.mc"
-    run("encode", "--codec", "raw", "--quant", quant, "--drop-attributes", path, stream)
-    info = json.loads(run("info", stream, "--json"))
-    return info["vertices"], info["triangles"]
 
 
 def read_glb(path):
@@ -124,15 +102,6 @@ def write_ply(path, points, faces, normals, uvs, colours):
     path.write_bytes(header.encode() + rows.tobytes() + tri.tobytes())
 
 
-def best_of(fn, runs=5):
-    best, out = float("inf"), None
-    for _ in range(runs):
-        start = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - start)
-    return best, out
-
-
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("meshes", nargs="+")
@@ -149,7 +118,7 @@ def main():
         with tempfile.TemporaryDirectory() as tmp:
             tmp = Path(tmp)
             vertices, triangles = canonical_counts(path, args.quant, tmp)
-            run("convert", path, tmp / "split.glb")
+            meshcodec("convert", path, tmp / "split.glb")
             arrays, faces = read_glb(tmp / "split.glb")
             points = arrays["POSITION"].astype(np.float32)
             normals, uvs, colours = arrays["NORMAL"], arrays["TEXCOORD_0"], arrays["COLOR_0"]
@@ -183,7 +152,7 @@ def main():
             write_ply(tmp / "decoded.ply", decoded_points, decoded_faces,
                       get(decoded.normals if normals is not None else None, 3),
                       get(decoded.tex_coord if uvs is not None else None, 2), decoded_colours)
-            report = json.loads(run("distance", path, tmp / "decoded.ply", "--samples", args.samples, "--json"))
+            report = json.loads(meshcodec("distance", path, tmp / "decoded.ply", "--samples", args.samples, "--json"))
         bits = len(whole) * 8
         result = {
             "codec": "draco", "mesh": name, "source": str(path),

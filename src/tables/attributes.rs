@@ -236,12 +236,7 @@ pub fn attributes_checker(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             let picture = render_textured(m, &uvs, &frame, view, PANEL, PANEL);
             let (x0, y0) = (col as u32 * PANEL, row as u32 * (PANEL + CAPTION));
             super::draw_panel(&root, &picture.pixels, PANEL, (x0, y0))?;
-            root.draw_text(
-                &caption,
-                &("sans-serif", 20).into_font().color(&BLACK),
-                (x0 as i32 + 12, (y0 + PANEL + 2) as i32),
-            )
-            .map_err(|e| fail(&e))?;
+            super::draw_caption(&root, &caption, 20, (x0 + 12, y0 + PANEL + 2))?;
         }
     }
     root.present().map_err(|e| fail(&e))?;

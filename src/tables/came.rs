@@ -399,12 +399,7 @@ pub fn fig4(results: &Path, out: &Path) -> Result<PathBuf> {
         if let Some(error) = error {
             draw_panel(&root, error, PANEL, (x0, TITLE + PANEL + CAPTION))?;
         }
-        root.draw_text(
-            caption,
-            &("sans-serif", 17).into_font().color(&BLACK),
-            (x0 as i32 + 8, (TITLE + PANEL + 4) as i32),
-        )
-        .map_err(|e| fail(&e))?;
+        super::draw_caption(&root, caption, 17, (x0 + 8, TITLE + PANEL + 4))?;
     }
     root.present().map_err(|e| fail(&e))?;
     drop(root);

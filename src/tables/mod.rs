@@ -270,17 +270,27 @@ pub fn emc_fig5(results: &Path, out: &Path) -> Result<PathBuf> {
             draw_panel(&root, &picture.pixels, PANEL, (x0, y0))?;
             let bytes = result.levels[level - 1].bits / 8;
             let caption = format!("EMC level {level}: {bytes} bytes");
-            root.draw_text(
-                &caption,
-                &("sans-serif", 20).into_font().color(&BLACK),
-                (x0 as i32 + 12, (y0 + PANEL + 2) as i32),
-            )
-            .map_err(|e| fail(&e))?;
+            draw_caption(&root, &caption, 20, (x0 + 12, y0 + PANEL + 2))?;
         }
     }
     root.present().map_err(|e| fail(&e))?;
     drop(root);
     Ok(path)
+}
+
+/// Draws `text` in black at `origin` (its top left), `size` pixels high.
+fn draw_caption<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    text: &str,
+    size: u32,
+    (x, y): (u32, u32),
+) -> Result<()> {
+    root.draw_text(
+        text,
+        &("sans-serif", size).into_font().color(&BLACK),
+        (x as i32, y as i32),
+    )
+    .map_err(|e| Error::Io(std::io::Error::other(format!("plot: {e}"))))
 }
 
 /// Draws a rendered panel of `width`-pixel rows at `origin`, its white background left out.

@@ -432,7 +432,7 @@ pub fn run(
                 // contexts (a smooth region predicts well, an edge in the colours does not).
                 let (predicted, spread): ([u8; 4], u32) = match known_colours[..] {
                     [a, b] => (
-                        std::array::from_fn(|i| ((a[i] as u16 + b[i] as u16 + 1) / 2) as u8),
+                        std::array::from_fn(|i| (a[i] as u16 + b[i] as u16).div_ceil(2) as u8),
                         a.iter()
                             .zip(b)
                             .map(|(x, y)| x.abs_diff(y) as u32)

@@ -384,6 +384,23 @@ pub fn write_attributed(m: &AttributedMesh, binary: bool) -> Result<Vec<u8>> {
         .iter()
         .map(|&v| mesh.positions[v as usize])
         .collect();
+    // glTF stores 32-bit floats: a value beyond their range would become infinite.
+    let beyond_f32 = |what: &str, values: &mut dyn Iterator<Item = f64>| -> Result<()> {
+        let mut outside = values.filter(|x| !(*x as f32).is_finite());
+        match outside.next() {
+            Some(x) => Err(Error::Unsupported(format!(
+                "glTF holds 32-bit floats; a {what} coordinate {x:e} is beyond their range"
+            ))),
+            None => Ok(()),
+        }
+    };
+    beyond_f32("position", &mut points.iter().flat_map(|p| p.to_array()))?;
+    if let Some(normals) = &a.normals {
+        beyond_f32("normal", &mut normals.iter().flat_map(|n| n.to_array()))?;
+    }
+    if let Some(uvs) = &a.uvs {
+        beyond_f32("texture", &mut uvs.iter().flat_map(|t| t.to_array()))?;
+    }
     let (mut min, mut max) = (vec![f64::INFINITY; 3], vec![f64::NEG_INFINITY; 3]);
     for p in &points {
         for (axis, x) in p.to_array().into_iter().enumerate() {
