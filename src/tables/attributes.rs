@@ -202,12 +202,13 @@ pub fn attributes_checker(results_dir: &Path, out: &Path) -> Result<PathBuf> {
     let root = BitMapBackend::new(&path, (width, height)).into_drawing_area();
     let fail = |e: &dyn std::fmt::Display| Error::Io(std::io::Error::other(format!("plot: {e}")));
     root.fill(&WHITE).map_err(|e| fail(&e))?;
-    let view = View {
-        up: 1,
-        yaw: 30.0,
-        pitch: 20.0,
-    };
     for (row, mesh) in CHECKER_MESHES.iter().enumerate() {
+        // Spot looks along −z: turn it to face the camera.
+        let view = View {
+            up: 1,
+            yaw: if *mesh == "spot" { 210.0 } else { 30.0 },
+            pitch: 20.0,
+        };
         let stem = format!("{mesh}{APPEARANCE_SUFFIX}");
         let result_path = results::path(results_dir, "emc", &stem, ".json");
         let result = read_result(&result_path).map_err(|e| missing(&result_path, e))?;
