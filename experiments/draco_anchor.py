@@ -13,7 +13,6 @@ Run (after tests/run.sh has made the venv and the release build):
 
 import argparse
 import json
-import subprocess
 import tempfile
 from pathlib import Path
 
@@ -21,7 +20,7 @@ import DracoPy
 import numpy as np
 import open3d as o3d
 
-from anchor_common import BIN, ROOT, best_of, canonical_counts, resolve
+from anchor_common import ROOT, best_of, canonical_counts, distance_report, resolve, single_rate_result
 
 
 def write_ply(path, points, faces):
@@ -66,25 +65,14 @@ def main():
                 decoded_path = tmp / "decoded.ply"
                 write_ply(decoded_path, np.asarray(decoded.points, dtype=np.float64),
                           np.asarray(decoded.faces, dtype=np.int64).reshape(-1, 3))
-                report = json.loads(subprocess.run(
-                    [str(BIN), "distance", str(path), str(decoded_path), "--samples", str(args.samples), "--json"],
-                    check=True, capture_output=True, text=True).stdout)
+                report = distance_report(path, decoded_path, args.samples)
             bits = len(data) * 8
-            result = {
-                "codec": "draco", "mesh": name, "source": str(path),
-                "vertices": vertices, "triangles": triangles, "quant_bits": q, "bytes": len(data),
-                "encode_seconds": enc_s, "decode_seconds": dec_s, "lossless": False,
-                "lossless_error": "Draco is single-rate and quantizes on its own grid; not checked against docs/CONTRACT.md §3",
-                "draco": {"compression_level": 10, "quantization_bits": q, "version": getattr(DracoPy, "__version__", "")},
-                "levels": [{
-                    "level": 1, "bits": bits, "connectivity_bits": 0, "geometry_bits": 0,
-                    "vertices": len(np.asarray(decoded.points).reshape(-1, 3)),
-                    "triangles": len(np.asarray(decoded.faces).reshape(-1, 3)),
-                    "bits_per_vertex": bits / vertices, "bits_per_triangle": bits / triangles,
-                    "hausdorff": report["hausdorff_relative"], "rms": report["rms_relative"],
-                    "hausdorff_paper": report["hausdorff_paper"] / report["diagonal"],
-                }],
-            }
+            result = single_rate_result(
+                name, path, (vertices, triangles), q, data, (enc_s, dec_s),
+                (len(np.asarray(decoded.points).reshape(-1, 3)), len(np.asarray(decoded.faces).reshape(-1, 3))),
+                report,
+                "Draco is single-rate and quantizes on its own grid; not checked against docs/CONTRACT.md §3",
+                {"compression_level": 10, "quantization_bits": q, "version": getattr(DracoPy, "__version__", "")})
             target = out / f"{name}-q{q}.json"
             target.write_text(json.dumps(result, indent=2) + "\n")
             print(f"draco {name} q{q}: {len(data)} bytes = {bits / vertices:.2f} bits/vertex, "

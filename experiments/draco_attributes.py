@@ -25,7 +25,7 @@ from pathlib import Path
 import DracoPy
 import numpy as np
 
-from anchor_common import ROOT, best_of, canonical_counts, meshcodec, resolve
+from anchor_common import ROOT, best_of, canonical_counts, distance_report, meshcodec, resolve, single_rate_result
 
 
 COMPONENT = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
@@ -152,28 +152,18 @@ def main():
             write_ply(tmp / "decoded.ply", decoded_points, decoded_faces,
                       get(decoded.normals if normals is not None else None, 3),
                       get(decoded.tex_coord if uvs is not None else None, 2), decoded_colours)
-            report = json.loads(meshcodec("distance", path, tmp / "decoded.ply", "--samples", args.samples, "--json"))
+            report = distance_report(path, tmp / "decoded.ply", args.samples)
         bits = len(whole) * 8
-        result = {
-            "codec": "draco", "mesh": name, "source": str(path),
-            "vertices": vertices, "triangles": triangles, "quant_bits": args.quant, "bytes": len(whole),
-            "encode_seconds": enc_s, "decode_seconds": dec_s, "lossless": False,
-            "lossless_error": "Draco is single-rate and quantizes on its own grids; not checked against docs/CONTRACT.md §3",
-            "draco": {
+        result = single_rate_result(
+            name, path, (vertices, triangles), args.quant, whole, (enc_s, dec_s),
+            (len(decoded_points), len(decoded_faces)), report,
+            "Draco is single-rate and quantizes on its own grids; not checked against docs/CONTRACT.md §3",
+            {
                 "compression_level": 10, "quantization_bits": args.quant, "tex_coord_quantization_bits": args.uv_bits,
                 "normal_quantization_bits": args.normal_bits, "version": getattr(DracoPy, "__version__", ""),
                 "split_vertices": len(points), "geometry_bytes": len(geometry),
                 "geometry_decode_seconds": geometry_dec_s, "fields": fields,
-            },
-            "levels": [{
-                "level": 1, "bits": bits, "connectivity_bits": 0, "geometry_bits": 0,
-                "vertices": len(decoded_points), "triangles": len(decoded_faces),
-                "bits_per_vertex": bits / vertices, "bits_per_triangle": bits / triangles,
-                "hausdorff": report["hausdorff_relative"], "rms": report["rms_relative"],
-                "hausdorff_paper": report["hausdorff_paper"] / report["diagonal"],
-                **(report.get("appearance") or {}),
-            }],
-        }
+            })
         target = out / f"{name}-appearance.json"
         target.write_text(json.dumps(result, indent=2) + "\n")
         print(f"draco {name}: {len(whole)} bytes = {bits / vertices:.2f} bits/vertex "

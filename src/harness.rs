@@ -78,14 +78,18 @@ struct Input {
     appearance: Option<CanonicalAttributes>,
 }
 
-fn read_input(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<Input> {
-    let encode = encode_options(codec, options);
+fn read_input(
+    codec: &dyn Codec,
+    path: &Path,
+    options: &RunOptions,
+    encode: &EncodeOptions,
+) -> Result<Input> {
     let carries = codec
         .capabilities()
         .contains(&codecs::Capability::Attributes);
     if let (Some(bits), true) = (options.appearance, carries) {
         let original = read_attributed(path)?;
-        let (canonical, appearance) = codecs::canonical_attributed_for(&original, &encode, bits)?;
+        let (canonical, appearance) = codecs::canonical_attributed_for(&original, encode, bits)?;
         return Ok(Input {
             original,
             uncoded: Appearance::default(),
@@ -94,7 +98,7 @@ fn read_input(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<In
         });
     }
     let (mesh, uncoded) = read_mesh_and_appearance(path)?;
-    let canonical = codecs::canonical_for(&mesh, &encode)?;
+    let canonical = codecs::canonical_for(&mesh, encode)?;
     Ok(Input {
         original: AttributedMesh {
             mesh,
@@ -108,13 +112,13 @@ fn read_input(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<In
 
 /// Runs `codec` on the mesh file at `path`.
 pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOutput> {
+    let encode = encode_options(codec, options);
     let Input {
         original,
         uncoded,
         canonical,
         appearance,
-    } = read_input(codec, path, options)?;
-    let encode = encode_options(codec, options);
+    } = read_input(codec, path, options, &encode)?;
 
     let started = Instant::now();
     let encoded = codecs::encode_attributed(codec, &canonical, appearance.as_ref())?;
@@ -171,12 +175,14 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
                 encoded.levels.len()
             )));
         }
-        let mut row = measure_level(decoder.as_ref(), record, &reference, v, t)?;
-        if let Some(reference) = &original_appearance {
-            let level = decoder.mesh()?;
-            row.appearance = reference.compare(&level.mesh, level.attributes.as_ref());
-        }
-        levels.push(row);
+        levels.push(measure_level(
+            decoder.as_ref(),
+            record,
+            &reference,
+            original_appearance.as_ref(),
+            v,
+            t,
+        )?);
         bar.inc(1);
     }
     bar.finish_and_clear();
@@ -230,11 +236,15 @@ fn measure_level(
     decoder: &dyn LevelDecoder,
     record: &codecs::LevelRecord,
     reference: &Reference,
+    appearance: Option<&AppearanceReference>,
     full_vertices: f64,
     full_triangles: f64,
 ) -> Result<LevelRow> {
     let level = decoder.mesh()?;
     let distance = reference.compare(&level);
+    let appearance = appearance.map_or_else(Default::default, |a| {
+        a.compare(&level.mesh, level.attributes.as_ref())
+    });
     let bits = record.end_byte as u64 * 8;
     Ok(LevelRow {
         level: decoder.levels_decoded(),
@@ -248,7 +258,7 @@ fn measure_level(
         hausdorff: distance.map(|d| d.hausdorff),
         rms: distance.map(|d| d.rms),
         hausdorff_paper: distance.map(|d| d.hausdorff_paper),
-        appearance: Default::default(),
+        appearance,
     })
 }
 

@@ -57,7 +57,7 @@ impl AppearanceReference {
     /// original has no appearance.
     pub fn new(original: &AttributedMesh, count: usize, seed: u64) -> Option<AppearanceReference> {
         let a = &original.attributes;
-        if a.uvs.is_none() && a.normals.is_none() && a.colours.is_none() && a.materials.is_none() {
+        if a.is_empty() {
             return None;
         }
         let samples = sample_faces(&original.mesh, count, seed);

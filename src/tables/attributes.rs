@@ -33,19 +33,21 @@ struct DracoExtras {
     split_vertices: f64,
 }
 
-fn draco_extras(path: &Path) -> Result<DracoExtras> {
-    let text = std::fs::read_to_string(path)?;
-    let value: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| Error::Unsupported(format!("{}: {e}", path.display())))?;
+/// Draco's result file, read once: the common schema and the extras beside it.
+fn read_draco(path: &Path) -> Result<(RunResult, DracoExtras)> {
+    let text = std::fs::read_to_string(path).map_err(|e| missing(path, e))?;
+    let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| missing(path, e))?;
     let get = |key: &str| {
         value["draco"][key]
             .as_f64()
-            .ok_or_else(|| Error::Unsupported(format!("{}: no draco.{key}", path.display())))
+            .ok_or_else(|| missing(path, format!("no draco.{key}")))
     };
-    Ok(DracoExtras {
+    let extras = DracoExtras {
         geometry_bytes: get("geometry_bytes")?,
         split_vertices: get("split_vertices")?,
-    })
+    };
+    let result = serde_json::from_value(value).map_err(|e| missing(path, e))?;
+    Ok((result, extras))
 }
 
 fn missing(path: &Path, e: impl std::fmt::Display) -> Error {
@@ -91,8 +93,7 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             &format!("{mesh}{APPEARANCE_SUFFIX}"),
             ".json",
         );
-        let draco = read_result(&draco_path).map_err(|e| missing(&draco_path, e))?;
-        let extras = draco_extras(&draco_path)?;
+        let (draco, extras) = read_draco(&draco_path)?;
         let _ = writeln!(md, "## {mesh} ({what})\n");
         let _ = writeln!(
             md,

@@ -141,6 +141,10 @@ pub fn run(
     let mut previous_material = 0u32;
     let normal_max = spec.normal_bits.map(octahedral_max);
     let uv_cells = spec.uv_grid.map(|g| 1u64 << g.bits);
+    // The fitted uv prediction's corners and their wedges, kept between wedges to spare an
+    // allocation each.
+    let mut pairs: Vec<(DVec3, DVec2)> = Vec::new();
+    let mut seen: Vec<u32> = Vec::new();
     for &f in &traversal.order {
         let fu = f as usize;
         let face = faces[fu];
@@ -336,8 +340,8 @@ pub fn run(
                         );
                         // The chart's corners around the known edge: every corner of the
                         // faces visited so far at either end that continue its wedge there.
-                        let mut pairs: Vec<(DVec3, DVec2)> = Vec::new();
-                        let mut seen: Vec<u32> = Vec::new();
+                        pairs.clear();
+                        seen.clear();
                         let mut plane_normal = face_normal(p(0), p(1), p(2));
                         for (end, wedge) in [(face[others[0]], ea), (face[others[1]], eb)] {
                             for &g in traversal.faces_at(end) {
