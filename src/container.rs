@@ -29,10 +29,14 @@ use std::io::Read as _;
 pub const MAGIC: [u8; 4] = *b"MshC";
 /// Version of the stream syntax: bumped on every change to the bytes any codec writes
 /// (docs/FORMAT.md, "History"). Versions 3 and 4 are version 2 with an appearance block after
-/// the header and an appearance unit after the last (4 predicts uvs and colours better, so version 3's
-/// units no longer decode); a stream without appearance is written in version 2, which this
-/// build also reads.
-pub const FORMAT_VERSION: u8 = 4;
+/// the header and an appearance unit after the last level (4 predicts uvs and colours better,
+/// so version 3's units no longer decode); version 5 is version 4 whose appearance block may
+/// say that the values are coded inside the levels (`pm`), with no appearance unit. Each
+/// stream is written in the oldest version that holds it — 2 without appearance, 4 with an
+/// appearance unit — and this build reads 2, 4 and 5.
+pub const FORMAT_VERSION: u8 = 5;
+/// The version of streams with an appearance unit.
+pub const APPEARANCE_UNIT_VERSION: u8 = 4;
 /// The version of streams without appearance, and the oldest this build reads.
 pub const GEOMETRY_ONLY_VERSION: u8 = 2;
 /// The fewest bytes an index entry takes (three one-byte varints).
@@ -56,13 +60,14 @@ pub struct Header {
 }
 
 impl Header {
-    /// The format version this header is written in: [`FORMAT_VERSION`] with appearance,
+    /// The format version this header is written in: [`FORMAT_VERSION`] with appearance in
+    /// the levels, [`APPEARANCE_UNIT_VERSION`] with an appearance unit,
     /// [`GEOMETRY_ONLY_VERSION`] without.
     pub fn version(&self) -> u8 {
-        if self.appearance.is_some() {
-            FORMAT_VERSION
-        } else {
-            GEOMETRY_ONLY_VERSION
+        match &self.appearance {
+            Some(a) if a.in_levels => FORMAT_VERSION,
+            Some(_) => APPEARANCE_UNIT_VERSION,
+            None => GEOMETRY_ONLY_VERSION,
         }
     }
 }
@@ -78,6 +83,9 @@ pub struct AppearanceSpec {
     pub colours: bool,
     /// The material names faces' ids index, when faces carry materials.
     pub materials: Option<MaterialNames>,
+    /// Whether the values are coded inside the codec's own levels, so that every level carries
+    /// them (`pm`), rather than in an appearance unit after the last.
+    pub in_levels: bool,
 }
 
 /// Material names and the library they come from.
@@ -93,13 +101,15 @@ const FLAG_NORMALS: u8 = 1;
 const FLAG_UVS: u8 = 2;
 const FLAG_COLOURS: u8 = 4;
 const FLAG_MATERIALS: u8 = 8;
+const FLAG_IN_LEVELS: u8 = 16;
 
 impl AppearanceSpec {
     fn write(&self, out: &mut Vec<u8>) {
         let flags = self.normal_bits.map_or(0, |_| FLAG_NORMALS)
             | self.uv_grid.map_or(0, |_| FLAG_UVS)
             | if self.colours { FLAG_COLOURS } else { 0 }
-            | self.materials.as_ref().map_or(0, |_| FLAG_MATERIALS);
+            | self.materials.as_ref().map_or(0, |_| FLAG_MATERIALS)
+            | if self.in_levels { FLAG_IN_LEVELS } else { 0 };
         out.push(flags);
         if let Some(bits) = self.normal_bits {
             out.push(bits);
@@ -131,7 +141,8 @@ impl AppearanceSpec {
         };
         let at = *pos;
         let flags = byte(pos)?;
-        if flags == 0 || flags & !(FLAG_NORMALS | FLAG_UVS | FLAG_COLOURS | FLAG_MATERIALS) != 0 {
+        let attributes = FLAG_NORMALS | FLAG_UVS | FLAG_COLOURS | FLAG_MATERIALS;
+        if flags & attributes == 0 || flags & !(attributes | FLAG_IN_LEVELS) != 0 {
             return Err(Error::malformed(
                 0,
                 at,
@@ -140,6 +151,7 @@ impl AppearanceSpec {
         }
         let mut spec = AppearanceSpec {
             colours: flags & FLAG_COLOURS != 0,
+            in_levels: flags & FLAG_IN_LEVELS != 0,
             ..AppearanceSpec::default()
         };
         if flags & FLAG_NORMALS != 0 {
@@ -430,9 +442,15 @@ impl Header {
             return Err(bad(0, "not a meshcodec stream (bad magic)"));
         }
         let version = *bytes.get(4).ok_or_else(cut)?;
-        if version != GEOMETRY_ONLY_VERSION && version != FORMAT_VERSION {
+        if ![
+            GEOMETRY_ONLY_VERSION,
+            APPEARANCE_UNIT_VERSION,
+            FORMAT_VERSION,
+        ]
+        .contains(&version)
+        {
             return Err(Error::Unsupported(format!(
-                "stream format version {version} (this build reads versions {GEOMETRY_ONLY_VERSION} and {FORMAT_VERSION})"
+                "stream format version {version} (this build reads versions {GEOMETRY_ONLY_VERSION}, {APPEARANCE_UNIT_VERSION} and {FORMAT_VERSION})"
             )));
         }
         let codec_id = *bytes.get(5).ok_or_else(cut)?;
@@ -479,10 +497,20 @@ impl Header {
                 &format!("header declares {vertices} vertices and {triangles} triangles"),
             ));
         }
-        let appearance = if version == FORMAT_VERSION {
-            Some(AppearanceSpec::read(bytes, &mut pos)?)
-        } else {
+        let appearance = if version == GEOMETRY_ONLY_VERSION {
             None
+        } else {
+            let at = pos;
+            let spec = AppearanceSpec::read(bytes, &mut pos)?;
+            // Each version says where the values are: 4 in a unit, 5 in the levels.
+            if spec.in_levels != (version == FORMAT_VERSION) {
+                return Err(Error::malformed(
+                    0,
+                    at,
+                    format!("version {version} streams do not carry appearance that way"),
+                ));
+            }
+            Some(spec)
         };
         let header = Header {
             codec_id,
@@ -497,12 +525,12 @@ impl Header {
 }
 
 /// Reads the header and index at the start of `bytes`; returns them and the payload's offset.
-/// When the header declares appearance, the index's last unit is the appearance unit: it is
+/// When the header declares an appearance unit, the index's last unit is that unit: it is
 /// taken out of the units into [`Index::appearance`], so a codec sees its own units only.
 pub fn read_header_and_index(bytes: &[u8]) -> Result<(Header, Index, usize)> {
     let (header, mut pos) = Header::read(bytes)?;
     let mut index = Index::read(bytes, &mut pos)?;
-    if header.appearance.is_some() {
+    if header.appearance.as_ref().is_some_and(|a| !a.in_levels) {
         if index.units.len() < 2 {
             return Err(Error::malformed(
                 0,

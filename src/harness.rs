@@ -31,6 +31,9 @@ pub struct RunOptions {
     /// Code the file's appearance at these bits when the codec carries appearance
     /// (`None`: positions and triangles only, whatever the file holds).
     pub appearance: Option<AttributeBits>,
+    /// With appearance, code it inside the levels by this rule for collapsed wedges, for codecs
+    /// that can (`pm`; `None`: an appearance unit after the last level).
+    pub appearance_in_levels: Option<codecs::AttributeFit>,
 }
 
 impl Default for RunOptions {
@@ -41,6 +44,7 @@ impl Default for RunOptions {
             samples_per_triangle: DEFAULT_SAMPLES_PER_TRIANGLE,
             progress: false,
             appearance: None,
+            appearance_in_levels: None,
         }
     }
 }
@@ -121,7 +125,12 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
     } = read_input(codec, path, options, &encode)?;
 
     let started = Instant::now();
-    let encoded = codecs::encode_attributed(codec, &canonical, appearance.as_ref())?;
+    let encoded = codecs::encode_attributed_with(
+        codec,
+        &canonical,
+        appearance.as_ref(),
+        options.appearance_in_levels,
+    )?;
     let encode_seconds = started.elapsed().as_secs_f64();
 
     // Time the bare decode (no metrics); repeat short ones so the figure is not timer noise.
@@ -218,9 +227,14 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
             .filter(|(_, present)| *present)
             .map(|(name, _)| name.to_string())
             .collect(),
+            // An appearance unit's bytes, or what a codec that codes appearance in its levels
+            // booked for it.
             bits: codec_stats
                 .get_named("appearance_bytes")
-                .map_or(0, |b| b as u64 * 8),
+                .map(|b| b * 8.0)
+                .or_else(|| codec_stats.get_named("appearance_bits"))
+                .map_or(0, |b| b.round() as u64),
+            in_levels: options.appearance_in_levels.map(|f| f.name().to_string()),
         }),
         codec_stats,
         levels,

@@ -92,8 +92,12 @@ pub struct AppearanceRun {
     pub wedges: usize,
     /// The attributes carried, of normals, uvs, colours, materials.
     pub fields: Vec<String>,
-    /// Bits of the appearance unit.
+    /// Bits of the appearance: its unit's, or what the levels spent on it.
     pub bits: u64,
+    /// The rule for collapsed wedges (`fit`, `keep`) when the levels carry the appearance
+    /// (`pm --attributes`); absent when an appearance unit follows the last level.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub in_levels: Option<String>,
 }
 
 impl RunResult {
@@ -131,8 +135,12 @@ pub fn result_stem(defaults: &EncodeOptions, result: &RunResult) -> String {
         grid: result.grid,
     };
     let mut stem = stem(defaults, &result.mesh, &quantization);
-    if result.appearance.is_some() {
+    if let Some(appearance) = &result.appearance {
         stem.push_str(APPEARANCE_SUFFIX);
+        if let Some(rule) = &appearance.in_levels {
+            stem.push('-');
+            stem.push_str(rule);
+        }
     }
     stem
 }

@@ -154,3 +154,66 @@ fn the_harness_codes_appearance_when_asked_and_measures_it_at_the_level_that_car
     let lossy = run(codecs::by_name("came-paper").unwrap(), &path, &options).unwrap();
     assert!(lossy.result.appearance.is_none() && !lossy.appearance.is_empty());
 }
+
+/// `pm` with the appearance inside its vertex splits (`--attributes fit|keep`): every level
+/// carries it, the full level is lossless with it, PMeshIter walks back to the base mesh and
+/// forward again to the same appearance, and a cut or damaged stream is an error.
+#[test]
+fn pm_carries_appearance_at_every_level_with_either_rule() {
+    use meshcodec::codecs::pm::iter::PMeshIter;
+    use meshcodec::codecs::AttributeFit;
+    for name in ["spot", "airplane-colored"] {
+        let mesh = read_attributed(&resolve(name).unwrap()).unwrap();
+        for codec_name in ["pm", "pm-reordered"] {
+            let codec = codecs::by_name(codec_name).unwrap();
+            let mut options = codec.default_options();
+            options.quant_bits = 12;
+            let (canonical, appearance) =
+                codecs::canonical_attributed_for(&mesh, &options, AttributeBits::default())
+                    .unwrap();
+            for fit in [AttributeFit::Fit, AttributeFit::Keep] {
+                let what = format!("{name} {codec_name} {}", fit.name());
+                let encoded =
+                    codecs::encode_attributed_with(codec, &canonical, Some(&appearance), Some(fit))
+                        .unwrap();
+                assert_eq!(encoded.bytes[4], meshcodec::container::FORMAT_VERSION);
+                let mut decoder = codecs::open(&encoded.bytes).unwrap();
+                let mut levels = 0;
+                while decoder.advance().unwrap() {
+                    let level = decoder.mesh().unwrap();
+                    let attributes = level.attributes.as_ref().expect("every level");
+                    assert_eq!(attributes.corners.len(), level.mesh.faces.len(), "{what}");
+                    levels += 1;
+                }
+                assert!(levels > 1, "{what}");
+                let full = decoder.mesh().unwrap();
+                assert_eq!(
+                    appearance.check_lossless(
+                        &canonical,
+                        &full.mesh,
+                        full.attributes.as_ref().unwrap()
+                    ),
+                    Ok(()),
+                    "{what}"
+                );
+                let mut iter = PMeshIter::from_stream(&encoded.bytes).unwrap();
+                while iter.next().unwrap() {}
+                let end = iter.attributes().unwrap();
+                iter.goto_nvertices(0).unwrap();
+                let base = iter.attributes().unwrap();
+                assert_eq!(base.corners.len(), iter.nfaces(), "{what}");
+                while iter.next().unwrap() {}
+                assert_eq!(iter.attributes().unwrap(), end, "{what}");
+                // Cut inside the last level: the levels before it, with their appearance.
+                let cut = &encoded.bytes[..encoded.bytes.len() - 3];
+                let (partial, _) = codecs::decode(cut, Stop::All).unwrap();
+                assert!(partial.attributes.is_some(), "{what}");
+                // Damaged bytes in the levels: an error or a mesh, never a panic.
+                let mut damaged = encoded.bytes.clone();
+                let at = damaged.len() / 2;
+                damaged[at] ^= 0x5a;
+                let _ = codecs::decode(&damaged, Stop::All);
+            }
+        }
+    }
+}

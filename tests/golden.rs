@@ -8,7 +8,7 @@
 //! - `tests/golden/rates.txt` pins each codec's bits per vertex on three meshes; a codec that
 //!   codes any of them in more bits fails.
 //!
-//! - `tests/golden/v<FORMAT_VERSION>/emc-spot-appearance.mc` is `emc`'s stream of spot.obj with
+//! - `tests/golden/v<APPEARANCE_UNIT_VERSION>/emc-spot-appearance.mc` is `emc`'s stream of spot.obj with
 //!   its uvs (12-bit positions and uvs): the appearance unit's bytes are pinned too, and the
 //!   stream must decode to the canonical mesh with its appearance exactly.
 //!
@@ -16,7 +16,7 @@
 //! which a change of syntax must come with (and a new format version: docs/FORMAT.md, History).
 
 use meshcodec::codecs::{self, Codec, Stop};
-use meshcodec::container::{FORMAT_VERSION, GEOMETRY_ONLY_VERSION};
+use meshcodec::container::{APPEARANCE_UNIT_VERSION, FORMAT_VERSION, GEOMETRY_ONLY_VERSION};
 use meshcodec::mesh::io::{read_mesh, resolve, write_mesh};
 use meshcodec::mesh::{CanonicalMesh, TriMesh};
 use meshcodec::Error;
@@ -165,10 +165,10 @@ fn the_appearance_golden_stream_is_reproduced_and_decodes_exactly() {
     let bytes = codecs::encode_attributed(codec, &canonical, Some(&appearance))
         .unwrap()
         .bytes;
-    assert_eq!(bytes[4], FORMAT_VERSION);
+    assert_eq!(bytes[4], APPEARANCE_UNIT_VERSION);
     let golden = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/golden")
-        .join(format!("v{FORMAT_VERSION}"))
+        .join(format!("v{APPEARANCE_UNIT_VERSION}"))
         .join("emc-spot-appearance.mc");
     if updating() {
         std::fs::create_dir_all(golden.parent().unwrap()).unwrap();

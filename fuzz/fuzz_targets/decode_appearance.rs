@@ -1,4 +1,4 @@
-//! Streams with appearance (format version 4) on arbitrary bytes after the magic and version:
+//! Streams with an appearance unit (format version 4) on arbitrary bytes after the magic and version:
 //! the first byte picks the codec, the rest is its header with the appearance block, the index
 //! with the appearance unit, the levels and the unit.
 #![no_main]

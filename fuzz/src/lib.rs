@@ -8,7 +8,9 @@
 use arbitrary::{Arbitrary, Result as ArbitraryResult, Unstructured};
 use meshcodec::codecs::pm::iter::PMeshIter;
 use meshcodec::codecs::{self, EncodeOptions, LevelMesh, Stop};
-use meshcodec::container::{Header, FORMAT_VERSION, GEOMETRY_ONLY_VERSION, MAGIC};
+use meshcodec::container::{
+    Header, APPEARANCE_UNIT_VERSION, FORMAT_VERSION, GEOMETRY_ONLY_VERSION, MAGIC,
+};
 use meshcodec::limits;
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::{generate, io, TriMesh};
@@ -35,9 +37,20 @@ pub fn decode_as(name: &str, body: &[u8]) {
 /// appearance: its first byte picks the codec, then the header with its appearance block, the
 /// index with the appearance unit last, the levels and the unit.
 pub fn decode_with_appearance(body: &[u8]) {
+    decode_in_version(APPEARANCE_UNIT_VERSION, body);
+}
+
+/// Decodes `body` as everything after the first five bytes of a stream whose levels carry the
+/// appearance (format version 5, `pm` and `pm-reordered`): the codec id, the header with its
+/// appearance block, the index, and levels whose vertex splits carry the corner values.
+pub fn decode_with_appearance_in_levels(body: &[u8]) {
+    decode_in_version(FORMAT_VERSION, body);
+}
+
+fn decode_in_version(version: u8, body: &[u8]) {
     let mut bytes = Vec::with_capacity(body.len() + 5);
     bytes.extend_from_slice(&MAGIC);
-    bytes.push(FORMAT_VERSION);
+    bytes.push(version);
     bytes.extend_from_slice(body);
     decode_every_way(&bytes);
 }

@@ -56,6 +56,11 @@ struct Settings {
     /// Qn: bits per octahedral normal coordinate when coding appearance.
     #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS)]
     normal_bits: u8,
+    /// With --appearance, code it inside the levels (pm only: every level carries it), giving
+    /// a collapsed wedge the values interpolated to where the vertex went (`fit`) or the
+    /// survivor's (`keep`); results as STEM-appearance-RULE.
+    #[arg(long, value_parser = ["fit", "keep"])]
+    attributes: Option<String>,
 }
 
 impl Settings {
@@ -70,6 +75,7 @@ impl Settings {
             appearance: false,
             uv_bits: meshcodec::mesh::attribute_quantization::DEFAULT_UV_BITS,
             normal_bits: meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS,
+            attributes: None,
         }
     }
 }
@@ -197,6 +203,10 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
                 normal: settings.normal_bits,
             },
         ),
+        appearance_in_levels: settings
+            .attributes
+            .as_deref()
+            .and_then(|name| meshcodec::codecs::AttributeFit::by_name(name).ok()),
     }
 }
 

@@ -51,6 +51,11 @@ enum Command {
         /// Bits per octahedral normal coordinate (Qn).
         #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS)]
         normal_bits: u8,
+        /// pm only: code the appearance inside the vertex splits, so that every level carries
+        /// it, a collapsed wedge taking the values interpolated to where its vertex went (`fit`)
+        /// or the survivor's (`keep`). Without it, an appearance unit follows the last level.
+        #[arg(long, value_parser = ["fit", "keep"])]
+        attributes: Option<String>,
         /// Mesh file or name.
         input: String,
         /// Stream file to write.
@@ -152,6 +157,7 @@ fn main() -> ExitCode {
             drop_attributes,
             uv_bits,
             normal_bits,
+            attributes,
             input,
             output,
         } => encode(
@@ -161,10 +167,15 @@ fn main() -> ExitCode {
             if drop_attributes {
                 Attributes::Drop
             } else {
-                Attributes::Carry(AttributeBits {
-                    uv: uv_bits,
-                    normal: normal_bits,
-                })
+                Attributes::Carry(
+                    AttributeBits {
+                        uv: uv_bits,
+                        normal: normal_bits,
+                    },
+                    attributes
+                        .as_deref()
+                        .and_then(|name| codecs::AttributeFit::by_name(name).ok()),
+                )
             },
             &input,
             &output,
@@ -249,8 +260,9 @@ fn load_attributed(name: &str) -> Result<(PathBuf, meshcodec::mesh::attributes::
 
 /// What `encode` does with a file's appearance.
 enum Attributes {
-    /// Carries it at these bits (a codec that cannot is refused).
-    Carry(AttributeBits),
+    /// Carries it at these bits (a codec that cannot is refused), inside the levels by this
+    /// rule when given (pm).
+    Carry(AttributeBits, Option<codecs::AttributeFit>),
     /// Encodes the geometry alone.
     Drop,
 }
@@ -282,7 +294,9 @@ fn encode(
     // The file is read once: with its appearance when the codec carries it.
     let mut dropped = None;
     let (canonical, encoded) = match attributes {
-        Attributes::Carry(bits) if codec.capabilities().contains(&Capability::Attributes) => {
+        Attributes::Carry(bits, in_levels)
+            if codec.capabilities().contains(&Capability::Attributes) =>
+        {
             let attributed = read_attributed(&path).with_context(context)?;
             if attributed.attributes.is_empty() {
                 geometry(&attributed.mesh)?
@@ -290,8 +304,9 @@ fn encode(
                 let (canonical, appearance) =
                     codecs::canonical_attributed_for(&attributed, &options, bits)
                         .with_context(context)?;
-                let encoded = codecs::encode_attributed(codec, &canonical, Some(&appearance))
-                    .with_context(context)?;
+                let encoded =
+                    codecs::encode_attributed_with(codec, &canonical, Some(&appearance), in_levels)
+                        .with_context(context)?;
                 (canonical, encoded)
             }
         }
@@ -299,7 +314,7 @@ fn encode(
             let (mesh, appearance) =
                 meshcodec::mesh::io::read_mesh_and_appearance(&path).with_context(context)?;
             if !appearance.is_empty() {
-                if matches!(attributes, Attributes::Carry(_)) {
+                if matches!(attributes, Attributes::Carry(..)) {
                     return Err(meshcodec::Error::Unsupported(format!(
                         "holds {appearance}, which {} does not carry (its full level is lossy); --drop-attributes encodes the geometry alone",
                         codec.name()
@@ -593,19 +608,27 @@ fn info(input: &Path, json: bool) -> Result<()> {
                     .map_or(String::new(), |l| format!(" from {l}"))
             ));
         }
-        let unit = reader.index().appearance.map_or(String::new(), |u| {
-            format!(
-                "; unit at bytes {}..{} ({} bytes{})",
-                payload_start + u.offset,
-                payload_start + u.end(),
-                u.length,
-                if reader.appearance_unit().is_some() {
-                    ""
-                } else {
-                    ", not present"
-                }
-            )
-        });
+        let in_levels = if spec.in_levels {
+            "; in every level"
+        } else {
+            ""
+        };
+        let unit = reader
+            .index()
+            .appearance
+            .map_or(in_levels.to_string(), |u| {
+                format!(
+                    "; unit at bytes {}..{} ({} bytes{})",
+                    payload_start + u.offset,
+                    payload_start + u.end(),
+                    u.length,
+                    if reader.appearance_unit().is_some() {
+                        ""
+                    } else {
+                        ", not present"
+                    }
+                )
+            });
         let _ = writeln!(text, "appearance: {}{unit}", carried.join(", "));
     }
     let _ = writeln!(

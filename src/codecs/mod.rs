@@ -78,6 +78,39 @@ pub enum Capability {
     Attributes,
 }
 
+/// How a codec that refines appearance level by level gives a collapsed wedge its values
+/// (`pm`; docs/CONTRACT.md §2.1): interpolated along the collapsed edge to where the surviving
+/// vertex went, or the survivor's own (the fast-QEM paper's rule).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum AttributeFit {
+    /// Interpolated to the collapsed position.
+    #[default]
+    Fit,
+    /// The survivor's.
+    Keep,
+}
+
+impl AttributeFit {
+    /// The name on the command line and in results.
+    pub fn name(self) -> &'static str {
+        match self {
+            AttributeFit::Fit => "fit",
+            AttributeFit::Keep => "keep",
+        }
+    }
+
+    /// The rule called `name`.
+    pub fn by_name(name: &str) -> Result<AttributeFit> {
+        match name {
+            "fit" => Ok(AttributeFit::Fit),
+            "keep" => Ok(AttributeFit::Keep),
+            _ => Err(Error::Unsupported(format!(
+                "unknown attribute rule '{name}' (fit, keep)"
+            ))),
+        }
+    }
+}
+
 /// A progressive mesh codec.
 pub trait Codec: Send + Sync {
     /// Name on the command line and in results/ ([`names`]).
@@ -103,6 +136,21 @@ pub trait Codec: Send + Sync {
     /// Codec-specific measurements of an encoded stream (PM: iteration rates), stored with the
     /// run's results; codecs with none return an empty set.
     fn measure(&self, stream: &[u8]) -> Result<Stats>;
+    /// Encodes the canonical mesh with its appearance coded inside the levels, so that every
+    /// level carries it; `None` for codecs that carry appearance in an appearance unit after
+    /// their last level ([`encode_attributed`]).
+    fn encode_with_appearance(
+        &self,
+        _mesh: &CanonicalMesh,
+        _appearance: &CanonicalAttributes,
+        _fit: AttributeFit,
+    ) -> Option<Result<Encoded>> {
+        None
+    }
+    /// Whether this codec's streams carry appearance inside their levels.
+    fn appearance_in_levels(&self) -> bool {
+        false
+    }
     /// How many bytes of the stream, from its first, decoding each level needs (entry k for
     /// level k + 1): where a reader of a stream still arriving can decode the next level. From
     /// the header and index alone; this default is for streams whose units are their levels.
@@ -221,9 +269,20 @@ pub fn encode_attributed(
     canonical: &CanonicalMesh,
     appearance: Option<&CanonicalAttributes>,
 ) -> Result<Encoded> {
-    let mut encoded = codec.encode(canonical)?;
+    encode_attributed_with(codec, canonical, appearance, None)
+}
+
+/// [`encode_attributed`], or, with `in_levels`, the appearance coded inside the levels by a
+/// codec that can (`pm`), so that every level carries it, collapsed wedges valued by the rule
+/// given.
+pub fn encode_attributed_with(
+    codec: &dyn Codec,
+    canonical: &CanonicalMesh,
+    appearance: Option<&CanonicalAttributes>,
+    in_levels: Option<AttributeFit>,
+) -> Result<Encoded> {
     let Some(appearance) = appearance.filter(|a| !a.is_empty()) else {
-        return Ok(encoded);
+        return codec.encode(canonical);
     };
     if !codec.capabilities().contains(&Capability::Attributes) {
         return Err(Error::Unsupported(format!(
@@ -231,6 +290,17 @@ pub fn encode_attributed(
             codec.name()
         )));
     }
+    if let Some(fit) = in_levels {
+        return codec
+            .encode_with_appearance(canonical, appearance, fit)
+            .unwrap_or_else(|| {
+                Err(Error::Unsupported(format!(
+                    "{} codes appearance after its last level only (--attributes is for pm)",
+                    codec.name()
+                )))
+            });
+    }
+    let mut encoded = codec.encode(canonical)?;
     let (full, _) = decode(&encoded.bytes, Stop::All)?;
     let (unit, fields) = appearance::encode(&full.mesh, canonical, appearance)?;
     let (mut header, mut index, start) = crate::container::read_header_and_index(&encoded.bytes)?;
@@ -293,9 +363,22 @@ pub fn canonical_attributed_for(
 /// unit decodes it after its last level.
 pub fn open(bytes: &[u8]) -> Result<Box<dyn LevelDecoder + '_>> {
     let reader = StreamReader::open(bytes)?;
-    let appearance = reader.header().appearance.clone();
+    let appearance = reader.header().appearance.clone().filter(|a| !a.in_levels);
     let unit = reader.appearance_unit();
-    let inner = by_id(reader.header().codec_id)?.decoder(reader)?;
+    let codec = by_id(reader.header().codec_id)?;
+    let in_levels = reader
+        .header()
+        .appearance
+        .as_ref()
+        .is_some_and(|a| a.in_levels);
+    if in_levels && !codec.appearance_in_levels() {
+        return Err(Error::malformed(
+            0,
+            5,
+            format!("{} streams do not carry appearance that way", codec.name()),
+        ));
+    }
+    let inner = codec.decoder(reader)?;
     Ok(match appearance {
         Some(spec) => Box::new(appearance::decoder::WithAppearance::new(inner, spec, unit)),
         None => inner,

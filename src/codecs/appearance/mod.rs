@@ -57,6 +57,7 @@ pub fn spec_of(appearance: &CanonicalAttributes) -> AppearanceSpec {
             names: m.names.clone(),
             library: m.library.clone(),
         }),
+        in_levels: false,
     }
 }
 

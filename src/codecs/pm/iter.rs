@@ -3,6 +3,7 @@
 //! Geomorph (§5), which blends a finer mesh towards its ancestors in a coarser one.
 
 use super::syntax::{self, Layout, SplitContexts};
+use super::wedges::{self, SplitWedges, WedgeContexts, WedgeState};
 use super::PmParams;
 use crate::codecs::LevelMesh;
 use crate::coding::arith::ArithDecoder;
@@ -22,6 +23,7 @@ struct SplitReader<'a> {
     levels_read: usize,
     previous_flclw: u32,
     layout: Layout,
+    wedge_contexts: WedgeContexts,
 }
 
 impl SplitReader<'_> {
@@ -74,10 +76,18 @@ impl SplitReader<'_> {
     }
 }
 
+/// The corner values a stream with appearance carries along the sequence: those of the
+/// current mesh, and what each split read so far changed.
+struct Wedges {
+    state: WedgeState,
+    splits: Vec<SplitWedges>,
+}
+
 /// An iterator over the meshes M⁰ … Mⁿ of a progressive mesh.
 pub struct PMeshIter<'a> {
     base: PmMesh,
     mesh: PmMesh,
+    wedges: Option<Wedges>,
     records: Vec<Vsplit>,
     applied: usize,
     reader: Option<SplitReader<'a>>,
@@ -103,11 +113,15 @@ impl<'a> PMeshIter<'a> {
         let base = stream
             .next_owned_level()?
             .ok_or_else(|| Error::Truncated("the stream ends before its base mesh".into()))?;
-        let mesh = super::read_base(&header, &base.bytes)
+        let (mesh, values) = super::read_base(&header, &base.bytes)
             .ok_or_else(|| Error::malformed(1, base.start, "base mesh cannot be read"))?;
         Ok(PMeshIter {
             base: mesh.clone(),
             mesh,
+            wedges: values.map(|state| Wedges {
+                state,
+                splits: Vec::new(),
+            }),
             records: Vec::new(),
             applied: 0,
             full_vertices: header.vertices,
@@ -124,15 +138,17 @@ impl<'a> PMeshIter<'a> {
                     flclw: params.flclw_coding(),
                     with_vad_s: params.with_vad_s(),
                 },
+                wedge_contexts: WedgeContexts::default(),
             }),
         })
     }
 
-    /// An iterator over records held in memory (a PMesh), at M⁰.
+    /// An iterator over records held in memory (a PMesh), at M⁰; geometry only.
     pub fn from_records(base: PmMesh, records: Vec<Vsplit>, header: Header) -> PMeshIter<'static> {
         PMeshIter {
             full_vertices: (base.positions.len() + records.len()) as u64,
             mesh: base.clone(),
+            wedges: None,
             base,
             records,
             applied: 0,
@@ -192,6 +208,13 @@ impl<'a> PMeshIter<'a> {
             .faces
             .get(split.flclw as usize)
             .map(|f| f.v[(split.vs_index as usize).min(2)]);
+        // A split read for the first time reads its wedges after it applies.
+        let coarse = match &self.wedges {
+            Some(w) if w.splits.len() == self.applied => {
+                wedges::coarse(&self.mesh, &w.state, &split)
+            }
+            _ => None,
+        };
         if self.mesh.positions.len() as u64 >= self.full_vertices {
             return Err(Error::malformed(
                 self.levels_read(),
@@ -218,6 +241,53 @@ impl<'a> PMeshIter<'a> {
                 0,
                 "vsplit moves a vertex off the grid",
             ));
+        }
+        if let Some(w) = self.wedges.as_mut() {
+            if let Some(done) = w.splits.get(self.applied) {
+                w.state.redo(done);
+            } else {
+                let read = match (coarse, self.reader.as_mut()) {
+                    (Some(coarse), Some(reader)) => {
+                        let spec = self
+                            .header
+                            .appearance
+                            .as_ref()
+                            .expect("a stream with appearance");
+                        let mut symbols = crate::codecs::appearance::coder::Reader {
+                            coder: reader.coder.take().expect("a level is open"),
+                            unit: reader.levels_read,
+                            start: reader.level_start,
+                        };
+                        let read = wedges::code_split(
+                            &mut symbols,
+                            &mut reader.wedge_contexts,
+                            &self.mesh,
+                            &mut w.state,
+                            &coarse,
+                            spec,
+                            None,
+                        );
+                        reader.coder = Some(symbols.coder);
+                        read.map_err(|e| match e {
+                            Error::Malformed { what, .. } => what,
+                            e => e.to_string(),
+                        })
+                    }
+                    _ => Err("its record does not locate".to_string()),
+                };
+                let read = match read {
+                    Ok(read) => read,
+                    Err(what) => {
+                        self.mesh.ecol(&split);
+                        return Err(Error::malformed(
+                            self.levels_read(),
+                            0,
+                            format!("vsplit {}: {what}", self.applied),
+                        ));
+                    }
+                };
+                w.splits.push(read);
+            }
         }
         self.applied += 1;
         Ok(())
@@ -260,6 +330,9 @@ impl<'a> PMeshIter<'a> {
         self.applied -= 1;
         let split = self.records[self.applied];
         self.mesh.ecol(&split);
+        if let Some(w) = self.wedges.as_mut() {
+            w.state.undo(&w.splits[self.applied]);
+        }
         true
     }
 
@@ -282,8 +355,22 @@ impl<'a> PMeshIter<'a> {
         LevelMesh {
             mesh: to_trimesh(&self.mesh, &self.header.grid),
             loose_edges: Vec::new(),
-            attributes: None,
+            attributes: self.attributes(),
         }
+    }
+
+    /// The current mesh's appearance, when the stream carries one: its wedges welded from the
+    /// corners' values.
+    pub fn attributes(&self) -> Option<crate::mesh::attributes::Attributes> {
+        let (w, spec) = (self.wedges.as_ref()?, self.header.appearance.as_ref()?);
+        let (corners, wedge_vertex, codes) = wedges::weld(&w.state, &self.mesh);
+        let appearance = crate::codecs::appearance::Appearance {
+            corners,
+            wedge_vertex,
+            codes,
+            materials: w.state.materials.clone(),
+        };
+        Some(crate::codecs::appearance::to_attributes(&appearance, spec))
     }
 
     /// The stream's header.

@@ -15,6 +15,7 @@
 //! | ii, vad_l, vad_s | position prediction (Fig. 10) and the large / small position deltas, in grid cells |
 //! | PMeshIter next / prev / goto | [`iter::PMeshIter`] |
 //! | Geomorph, Ancestry | [`iter::Geomorph`] |
+//! | wedge, corners field, wedge deltas, matid | [`wedges`]: a corner's value is a candidate choice or a predicted residual |
 //! | Δflclw, reordering by a dependency graph | `pm-reordered` (Table 4); `pm` keeps the collapse order (Table 3) |
 //!
 //! # Stream
@@ -24,24 +25,32 @@
 //! adaptive binary context of its own ([`syntax`]); the coder is flushed per level.
 //!
 //! Positions are the canonical mesh's cells (docs/CONTRACT.md §2, 16 bits by default as Hoppe §6.2), so
-//! the full level is lossless. Wedges (normals, texture coordinates) and material ids are not
-//! coded: the shared meshes carry none that the canonical mesh keeps; the `Vsplit` record leaves
-//! room for Hoppe's `corners` and `matid_predict` fields after `ii`.
+//! the full level is lossless. Appearance (wedges: normals, texture coordinates, colours; face
+//! materials) travels in an appearance unit after the last level, as for every codec, or, with
+//! [`AttributeFit`] (`--attributes fit|keep`), inside the splits so that every level carries it
+//! ([`wedges`], docs/FORMAT.md §6.1): Hoppe's `corners` / wedge-delta / `matid` fields as
+//! candidate choices and predicted residuals, the simplifier keeping seams
+//! ([`simplify::simplify_keeping_seams`]) and the encoder valuing collapsed wedges by the rule
+//! ([`wedge_levels`]).
 
 pub mod iter;
 pub mod syntax;
+pub mod wedge_levels;
+pub mod wedges;
 
 use super::stats::PmField;
 use super::{
-    names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, Stat, Stats,
+    names, AttributeFit, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, Stat,
+    Stats,
 };
 use crate::coding::arith::{ArithDecoder, ArithEncoder};
 use crate::coding::bits::index_bits;
 use crate::coding::SyntaxClass;
-use crate::container::{Header, LevelCost, StreamReader, StreamWriter};
+use crate::container::{AppearanceSpec, Header, LevelCost, StreamReader, StreamWriter};
 use crate::error::{Error, Result};
 use crate::hierarchy::pmesh::PmMesh;
 use crate::hierarchy::simplify::{self, Placement};
+use crate::mesh::canonical_attributes::CanonicalAttributes;
 use crate::mesh::quantize::GridShape;
 use crate::mesh::topology::analyze;
 use crate::mesh::{CanonicalMesh, TriMesh};
@@ -138,8 +147,8 @@ fn check_manifold(mesh: &CanonicalMesh) -> Result<()> {
     Ok(())
 }
 
-/// Reads a base-mesh level.
-fn read_base(header: &Header, bytes: &[u8]) -> Option<PmMesh> {
+/// Reads a base-mesh level: the mesh and, when the stream carries appearance, its values.
+fn read_base(header: &Header, bytes: &[u8]) -> Option<(PmMesh, Option<wedges::WedgeState>)> {
     let mut dec = ArithDecoder::new(bytes)?;
     let mut ctx = SplitContexts::default();
     let v = syntax::get_count(&mut dec, &mut ctx)?;
@@ -177,7 +186,137 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<PmMesh> {
     }
     // from_triangles links faces across shared edges; a base mesh whose vertices are not
     // manifold (two fans meeting at one vertex) links but is no mesh PM can split.
-    PmMesh::from_triangles(positions, &faces).filter(|mesh| mesh.check_invariants().is_ok())
+    let mesh =
+        PmMesh::from_triangles(positions, &faces).filter(|mesh| mesh.check_invariants().is_ok())?;
+    let state = match header.appearance.as_ref().filter(|a| a.in_levels) {
+        Some(spec) => {
+            let mut reader = crate::codecs::appearance::coder::Reader {
+                coder: dec,
+                unit: 1,
+                start: 0,
+            };
+            let mut contexts = wedges::WedgeContexts::default();
+            Some(wedges::code_base(&mut reader, &mut contexts, &mesh, spec, None).ok()?)
+        }
+        None => None,
+    };
+    Some((mesh, state))
+}
+
+/// Seams of the canonical mesh's appearance: edges whose two faces differ in material or in
+/// the values at either end (sorted vertex pairs, sorted).
+fn seams_of(mesh: &CanonicalMesh, appearance: &CanonicalAttributes) -> Vec<[u32; 2]> {
+    let mut directed: std::collections::HashMap<(u32, u32), (usize, usize)> =
+        std::collections::HashMap::with_capacity(mesh.faces.len() * 3);
+    for (f, t) in mesh.faces.iter().enumerate() {
+        for k in 0..3 {
+            directed.insert((t[k], t[(k + 1) % 3]), (f, k));
+        }
+    }
+    let code = |f: usize, k: usize| appearance.code(appearance.corners[f][k]);
+    let material = |f: usize| appearance.materials.as_ref().map(|m| m.face[f]);
+    let mut seams = Vec::new();
+    for (&(u, w), &(f, k)) in &directed {
+        if u > w {
+            continue;
+        }
+        let Some(&(g, j)) = directed.get(&(w, u)) else {
+            continue;
+        };
+        // f holds u at k and w at k + 1; g holds w at j and u at j + 1.
+        if code(f, k) != code(g, (j + 1) % 3)
+            || code(f, (k + 1) % 3) != code(g, j)
+            || material(f) != material(g)
+        {
+            seams.push([u, w]);
+        }
+    }
+    seams.sort_unstable();
+    seams
+}
+
+impl Pm {
+    fn params(&self) -> PmParams {
+        PmParams {
+            ordering: self.ordering,
+        }
+    }
+
+    /// The progressive mesh of `mesh`, keeping `seams` when given.
+    fn progressive_mesh(
+        &self,
+        mesh: &CanonicalMesh,
+        seams: Option<&[[u32; 2]]>,
+    ) -> simplify::ProgressiveMesh {
+        let cells: Vec<[i32; 3]> = mesh.cells.iter().map(|c| c.map(|x| x as i32)).collect();
+        let placement = match self.ordering {
+            Ordering::Natural => Placement::Optimal,
+            Ordering::Reordered => Placement::EndpointOrMidpoint,
+        };
+        let simplified = match seams {
+            Some(seams) => simplify::simplify_keeping_seams(&cells, &mesh.faces, placement, seams),
+            None => simplify::simplify(&cells, &mesh.faces, placement),
+        };
+        match self.ordering {
+            Ordering::Natural => simplify::progressive_mesh(&mesh.faces, &simplified),
+            Ordering::Reordered => simplify::reordered_progressive_mesh(&mesh.faces, &simplified),
+        }
+    }
+
+    /// Encodes with the appearance inside the vertex splits ([`wedges`]).
+    fn encode_appearance(
+        &self,
+        mesh: &CanonicalMesh,
+        appearance: &CanonicalAttributes,
+        fit: AttributeFit,
+    ) -> Result<Encoded> {
+        check_manifold(mesh)?;
+        let seams = seams_of(mesh, appearance);
+        let pm = self.progressive_mesh(mesh, Some(&seams));
+        let mut full = pm.base.clone();
+        for split in &pm.vsplits {
+            full.vsplit(split).expect("the encoder's own splits apply");
+        }
+        // Each face of Mⁿ is a canonical face: its values, rotated to its first corner.
+        let mut canonical_face: std::collections::HashMap<[u32; 3], usize> =
+            std::collections::HashMap::with_capacity(mesh.faces.len());
+        for (f, t) in mesh.faces.iter().enumerate() {
+            canonical_face.insert(*t, f);
+        }
+        let mut state = wedges::WedgeState {
+            corners: Vec::with_capacity(full.faces.len()),
+            materials: appearance.materials.as_ref().map(|_| Vec::new()),
+        };
+        for face in &full.faces {
+            let t = face.v.map(|v| pm.vertex_origin[v as usize]);
+            let (f, r) = (0..3)
+                .find_map(|r| {
+                    canonical_face
+                        .get(&[t[r], t[(r + 1) % 3], t[(r + 2) % 3]])
+                        .map(|&f| (f, r))
+                })
+                .ok_or_else(|| Error::Unsupported("pm rebuilt a face the mesh lacks".into()))?;
+            // Canonical corner i is our corner (i + r).
+            let mut codes = [Default::default(); 3];
+            for (i, &w) in appearance.corners[f].iter().enumerate() {
+                codes[(i + r) % 3] = appearance.code(w);
+            }
+            state.corners.push(codes);
+            if let (Some(out), Some(m)) = (state.materials.as_mut(), &appearance.materials) {
+                out.push(m.face[f]);
+            }
+        }
+        let mut spec = super::appearance::spec_of(appearance);
+        spec.in_levels = true;
+        let levels = wedge_levels::derive(&full, state, &pm.vsplits, fit, &spec);
+        Ok(encode_pm(
+            self.id(),
+            self.params(),
+            mesh,
+            &pm,
+            Some((&spec, &levels)),
+        ))
+    }
 }
 
 impl Codec for Pm {
@@ -209,20 +348,21 @@ impl Codec for Pm {
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         check_manifold(mesh)?;
-        let params = PmParams {
-            ordering: self.ordering,
-        };
-        let cells: Vec<[i32; 3]> = mesh.cells.iter().map(|c| c.map(|x| x as i32)).collect();
-        let placement = match self.ordering {
-            Ordering::Natural => Placement::Optimal,
-            Ordering::Reordered => Placement::EndpointOrMidpoint,
-        };
-        let simplified = simplify::simplify(&cells, &mesh.faces, placement);
-        let pm = match self.ordering {
-            Ordering::Natural => simplify::progressive_mesh(&mesh.faces, &simplified),
-            Ordering::Reordered => simplify::reordered_progressive_mesh(&mesh.faces, &simplified),
-        };
-        Ok(encode_pm(self.id(), params, mesh, &pm))
+        let pm = self.progressive_mesh(mesh, None);
+        Ok(encode_pm(self.id(), self.params(), mesh, &pm, None))
+    }
+
+    fn encode_with_appearance(
+        &self,
+        mesh: &CanonicalMesh,
+        appearance: &CanonicalAttributes,
+        fit: AttributeFit,
+    ) -> Option<Result<Encoded>> {
+        Some(self.encode_appearance(mesh, appearance, fit))
+    }
+
+    fn appearance_in_levels(&self) -> bool {
+        true
     }
 
     fn measure(&self, stream: &[u8]) -> Result<Stats> {
@@ -272,6 +412,7 @@ fn encode_pm(
     params: PmParams,
     mesh: &CanonicalMesh,
     pm: &simplify::ProgressiveMesh,
+    appearance: Option<(&AppearanceSpec, &wedge_levels::WedgeLevels)>,
 ) -> Encoded {
     let base = &pm.base;
     let mut schedule = Vec::new();
@@ -289,7 +430,7 @@ fn encode_pm(
         grid: mesh.grid,
         vertices: mesh.vertex_count() as u64,
         triangles: mesh.face_count() as u64,
-        appearance: None,
+        appearance: appearance.map(|(spec, _)| spec.clone()),
     };
     let mut writer = StreamWriter::new(&header);
     let mut stats = Stats::default();
@@ -312,6 +453,13 @@ fn encode_pm(
             enc.raw(v as u64, b, SyntaxClass::Connectivity, field);
         }
     }
+    // The base level's contexts are its own, as the decoder reads it apart.
+    let mut wedge_state = appearance.map(|(spec, levels)| {
+        let mut contexts = wedges::WedgeContexts::default();
+        wedges::code_base(&mut enc, &mut contexts, base, spec, Some(&levels.base))
+            .expect("the encoder codes its own values")
+    });
+    let mut wedge_contexts = wedges::WedgeContexts::default();
     let mut push = |enc: ArithEncoder, vertices: usize, triangles: usize, stats: &mut Stats| {
         for (field, bits) in &enc.field_bits {
             stats.add_named(&format!("bits_{field}"), *bits);
@@ -337,7 +485,7 @@ fn encode_pm(
     for n in schedule {
         let mut enc = ArithEncoder::default();
         syntax::put_count(&mut enc, &mut ctx, n as u64);
-        for split in &pm.vsplits[next..next + n] {
+        for (i, split) in pm.vsplits[next..next + n].iter().enumerate() {
             let faces = state.faces.len() as u32;
             let tangent = syntax::Tangent::at(&state, split);
             syntax::put_split(
@@ -350,12 +498,36 @@ fn encode_pm(
                 tangent,
             );
             previous = split.flclw;
+            let coarse = wedge_state
+                .as_ref()
+                .and_then(|w| wedges::coarse(&state, w, split));
             state.vsplit(split).expect("the encoder's own splits apply");
+            if let (Some((spec, levels)), Some(w), Some(coarse)) =
+                (appearance, wedge_state.as_mut(), coarse)
+            {
+                wedges::code_split(
+                    &mut enc,
+                    &mut wedge_contexts,
+                    &state,
+                    w,
+                    &coarse,
+                    spec,
+                    Some(&levels.truths[next + i]),
+                )
+                .expect("the encoder codes its own values");
+            }
         }
         next += n;
         push(enc, state.positions.len(), state.faces.len(), &mut stats);
     }
     let (bytes, levels) = writer.finish();
+    if appearance.is_some() {
+        let bits: f64 = ["wedge", "uv", "normal", "colour", "material"]
+            .iter()
+            .filter_map(|f| stats.get_named(&format!("bits_{f}")))
+            .sum();
+        stats.add_named("appearance_bits", bits);
+    }
     stats.set(Stat::Vsplits, pm.vsplits.len() as f64);
     stats.set(Stat::BaseVertices, base.positions.len() as f64);
     stats.set(Stat::BaseFaces, base.faces.len() as f64);

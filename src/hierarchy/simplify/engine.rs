@@ -45,6 +45,19 @@ pub(super) struct State {
     pub(super) placement: Placement,
     /// Box of the input cells: placements stay inside it, hence on the grid.
     pub(super) bounds: ([i32; 3], [i32; 3]),
+    /// Whether each edge is a seam to keep (empty: none; see `simplify_keeping_seams`).
+    pub(super) seam: Vec<bool>,
+}
+
+/// What the seams allow of a collapse of an edge.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum SeamRule {
+    /// Either end may vanish.
+    Free,
+    /// Only the other end may vanish: this one survives.
+    Survivor(u32),
+    /// Neither may.
+    Refused,
 }
 
 impl State {
@@ -70,6 +83,52 @@ impl State {
             frozen,
             placement,
             bounds,
+            seam: Vec::new(),
+        }
+    }
+
+    /// The edge between `a` and `b`, if any.
+    fn edge_between(&self, a: u32, b: u32) -> Option<u32> {
+        self.vedges[a as usize]
+            .iter()
+            .copied()
+            .find(|&e| self.other_end(e, a) == b)
+    }
+
+    fn is_seam(&self, a: u32, b: u32) -> bool {
+        !self.seam.is_empty()
+            && self
+                .edge_between(a, b)
+                .is_some_and(|e| self.seam[e as usize])
+    }
+
+    fn seams_at(&self, v: u32) -> usize {
+        self.vedges[v as usize]
+            .iter()
+            .filter(|&&e| self.seam[e as usize])
+            .count()
+    }
+
+    /// Which end of (a, b) may vanish without moving or joining seams: an end on no seam when
+    /// the edge is none, an end on exactly two when the edge is one of them.
+    pub(super) fn seam_rule(&self, a: u32, b: u32) -> SeamRule {
+        if self.seam.is_empty() {
+            return SeamRule::Free;
+        }
+        let along = self.is_seam(a, b);
+        let may_vanish = |v: u32| {
+            let s = self.seams_at(v);
+            if along {
+                s == 2
+            } else {
+                s == 0
+            }
+        };
+        match (may_vanish(a), may_vanish(b)) {
+            (true, true) => SeamRule::Free,
+            (true, false) => SeamRule::Survivor(b),
+            (false, true) => SeamRule::Survivor(a),
+            (false, false) => SeamRule::Refused,
         }
     }
 
@@ -105,6 +164,16 @@ impl State {
 
     /// Best position for collapsing (a, b) and its cost.
     pub(super) fn place(&self, a: u32, b: u32) -> ([i32; 3], f64) {
+        // A survivor forced by the seams comes first, so that the endpoint and midpoint
+        // placements are its own (vad_s = 0 holds for them).
+        let (a, b) = match self.seam_rule(a, b) {
+            SeamRule::Free => (a, b),
+            SeamRule::Survivor(s) => (s, if s == a { b } else { a }),
+            SeamRule::Refused => return (self.cells[a as usize], f64::INFINITY),
+        };
+        let forced = self.seam_rule(a, b) != SeamRule::Free;
+        // A survivor on a seam the edge does not follow stays where it is.
+        let pinned = forced && !self.is_seam(a, b);
         let q = Quadric::sum(&self.quadrics[a as usize], &self.quadrics[b as usize]);
         let (ca, cb) = (self.cells[a as usize], self.cells[b as usize]);
         let mut best = (ca, q.error(to_f(ca)));
@@ -114,9 +183,13 @@ impl State {
                 best = (c, e);
             }
         };
-        consider(cb);
-        consider(anchor(1, ca, cb));
-        consider(anchor(1, cb, ca));
+        if !pinned {
+            consider(cb);
+            consider(anchor(1, ca, cb));
+        }
+        if !forced {
+            consider(anchor(1, cb, ca));
+        }
         if self.placement == Placement::Optimal {
             if let Some(p) = q.minimizer() {
                 let lo = to_f(ca).min(to_f(cb));
@@ -219,6 +292,12 @@ impl State {
                 (b, a)
             }
         };
+        let (vs, vt) = match self.seam_rule(a, b) {
+            SeamRule::Free => (vs, vt),
+            SeamRule::Refused => return None,
+            SeamRule::Survivor(s) if edge_faces.len() == 1 && s != vs => return None,
+            SeamRule::Survivor(s) => (s, if s == a { b } else { a }),
+        };
         let fl = *edge_faces.iter().find(|&&f| holds(f, vt, vs))?;
         let fr = edge_faces
             .iter()
@@ -229,6 +308,14 @@ impl State {
             third(fl, vs, vt),
             if fr == NIL { NIL } else { third(fr, vs, vt) },
         );
+        // Along a seam, fl and fr must not be wholly inside seams (two seams would join).
+        if self.is_seam(vs, vt) {
+            for v in [vl, vr] {
+                if v != NIL && self.is_seam(vs, v) && self.is_seam(vt, v) {
+                    return None;
+                }
+            }
+        }
         // A split that gives vt no old face is located from vs's faces across (vs, vl) and
         // (vs, vr): they must exist.
         let vt_keeps_none = self.vfaces[vt as usize].iter().all(|&f| f == fl || f == fr);
@@ -368,6 +455,15 @@ impl State {
         self.vfaces[vt as usize] = Incident::new();
         // vt's edges: to vs it vanishes; to vl and vr it merges into vs's edge; the rest now
         // end at vs.
+        if !self.seam.is_empty() {
+            for w in [vl, vr] {
+                if w != NIL && self.is_seam(vt, w) {
+                    if let Some(kept) = self.edge_between(vs, w) {
+                        self.seam[kept as usize] = true;
+                    }
+                }
+            }
+        }
         for e in std::mem::take(&mut self.vedges[vt as usize]) {
             let w = self.other_end(e, vt);
             if w == vs || w == vl || w == vr {

@@ -34,7 +34,7 @@ pub use records::{progressive_mesh, ProgressiveMesh};
 pub use reorder::reordered_progressive_mesh;
 
 use engine::{topology, State};
-use quadric::initial_quadrics;
+use quadric::{add_seam_planes, initial_quadrics};
 use regions::{simplify_in_regions, REGION_MIN_FACES};
 
 /// Where a collapse puts the remaining vertex.
@@ -116,20 +116,63 @@ fn simplify_with_regions(
     placement: Placement,
     regions: bool,
 ) -> Simplified {
-    let n = cells.len();
-    let bounds = cells
+    let bounds = bounds_of(cells);
+    if regions {
+        return simplify_in_regions(cells, faces, placement, bounds);
+    }
+    simplify_whole(cells, faces, placement, bounds, &[])
+}
+
+/// [`simplify`] keeping `seams` (edges as sorted vertex pairs, the list sorted): a seam edge
+/// gets constraint planes as a boundary does, and a collapse may neither move a seam nor join
+/// two (Hoppe 1996 §4.3, on discontinuity curves): its removed vertex lies on no seam, or on
+/// exactly two with the collapsed edge one of them. Seams are attribute discontinuities —
+/// uv charts, normal creases, material boundaries — which collapses across would smear. The
+/// single greedy loop only: meshes with seams are simplified without the parallel phase.
+pub fn simplify_keeping_seams(
+    cells: &[[i32; 3]],
+    faces: &[[u32; 3]],
+    placement: Placement,
+    seams: &[[u32; 2]],
+) -> Simplified {
+    let bounds = bounds_of(cells);
+    simplify_whole(cells, faces, placement, bounds, seams)
+}
+
+/// The box of `cells`.
+fn bounds_of(cells: &[[i32; 3]]) -> ([i32; 3], [i32; 3]) {
+    cells
         .iter()
         .fold(([i32::MAX; 3], [i32::MIN; 3]), |(lo, hi), c| {
             (
                 [0, 1, 2].map(|a| lo[a].min(c[a])),
                 [0, 1, 2].map(|a| hi[a].max(c[a])),
             )
-        });
-    if regions {
-        return simplify_in_regions(cells, faces, placement, bounds);
-    }
+        })
+}
+
+/// The single greedy loop over the whole mesh, keeping `seams` (none when empty).
+fn simplify_whole(
+    cells: &[[i32; 3]],
+    faces: &[[u32; 3]],
+    placement: Placement,
+    bounds: ([i32; 3], [i32; 3]),
+    seams: &[[u32; 2]],
+) -> Simplified {
+    let n = cells.len();
     let t = topology(n, faces, &vec![true; faces.len()]);
-    let quadrics = initial_quadrics(cells, faces, &t);
+    let seam: Vec<bool> = if seams.is_empty() {
+        Vec::new()
+    } else {
+        t.edges
+            .iter()
+            .map(|e| seams.binary_search(e).is_ok())
+            .collect()
+    };
+    let mut quadrics = initial_quadrics(cells, faces, &t);
+    if !seam.is_empty() {
+        add_seam_planes(&mut quadrics, cells, faces, &t, &seam);
+    }
     let mut state = State::new(
         cells.to_vec(),
         faces.to_vec(),
@@ -139,6 +182,7 @@ fn simplify_with_regions(
         bounds,
         t,
     );
+    state.seam = seam;
     // When a pass runs dry, every remaining edge is queued again, until a pass collapses nothing.
     let (mut collapses, mut costs) = (Vec::new(), Vec::new());
     while state.collapse_greedily(f32::INFINITY, &mut collapses, &mut costs) > 0 {}

@@ -125,3 +125,35 @@ pub(in crate::hierarchy) fn initial_quadrics(
         })
         .collect()
 }
+
+/// Adds constraint planes through the seam edges (`seam[e]` for each edge of `topology`): on
+/// each face beside a seam, the plane through the edge perpendicular to the face, so that a
+/// seam keeps its course as a boundary does.
+pub(in crate::hierarchy) fn add_seam_planes(
+    quadrics: &mut [Quadric],
+    cells: &[[i32; 3]],
+    faces: &[[u32; 3]],
+    topology: &Topology,
+    seam: &[bool],
+) {
+    for (e, &[u, w]) in topology.edges.iter().enumerate() {
+        if !seam[e] {
+            continue;
+        }
+        let (pu, pw) = (to_f(cells[u as usize]), to_f(cells[w as usize]));
+        for &f in &topology.vfaces[u as usize] {
+            let t = faces[f as usize];
+            if !t.contains(&w) {
+                continue;
+            }
+            let [a, b, c] = t.map(|x| to_f(cells[x as usize]));
+            let side = (pw - pu).cross((b - a).cross(c - a));
+            if side.length_squared() > 0.0 {
+                let m = side.normalize();
+                let plane = Quadric::plane(m, -m.dot(pu), 100.0 * (pw - pu).length_squared());
+                quadrics[u as usize].add(&plane);
+                quadrics[w as usize].add(&plane);
+            }
+        }
+    }
+}

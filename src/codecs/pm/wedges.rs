@@ -1,0 +1,663 @@
+//! The wedges of a progressive mesh, level by level: the base mesh's corners, and what each
+//! vertex split changes (Hoppe 1998 §3's `corners`, wedge deltas and `matid` fields, with our
+//! predictions), written once for both directions over [`Symbols`] (docs/FORMAT.md §5.2).
+//!
+//! Every mesh of the sequence carries a value (a [`CornerCode`]) at every face corner; wedges
+//! are the distinct values at a vertex, as in the canonical mesh. A split of vs changes only the
+//! corners at vs and vt and the corners of vl in fl and vr in fr; the decoder holds the coarse
+//! values of vs's corners before the split and, for each changed corner, reads whether it takes
+//! one of the values its vertex already shows (the coarse value carried over, the value its
+//! neighbour across an edge took, another wedge of the vertex) or a new one. A new value is
+//! predicted from the coarse wedge it refines — for uvs through the affine map that fits that
+//! wedge's chart around vs in the coarse mesh (least squares over the tangent plane), applied
+//! at the corner's new position — and its residual is arithmetic-coded in contexts by how far
+//! the prediction moved it. Face materials of fl and fr are predicted from the faces across
+//! their edges at vl and vr.
+
+use crate::codecs::appearance::coder::Symbols;
+use crate::codecs::appearance::predict::{face_normal, uv_by_fit};
+use crate::coding::arith::{BitContext, IntContext, UintContext};
+use crate::container::AppearanceSpec;
+use crate::error::{Error, Result};
+use crate::hierarchy::pmesh::{PmMesh, Vsplit, NIL};
+use crate::mesh::attribute_quantization::octahedral_max;
+use crate::mesh::canonical_attributes::CornerCode;
+use glam::{DVec2, DVec3};
+
+/// Context sets for a new value's residual, by how far its prediction moved from the coarse
+/// value (log2 buckets of cells).
+const SCALES: usize = 12;
+
+/// The three kinds of changed corner: at vs in a face it keeps, at vt in a face that moved, in
+/// the new faces fl and fr.
+#[derive(Clone, Copy)]
+enum Class {
+    Survivor = 0,
+    Moved = 1,
+    New = 2,
+}
+
+/// Adaptive contexts of the wedge fields, kept across levels.
+#[derive(Default)]
+pub struct WedgeContexts {
+    /// Takes the first / second candidate: [class][candidate].
+    same: [[BitContext; 2]; 3],
+    /// Takes one of the further candidates: [class].
+    other: [BitContext; 3],
+    other_index: UintContext,
+    /// [class][scale][axis]
+    uv: [[[IntContext; 2]; SCALES]; 3],
+    /// [class][axis]
+    normal: [[IntContext; 2]; 3],
+    /// [class][channel]
+    colour: [[IntContext; 4]; 3],
+    material_same: [BitContext; 2],
+    material: UintContext,
+    base_known: BitContext,
+    base_index: UintContext,
+    base_uv: [IntContext; 2],
+    base_normal: [IntContext; 2],
+    base_colour: [IntContext; 4],
+}
+
+/// The corner values and face materials of the current mesh.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WedgeState {
+    /// Values of each face's corners.
+    pub corners: Vec<[CornerCode; 3]>,
+    /// Material of each face, when faces carry materials.
+    pub materials: Option<Vec<u32>>,
+}
+
+/// What one split changed, so that the split can be undone and redone without decoding again.
+#[derive(Clone, Debug)]
+pub struct SplitWedges {
+    /// Faces that existed before the split: values before and after.
+    changed: Vec<(u32, [CornerCode; 3], [CornerCode; 3])>,
+    /// Values and material of fl (and fr).
+    created: Vec<([CornerCode; 3], u32)>,
+}
+
+impl WedgeState {
+    /// Redoes a split's changes on the mesh it was decoded on (the split itself just applied).
+    pub fn redo(&mut self, s: &SplitWedges) {
+        for &(f, _, after) in &s.changed {
+            self.corners[f as usize] = after;
+        }
+        for &(codes, material) in &s.created {
+            self.corners.push(codes);
+            if let Some(m) = self.materials.as_mut() {
+                m.push(material);
+            }
+        }
+    }
+
+    /// Undoes a split's changes (the split itself undone too).
+    pub fn undo(&mut self, s: &SplitWedges) {
+        for _ in &s.created {
+            self.corners.pop();
+            if let Some(m) = self.materials.as_mut() {
+                m.pop();
+            }
+        }
+        for &(f, before, _) in &s.changed {
+            self.corners[f as usize] = before;
+        }
+    }
+}
+
+/// The split's neighbourhood before it applies: vs and its faces as they were.
+pub struct Coarse {
+    vs: u32,
+    faces: Vec<CoarseFace>,
+}
+
+/// One face of vs before the split.
+struct CoarseFace {
+    face: u32,
+    codes: [CornerCode; 3],
+    vs_corner: usize,
+    vertices: [u32; 3],
+    positions: [[i32; 3]; 3],
+}
+
+/// What the decoder knows of vs before `split` applies to `mesh`; `None` if the record does not
+/// locate (the split will fail on it too).
+pub fn coarse(mesh: &PmMesh, state: &WedgeState, split: &Vsplit) -> Option<Coarse> {
+    let face = mesh.faces.get(split.flclw as usize)?;
+    let vs = *face.v.get(split.vs_index as usize)?;
+    let faces = mesh
+        .fan(split.flclw, vs)
+        .into_iter()
+        .map(|f| {
+            let vertices = mesh.faces[f as usize].v;
+            CoarseFace {
+                face: f,
+                codes: state.corners[f as usize],
+                vs_corner: mesh.corner(f, vs).expect("a face of vs's fan"),
+                vertices,
+                positions: vertices.map(|v| mesh.positions[v as usize]),
+            }
+        })
+        .collect();
+    Some(Coarse { vs, faces })
+}
+
+/// The truth of one split for the encoder: every face at vs and vt after it, with its values
+/// and material.
+pub type SplitTruth = Vec<(u32, [CornerCode; 3], u32)>;
+
+fn point(c: [i32; 3]) -> DVec3 {
+    DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)
+}
+
+fn malformed(what: &str) -> Error {
+    Error::malformed(0, 0, format!("vsplit wedges: {what}"))
+}
+
+/// One corner's coding: its candidates (distinct values, likeliest first), and the coarse
+/// value and chart a new value is predicted from.
+struct Corner<'a> {
+    class: Class,
+    candidates: Vec<CornerCode>,
+    chart: Option<CornerCode>,
+    at: [i32; 3],
+    coarse: &'a Coarse,
+}
+
+/// Codes the wedges of the split that just applied to `mesh` (whose state before it `coarse`
+/// describes), updating `state`; the encoder passes `truth`. On an error `state` is left as
+/// it was before the split.
+pub fn code_split(
+    symbols: &mut impl Symbols,
+    contexts: &mut WedgeContexts,
+    mesh: &PmMesh,
+    state: &mut WedgeState,
+    coarse: &Coarse,
+    spec: &AppearanceSpec,
+    truth: Option<&SplitTruth>,
+) -> Result<SplitWedges> {
+    let faces = state.corners.len();
+    let coded = code_split_fields(symbols, contexts, mesh, state, coarse, spec, truth);
+    if coded.is_err() {
+        state.corners.truncate(faces);
+        if let Some(m) = state.materials.as_mut() {
+            m.truncate(faces);
+        }
+        for c in &coarse.faces {
+            state.corners[c.face as usize] = c.codes;
+        }
+    }
+    coded
+}
+
+fn code_split_fields(
+    symbols: &mut impl Symbols,
+    contexts: &mut WedgeContexts,
+    mesh: &PmMesh,
+    state: &mut WedgeState,
+    coarse: &Coarse,
+    spec: &AppearanceSpec,
+    truth: Option<&SplitTruth>,
+) -> Result<SplitWedges> {
+    let vs = coarse.vs;
+    let vt = mesh.positions.len() as u32 - 1;
+    let last = mesh.faces.len() as u32 - 1;
+    let (fl, fr) = if mesh.faces[last as usize].v[1] == vt {
+        (last - 1, last)
+    } else {
+        (last, NIL)
+    };
+    let created = if fr == NIL { 1 } else { 2 };
+    let truth_of = |f: u32| -> ([CornerCode; 3], u32) {
+        truth
+            .and_then(|t| t.iter().find(|x| x.0 == f))
+            .map_or(([CornerCode::default(); 3], 0), |x| (x.1, x.2))
+    };
+    let coarse_of = |f: u32| coarse.faces.iter().find(|x| x.face == f);
+    for _ in 0..created {
+        state.corners.push([CornerCode::default(); 3]);
+        if let Some(m) = state.materials.as_mut() {
+            m.push(0);
+        }
+    }
+    // Values decoded at vs and vt so far, and what each coarse value became there.
+    let mut known_s: Vec<CornerCode> = Vec::new();
+    let mut known_t: Vec<CornerCode> = Vec::new();
+    let mut map_s: Vec<(CornerCode, CornerCode)> = Vec::new();
+    let mut map_t: Vec<(CornerCode, CornerCode)> = Vec::new();
+    let corner_of = |f: u32, v: u32| mesh.corner(f, v).expect("a corner of the face");
+    let value_at = |state: &WedgeState, f: u32, v: u32| -> Option<CornerCode> {
+        if f == NIL {
+            return None;
+        }
+        mesh.corner(f, v).map(|k| state.corners[f as usize][k])
+    };
+    let push_distinct = |list: &mut Vec<CornerCode>, c: CornerCode| {
+        if !list.contains(&c) {
+            list.push(c);
+        }
+    };
+    let candidates_of = |first: &[Option<CornerCode>], rest: &[CornerCode]| {
+        let mut out: Vec<CornerCode> = Vec::new();
+        for c in first.iter().flatten().chain(rest) {
+            if !out.contains(c) {
+                out.push(*c);
+            }
+        }
+        out
+    };
+    // Faces vs keeps, then faces that moved to vt.
+    let fan_s: Vec<u32> = mesh.fan(fl, vs);
+    let fan_t: Vec<u32> = mesh.fan(fl, vt);
+    for (v, fan) in [(vs, &fan_s), (vt, &fan_t)] {
+        for &g in fan.iter().filter(|&&g| g != fl && g != fr) {
+            let k = corner_of(g, v);
+            let c = coarse_of(g)
+                .ok_or_else(|| malformed("a face of the split was not vs's"))?
+                .codes[k];
+            let (known, map) = if v == vs {
+                (&mut known_s, &mut map_s)
+            } else {
+                (&mut known_t, &mut map_t)
+            };
+            let mapped = map.iter().find(|x| x.0 == c).map(|x| x.1);
+            let first = if v == vs { mapped.or(Some(c)) } else { mapped };
+            let corner = Corner {
+                class: if v == vs {
+                    Class::Survivor
+                } else {
+                    Class::Moved
+                },
+                candidates: candidates_of(&[first], known),
+                chart: Some(c),
+                at: mesh.positions[v as usize],
+                coarse,
+            };
+            let value = code_corner(symbols, contexts, spec, &corner, truth_of(g).0[k])?;
+            if !map.iter().any(|x| x.0 == c) {
+                map.push((c, value));
+            }
+            push_distinct(known, value);
+            state.corners[g as usize][k] = value;
+        }
+    }
+    // fl = (vs, vl, vt), fr = (vs, vt, vr): neighbours x across (vs, vl), f0 across (vl, vt);
+    // fk across (vt, vr), y across (vr, vs).
+    for f in [fl, fr] {
+        if f == NIL {
+            continue;
+        }
+        let face = mesh.faces[f as usize];
+        let (beside_s, beside_t, other) = if f == fl {
+            (face.nei[0], face.nei[1], face.v[1])
+        } else {
+            (face.nei[2], face.nei[1], face.v[2])
+        };
+        let chart = |g: u32| coarse_of(g).map(|c| c.codes[c.vs_corner]);
+        let fallback = coarse.faces.first().map(|c| c.codes[c.vs_corner]);
+        let chart_s = (beside_s != NIL)
+            .then(|| chart(beside_s))
+            .flatten()
+            .or(fallback);
+        let chart_t = (beside_t != NIL)
+            .then(|| chart(beside_t))
+            .flatten()
+            .or(chart_s);
+        let (truth_codes, truth_material) = truth_of(f);
+        if let Some(materials) = state.materials.as_mut() {
+            let around = [beside_s, beside_t].map(|g| (g != NIL).then(|| materials[g as usize]));
+            let names = spec.materials.as_ref().map_or(0, |m| m.names.len());
+            materials[f as usize] =
+                code_material(symbols, contexts, &around, truth_material, names)?;
+        }
+        for (v, class_chart) in [(vs, chart_s), (vt, chart_t), (other, chart_s)] {
+            let k = corner_of(f, v);
+            let neighbour_s = value_at(state, beside_s, v);
+            let neighbour_t = value_at(state, beside_t, v);
+            let across = if f == fl {
+                value_at(state, fr, v)
+            } else {
+                value_at(state, fl, v)
+            };
+            let rest: &[CornerCode] = if v == vs {
+                &known_s
+            } else if v == vt {
+                &known_t
+            } else {
+                &[]
+            };
+            let first = if v == vt {
+                [neighbour_t, neighbour_s, across]
+            } else {
+                [neighbour_s, neighbour_t, across]
+            };
+            let corner = Corner {
+                class: Class::New,
+                candidates: candidates_of(&first, rest),
+                chart: class_chart,
+                at: mesh.positions[v as usize],
+                coarse,
+            };
+            let value = code_corner(symbols, contexts, spec, &corner, truth_codes[k])?;
+            state.corners[f as usize][k] = value;
+            if v == vs {
+                push_distinct(&mut known_s, value);
+            } else if v == vt {
+                push_distinct(&mut known_t, value);
+            }
+        }
+    }
+    let changed = coarse
+        .faces
+        .iter()
+        .map(|c| (c.face, c.codes, state.corners[c.face as usize]))
+        .collect();
+    let created = (0..created)
+        .map(|i| {
+            let f = fl as usize + i;
+            (
+                state.corners[f],
+                state.materials.as_ref().map_or(0, |m| m[f]),
+            )
+        })
+        .collect();
+    Ok(SplitWedges { changed, created })
+}
+
+fn code_material(
+    symbols: &mut impl Symbols,
+    contexts: &mut WedgeContexts,
+    around: &[Option<u32>; 2],
+    value: u32,
+    names: usize,
+) -> Result<u32> {
+    let mut tried: Vec<u32> = Vec::new();
+    for (i, m) in around.iter().flatten().enumerate() {
+        if tried.contains(m) {
+            continue;
+        }
+        tried.push(*m);
+        if symbols.bit(&mut contexts.material_same[i], value == *m, "material")? {
+            return Ok(*m);
+        }
+    }
+    let id = symbols.uint(&mut contexts.material, value as u64, "material")?;
+    if id >= names as u64 {
+        return Err(malformed("material id beyond the names"));
+    }
+    Ok(id as u32)
+}
+
+/// Codes one corner's value: one of its candidates, or a new value predicted from its chart.
+fn code_corner(
+    symbols: &mut impl Symbols,
+    contexts: &mut WedgeContexts,
+    spec: &AppearanceSpec,
+    corner: &Corner,
+    value: CornerCode,
+) -> Result<CornerCode> {
+    let class = corner.class as usize;
+    let candidates = &corner.candidates;
+    for (i, &c) in candidates.iter().take(2).enumerate() {
+        if symbols.bit(&mut contexts.same[class][i], value == c, "wedge")? {
+            return Ok(c);
+        }
+    }
+    if candidates.len() > 2 {
+        let rest = &candidates[2..];
+        let index = rest.iter().position(|&c| c == value);
+        if symbols.bit(&mut contexts.other[class], index.is_some(), "wedge")? {
+            let i = symbols.uint(
+                &mut contexts.other_index,
+                index.unwrap_or(0) as u64,
+                "wedge",
+            )?;
+            return rest
+                .get(i as usize)
+                .copied()
+                .ok_or_else(|| malformed("wedge index beyond the vertex's wedges"));
+        }
+    }
+    let chart = corner.chart.unwrap_or_default();
+    let mut out = CornerCode::default();
+    if let Some(bits) = spec.normal_bits {
+        let predicted = chart.normal.unwrap_or_default();
+        let truth = value.normal.unwrap_or_default();
+        let max = octahedral_max(bits) as i64;
+        let mut n = [0u32; 2];
+        for axis in 0..2 {
+            let d = symbols.int(
+                &mut contexts.normal[class][axis],
+                truth[axis] as i64 - predicted[axis] as i64,
+                "normal",
+            )?;
+            n[axis] = within(predicted[axis] as i64 + d, max + 1, "normal")?;
+        }
+        out.normal = Some(n);
+    }
+    if let Some(grid) = spec.uv_grid {
+        let cells = 1i64 << grid.bits;
+        let from = chart.uv.unwrap_or_default();
+        let predicted = match corner.chart {
+            Some(c) => predict_uv(corner.coarse, c, corner.at).map_or(from, |t| {
+                let last = (cells - 1) as f64;
+                [t.x, t.y].map(|x| {
+                    if x.is_finite() {
+                        x.round().clamp(0.0, last) as u32
+                    } else {
+                        0
+                    }
+                })
+            }),
+            None => from,
+        };
+        let moved = (0..2)
+            .map(|a| predicted[a].abs_diff(from[a]))
+            .max()
+            .unwrap_or(0);
+        let scale = ((32 - moved.leading_zeros()) as usize).min(SCALES - 1);
+        let truth = value.uv.unwrap_or_default();
+        let mut t = [0u32; 2];
+        for axis in 0..2 {
+            let d = symbols.int(
+                &mut contexts.uv[class][scale][axis],
+                truth[axis] as i64 - predicted[axis] as i64,
+                "uv",
+            )?;
+            t[axis] = within(predicted[axis] as i64 + d, cells, "uv")?;
+        }
+        out.uv = Some(t);
+    }
+    if spec.colours {
+        let predicted = chart.colour.unwrap_or_default();
+        let truth = value.colour.unwrap_or_default();
+        let mut rgba = [0u8; 4];
+        for channel in 0..4 {
+            let d = symbols.int(
+                &mut contexts.colour[class][channel],
+                truth[channel].wrapping_sub(predicted[channel]) as i8 as i64,
+                "colour",
+            )?;
+            if !(-128..=127).contains(&d) {
+                return Err(malformed("colour residual out of range"));
+            }
+            rgba[channel] = predicted[channel].wrapping_add(d as i8 as u8);
+        }
+        out.colour = Some(rgba);
+    }
+    Ok(out)
+}
+
+/// The uv at `at` by the affine map that fits the coarse chart of `chart` around vs: the
+/// corners of vs's coarse faces whose vs corner has that value.
+fn predict_uv(coarse: &Coarse, chart: CornerCode, at: [i32; 3]) -> Option<DVec2> {
+    let mut pairs: Vec<(DVec3, DVec2)> = Vec::with_capacity(2 * coarse.faces.len() + 1);
+    let mut seen: Vec<u32> = Vec::with_capacity(pairs.capacity());
+    let mut normal = DVec3::ZERO;
+    for c in coarse
+        .faces
+        .iter()
+        .filter(|c| c.codes[c.vs_corner] == chart)
+    {
+        let p = c.positions.map(point);
+        normal += face_normal(p[0], p[1], p[2]);
+        for ((&v, code), &at) in c.vertices.iter().zip(&c.codes).zip(&p) {
+            if seen.contains(&v) {
+                continue;
+            }
+            if let Some(t) = code.uv {
+                seen.push(v);
+                pairs.push((at, DVec2::new(t[0] as f64, t[1] as f64)));
+            }
+        }
+    }
+    uv_by_fit(point(at), normal, &pairs)
+}
+
+/// `value` when it lies in 0..`limit`; a malformed record otherwise.
+fn within(value: i64, limit: i64, what: &str) -> Result<u32> {
+    if value < 0 || value >= limit {
+        return Err(malformed(&format!("{what} value {value} outside the grid")));
+    }
+    Ok(value as u32)
+}
+
+/// Codes the base mesh's corner values and materials (the encoder passes `truth`).
+pub fn code_base(
+    symbols: &mut impl Symbols,
+    contexts: &mut WedgeContexts,
+    mesh: &PmMesh,
+    spec: &AppearanceSpec,
+    truth: Option<&WedgeState>,
+) -> Result<WedgeState> {
+    let mut state = WedgeState {
+        corners: Vec::with_capacity(mesh.faces.len()),
+        materials: spec
+            .materials
+            .as_ref()
+            .map(|_| Vec::with_capacity(mesh.faces.len())),
+    };
+    let mut known: Vec<Vec<CornerCode>> = vec![Vec::new(); mesh.positions.len()];
+    let mut previous = CornerCode::default();
+    let mut previous_material = None;
+    for (f, face) in mesh.faces.iter().enumerate() {
+        if let Some(materials) = state.materials.as_mut() {
+            let value = truth.and_then(|t| t.materials.as_ref()).map_or(0, |m| m[f]);
+            let names = spec.materials.as_ref().map_or(0, |m| m.names.len());
+            let id = code_material(symbols, contexts, &[previous_material, None], value, names)?;
+            materials.push(id);
+            previous_material = Some(id);
+        }
+        let mut codes = [CornerCode::default(); 3];
+        for (k, slot) in codes.iter_mut().enumerate() {
+            let v = face.v[k] as usize;
+            let value = truth.map_or(CornerCode::default(), |t| t.corners[f][k]);
+            let index = known[v].iter().position(|&c| c == value);
+            let code = if !known[v].is_empty()
+                && symbols.bit(&mut contexts.base_known, index.is_some(), "wedge")?
+            {
+                let i =
+                    symbols.uint(&mut contexts.base_index, index.unwrap_or(0) as u64, "wedge")?;
+                *known[v]
+                    .get(i as usize)
+                    .ok_or_else(|| malformed("base wedge index beyond the vertex's wedges"))?
+            } else {
+                let code = code_base_value(symbols, contexts, spec, previous, value)?;
+                known[v].push(code);
+                previous = code;
+                code
+            };
+            *slot = code;
+        }
+        state.corners.push(codes);
+    }
+    Ok(state)
+}
+
+fn code_base_value(
+    symbols: &mut impl Symbols,
+    contexts: &mut WedgeContexts,
+    spec: &AppearanceSpec,
+    previous: CornerCode,
+    value: CornerCode,
+) -> Result<CornerCode> {
+    let mut out = CornerCode::default();
+    if let Some(bits) = spec.normal_bits {
+        let (p, t) = (
+            previous.normal.unwrap_or_default(),
+            value.normal.unwrap_or_default(),
+        );
+        let max = octahedral_max(bits) as i64;
+        let mut n = [0u32; 2];
+        for axis in 0..2 {
+            let d = symbols.int(
+                &mut contexts.base_normal[axis],
+                t[axis] as i64 - p[axis] as i64,
+                "normal",
+            )?;
+            n[axis] = within(p[axis] as i64 + d, max + 1, "normal")?;
+        }
+        out.normal = Some(n);
+    }
+    if let Some(grid) = spec.uv_grid {
+        let (p, t) = (
+            previous.uv.unwrap_or_default(),
+            value.uv.unwrap_or_default(),
+        );
+        let mut uv = [0u32; 2];
+        for axis in 0..2 {
+            let d = symbols.int(
+                &mut contexts.base_uv[axis],
+                t[axis] as i64 - p[axis] as i64,
+                "uv",
+            )?;
+            uv[axis] = within(p[axis] as i64 + d, 1i64 << grid.bits, "uv")?;
+        }
+        out.uv = Some(uv);
+    }
+    if spec.colours {
+        let (p, t) = (
+            previous.colour.unwrap_or_default(),
+            value.colour.unwrap_or_default(),
+        );
+        let mut rgba = [0u8; 4];
+        for channel in 0..4 {
+            let d = symbols.int(
+                &mut contexts.base_colour[channel],
+                t[channel].wrapping_sub(p[channel]) as i8 as i64,
+                "colour",
+            )?;
+            if !(-128..=127).contains(&d) {
+                return Err(malformed("colour residual out of range"));
+            }
+            rgba[channel] = p[channel].wrapping_add(d as i8 as u8);
+        }
+        out.colour = Some(rgba);
+    }
+    Ok(out)
+}
+
+/// Faces' values around the mesh's wedges, for the codec's level meshes: wedge ids in order of
+/// first corner, face by face.
+pub fn weld(state: &WedgeState, mesh: &PmMesh) -> (Vec<[u32; 3]>, Vec<u32>, Vec<CornerCode>) {
+    let mut ids: std::collections::HashMap<(u32, CornerCode), u32> =
+        std::collections::HashMap::with_capacity(mesh.positions.len() * 2);
+    let mut wedge_vertex = Vec::new();
+    let mut codes = Vec::new();
+    let corners = mesh
+        .faces
+        .iter()
+        .zip(&state.corners)
+        .map(|(face, values)| {
+            std::array::from_fn(|k| {
+                *ids.entry((face.v[k], values[k])).or_insert_with(|| {
+                    wedge_vertex.push(face.v[k]);
+                    codes.push(values[k]);
+                    wedge_vertex.len() as u32 - 1
+                })
+            })
+        })
+        .collect();
+    (corners, wedge_vertex, codes)
+}
