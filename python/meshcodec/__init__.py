@@ -31,9 +31,10 @@ from typing import IO, Any, Dict, Iterator, List, Optional, Union
 import numpy as np
 
 from . import _core
-from ._core import FORMAT_VERSION, MeshcodecError, TruncatedStreamError
+from ._core import APPEARANCE_UNIT_VERSION, FORMAT_VERSION, MeshcodecError, TruncatedStreamError
 
 __all__ = [
+    "APPEARANCE_UNIT_VERSION",
     "FORMAT_VERSION",
     "Appearance",
     "Mesh",
@@ -55,7 +56,7 @@ Bytes = Union[bytes, bytearray, memoryview]
 PathLike = Union[str, "os.PathLike[str]"]
 
 # What `encode` accepts beyond the arrays, codec and quantization.
-_CODEC_OPTIONS = ("grid", "uv_bits", "normal_bits")
+_CODEC_OPTIONS = ("grid", "uv_bits", "normal_bits", "attributes")
 
 
 @dataclass
@@ -241,6 +242,10 @@ def encode(
             lossless codec carries it, ``came-paper`` refuses it.
         uv_bits: bits per uv axis over the uvs' bounding box (default 12).
         normal_bits: bits per octahedral normal coordinate (default 10).
+        attributes: ``pm`` and ``pm-reordered`` only: "fit" or "keep" codes the appearance
+            inside the vertex splits, so that every level carries it (a collapsed wedge takes
+            the values interpolated to where its vertex went, or the survivor's); the stream
+            is then format version :data:`FORMAT_VERSION`, else :data:`APPEARANCE_UNIT_VERSION`.
 
     Raises:
         MeshcodecError: bad arrays, an unknown codec or option, a mesh the codec refuses
@@ -263,6 +268,7 @@ def encode(
         None if appearance is None else appearance._dict(),
         _bits(codec_options.get("uv_bits", 12)),
         _bits(codec_options.get("normal_bits", 10)),
+        codec_options.get("attributes"),
     )
 
 

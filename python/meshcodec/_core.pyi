@@ -6,6 +6,7 @@ import numpy as np
 import numpy.typing as npt
 
 FORMAT_VERSION: int
+APPEARANCE_UNIT_VERSION: int
 
 class MeshcodecError(ValueError): ...
 class TruncatedStreamError(MeshcodecError): ...
@@ -23,6 +24,7 @@ def encode(
     appearance: Optional[_Appearance] = None,
     uv_bits: int = 12,
     normal_bits: int = 10,
+    attributes: Optional[str] = None,
 ) -> bytes: ...
 def canonical(
     vertices: npt.NDArray[np.float64],

@@ -9,7 +9,7 @@
 //! decoded, read, written or measured.
 
 use meshcodec::codecs::{self, Capability, Codec, EncodeOptions, LevelDecoder, LevelMesh, Stop};
-use meshcodec::container::{StreamReader, FORMAT_VERSION};
+use meshcodec::container::{StreamReader, APPEARANCE_UNIT_VERSION, FORMAT_VERSION};
 use meshcodec::mesh::attribute_quantization::AttributeBits;
 use meshcodec::mesh::attributes::{AttributedMesh, Attributes, Materials};
 use meshcodec::mesh::io;
@@ -315,9 +315,10 @@ fn grid_shape(grid: Option<&str>, default: GridShape) -> PyResult<GridShape> {
 }
 
 /// Encodes a mesh, with its appearance when given (uvs on `uv_bits`, normals octahedral on
-/// `normal_bits`); returns the stream.
+/// `normal_bits`; inside the levels by the rule `attributes`, "fit" or "keep", for pm);
+/// returns the stream.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, codec_name, quant_bits, grid=None, appearance=None, uv_bits=12, normal_bits=10))]
+#[pyo3(signature = (vertices, faces, codec_name, quant_bits, grid=None, appearance=None, uv_bits=12, normal_bits=10, attributes=None))]
 #[allow(clippy::too_many_arguments)]
 fn encode<'py>(
     py: Python<'py>,
@@ -329,8 +330,13 @@ fn encode<'py>(
     appearance: Option<Bound<'py, PyDict>>,
     uv_bits: u8,
     normal_bits: u8,
+    attributes: Option<&str>,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let codec = codec(codec_name)?;
+    let in_levels = attributes
+        .map(codecs::AttributeFit::by_name)
+        .transpose()
+        .map_err(to_py)?;
     let options = EncodeOptions {
         quant_bits,
         grid: grid_shape(grid, codec.default_options().grid)?,
@@ -356,7 +362,8 @@ fn encode<'py>(
                 let attributed = AttributedMesh { mesh, attributes };
                 let (canonical, appearance) =
                     codecs::canonical_attributed_for(&attributed, &options, bits)?;
-                codecs::encode_attributed(codec, &canonical, Some(&appearance)).map(|e| e.bytes)
+                codecs::encode_attributed_with(codec, &canonical, Some(&appearance), in_levels)
+                    .map(|e| e.bytes)
             }
         })
         .map_err(to_py)?;
@@ -697,6 +704,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.py().get_type::<TruncatedStreamError>(),
     )?;
     m.add("FORMAT_VERSION", FORMAT_VERSION)?;
+    m.add("APPEARANCE_UNIT_VERSION", APPEARANCE_UNIT_VERSION)?;
     m.add_class::<LevelIterator>()?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(decode, m)?)?;

@@ -170,7 +170,7 @@ def test_info_reads_the_header_and_index():
     stream = meshcodec.encode(mesh.vertices, mesh.faces, codec="came", quant_bits=14)
     about = meshcodec.info(stream)
     assert about["codec"] == "came" and about["quant_bits"] == 14
-    assert about["format_version"] == 2  # geometry alone; a stream with appearance is FORMAT_VERSION
+    assert about["format_version"] == 2  # geometry alone; a stream with an appearance unit is APPEARANCE_UNIT_VERSION
     assert about["bytes"] == about["stream_bytes"] == len(stream)
     assert not about["layered"] and not about["truncated"]
     units = about["units"]
@@ -203,7 +203,7 @@ def test_appearance_is_loaded_coded_decoded_and_saved(tmp_path):
     assert a.corners.shape == (mesh.face_count, 3) and a.material_names == ["01_-_Default"]
     assert meshcodec.load(MESHES / "bunny-10k-textured.obj", drop_attributes=True).appearance is None
     stream = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc", appearance=a)
-    assert meshcodec.info(stream)["format_version"] == meshcodec.FORMAT_VERSION
+    assert meshcodec.info(stream)["format_version"] == meshcodec.APPEARANCE_UNIT_VERSION
     plain = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc")
     assert len(plain) < len(stream) and meshcodec.info(plain)["format_version"] == 2
     levels = list(meshcodec.levels(stream))
@@ -221,6 +221,15 @@ def test_appearance_is_loaded_coded_decoded_and_saved(tmp_path):
     assert again.appearance.wedge_count == 6451
     assert np.allclose(again.appearance.uvs[again.appearance.corners],
                        decoded_corner_uvs, atol=1e-6)
+    # pm can carry the appearance inside its splits: every level then has it.
+    in_levels = meshcodec.encode(mesh.vertices, mesh.faces, codec="pm-reordered", appearance=a,
+                                 attributes="keep")
+    assert meshcodec.info(in_levels)["format_version"] == meshcodec.FORMAT_VERSION
+    pm_levels = list(meshcodec.levels(in_levels))
+    assert len(pm_levels) > 1 and all(l.appearance is not None for l in pm_levels)
+    assert pm_levels[-1].appearance.wedge_count == 6451
+    with pytest.raises(meshcodec.MeshcodecError, match="after its last level"):
+        meshcodec.encode(mesh.vertices, mesh.faces, codec="emc", appearance=a, attributes="fit")
     # came-paper's full level is lossy: it refuses appearance.
     with pytest.raises(meshcodec.MeshcodecError, match="cannot carry"):
         meshcodec.encode(mesh.vertices, mesh.faces, codec="came-paper", appearance=a)

@@ -420,69 +420,101 @@ fn code_corner(
         }
     }
     let chart = corner.chart.unwrap_or_default();
+    // A uv is predicted through the chart's fit; its contexts follow how far that moved it.
+    let mut predicted = chart;
+    let mut scale = 0;
+    if let (Some(grid), Some(c)) = (spec.uv_grid, corner.chart) {
+        let from = chart.uv.unwrap_or_default();
+        let last = ((1u64 << grid.bits) - 1) as f64;
+        let fitted = predict_uv(corner.coarse, c, corner.at).map_or(from, |t| {
+            [t.x, t.y].map(|x| {
+                if x.is_finite() {
+                    x.round().clamp(0.0, last) as u32
+                } else {
+                    0
+                }
+            })
+        });
+        let moved = (0..2)
+            .map(|a| fitted[a].abs_diff(from[a]))
+            .max()
+            .unwrap_or(0);
+        scale = ((32 - moved.leading_zeros()) as usize).min(SCALES - 1);
+        predicted.uv = Some(fitted);
+    }
+    let residuals = Residuals {
+        normal: &mut contexts.normal[class],
+        uv: &mut contexts.uv[class][scale],
+        colour: &mut contexts.colour[class],
+    };
+    code_value(symbols, residuals, spec, predicted, value)
+}
+
+/// The contexts of one value's residuals.
+struct Residuals<'a> {
+    normal: &'a mut [IntContext; 2],
+    uv: &'a mut [IntContext; 2],
+    colour: &'a mut [IntContext; 4],
+}
+
+/// Codes `value` as its residuals from `predicted`, field by field as `spec` declares.
+fn code_value(
+    symbols: &mut impl Symbols,
+    contexts: Residuals,
+    spec: &AppearanceSpec,
+    predicted: CornerCode,
+    value: CornerCode,
+) -> Result<CornerCode> {
     let mut out = CornerCode::default();
     if let Some(bits) = spec.normal_bits {
-        let predicted = chart.normal.unwrap_or_default();
-        let truth = value.normal.unwrap_or_default();
+        let (p, t) = (
+            predicted.normal.unwrap_or_default(),
+            value.normal.unwrap_or_default(),
+        );
         let max = octahedral_max(bits) as i64;
         let mut n = [0u32; 2];
         for axis in 0..2 {
             let d = symbols.int(
-                &mut contexts.normal[class][axis],
-                truth[axis] as i64 - predicted[axis] as i64,
+                &mut contexts.normal[axis],
+                t[axis] as i64 - p[axis] as i64,
                 "normal",
             )?;
-            n[axis] = within(predicted[axis] as i64 + d, max + 1, "normal")?;
+            n[axis] = within(p[axis] as i64 + d, max + 1, "normal")?;
         }
         out.normal = Some(n);
     }
     if let Some(grid) = spec.uv_grid {
-        let cells = 1i64 << grid.bits;
-        let from = chart.uv.unwrap_or_default();
-        let predicted = match corner.chart {
-            Some(c) => predict_uv(corner.coarse, c, corner.at).map_or(from, |t| {
-                let last = (cells - 1) as f64;
-                [t.x, t.y].map(|x| {
-                    if x.is_finite() {
-                        x.round().clamp(0.0, last) as u32
-                    } else {
-                        0
-                    }
-                })
-            }),
-            None => from,
-        };
-        let moved = (0..2)
-            .map(|a| predicted[a].abs_diff(from[a]))
-            .max()
-            .unwrap_or(0);
-        let scale = ((32 - moved.leading_zeros()) as usize).min(SCALES - 1);
-        let truth = value.uv.unwrap_or_default();
-        let mut t = [0u32; 2];
+        let (p, t) = (
+            predicted.uv.unwrap_or_default(),
+            value.uv.unwrap_or_default(),
+        );
+        let mut uv = [0u32; 2];
         for axis in 0..2 {
             let d = symbols.int(
-                &mut contexts.uv[class][scale][axis],
-                truth[axis] as i64 - predicted[axis] as i64,
+                &mut contexts.uv[axis],
+                t[axis] as i64 - p[axis] as i64,
                 "uv",
             )?;
-            t[axis] = within(predicted[axis] as i64 + d, cells, "uv")?;
+            uv[axis] = within(p[axis] as i64 + d, 1i64 << grid.bits, "uv")?;
         }
-        out.uv = Some(t);
+        out.uv = Some(uv);
     }
     if spec.colours {
-        let predicted = chart.colour.unwrap_or_default();
-        let truth = value.colour.unwrap_or_default();
+        let (p, t) = (
+            predicted.colour.unwrap_or_default(),
+            value.colour.unwrap_or_default(),
+        );
         let mut rgba = [0u8; 4];
         for channel in 0..4 {
             let d = symbols.int(
-                &mut contexts.colour[class][channel],
-                truth[channel].wrapping_sub(predicted[channel]) as i8 as i64,
+                &mut contexts.colour[channel],
+                t[channel].wrapping_sub(p[channel]) as i8 as i64,
                 "colour",
             )?;
             if !(-128..=127).contains(&d) {
                 return Err(malformed("colour residual out of range"));
             }
-            rgba[channel] = predicted[channel].wrapping_add(d as i8 as u8);
+            rgba[channel] = p[channel].wrapping_add(d as i8 as u8);
         }
         out.colour = Some(rgba);
     }
@@ -563,7 +595,12 @@ pub fn code_base(
                     .get(i as usize)
                     .ok_or_else(|| malformed("base wedge index beyond the vertex's wedges"))?
             } else {
-                let code = code_base_value(symbols, contexts, spec, previous, value)?;
+                let residuals = Residuals {
+                    normal: &mut contexts.base_normal,
+                    uv: &mut contexts.base_uv,
+                    colour: &mut contexts.base_colour,
+                };
+                let code = code_value(symbols, residuals, spec, previous, value)?;
                 known[v].push(code);
                 previous = code;
                 code
@@ -573,69 +610,6 @@ pub fn code_base(
         state.corners.push(codes);
     }
     Ok(state)
-}
-
-fn code_base_value(
-    symbols: &mut impl Symbols,
-    contexts: &mut WedgeContexts,
-    spec: &AppearanceSpec,
-    previous: CornerCode,
-    value: CornerCode,
-) -> Result<CornerCode> {
-    let mut out = CornerCode::default();
-    if let Some(bits) = spec.normal_bits {
-        let (p, t) = (
-            previous.normal.unwrap_or_default(),
-            value.normal.unwrap_or_default(),
-        );
-        let max = octahedral_max(bits) as i64;
-        let mut n = [0u32; 2];
-        for axis in 0..2 {
-            let d = symbols.int(
-                &mut contexts.base_normal[axis],
-                t[axis] as i64 - p[axis] as i64,
-                "normal",
-            )?;
-            n[axis] = within(p[axis] as i64 + d, max + 1, "normal")?;
-        }
-        out.normal = Some(n);
-    }
-    if let Some(grid) = spec.uv_grid {
-        let (p, t) = (
-            previous.uv.unwrap_or_default(),
-            value.uv.unwrap_or_default(),
-        );
-        let mut uv = [0u32; 2];
-        for axis in 0..2 {
-            let d = symbols.int(
-                &mut contexts.base_uv[axis],
-                t[axis] as i64 - p[axis] as i64,
-                "uv",
-            )?;
-            uv[axis] = within(p[axis] as i64 + d, 1i64 << grid.bits, "uv")?;
-        }
-        out.uv = Some(uv);
-    }
-    if spec.colours {
-        let (p, t) = (
-            previous.colour.unwrap_or_default(),
-            value.colour.unwrap_or_default(),
-        );
-        let mut rgba = [0u8; 4];
-        for channel in 0..4 {
-            let d = symbols.int(
-                &mut contexts.base_colour[channel],
-                t[channel].wrapping_sub(p[channel]) as i8 as i64,
-                "colour",
-            )?;
-            if !(-128..=127).contains(&d) {
-                return Err(malformed("colour residual out of range"));
-            }
-            rgba[channel] = p[channel].wrapping_add(d as i8 as u8);
-        }
-        out.colour = Some(rgba);
-    }
-    Ok(out)
 }
 
 /// Faces' values around the mesh's wedges, for the codec's level meshes: wedge ids in order of
