@@ -311,10 +311,14 @@ fn code_split_fields(
             materials[f as usize] =
                 code_material(symbols, contexts, &around, truth_material, names)?;
         }
-        for (v, class_chart) in [(vs, chart_s), (vt, chart_t), (other, chart_s)] {
+        // A new value at vs or vt in fl / fr starts a wedge across a seam from the neighbour
+        // beside it: it continues the chart on the other side (vs: the moved faces', vt: the
+        // kept faces'). At vl / vr it is predicted from that vertex's value beside it.
+        for (v, seam_chart) in [(vs, Some(chart_t)), (vt, Some(chart_s)), (other, None)] {
             let k = corner_of(f, v);
             let neighbour_s = value_at(state, beside_s, v);
             let neighbour_t = value_at(state, beside_t, v);
+            let class_chart = seam_chart.unwrap_or_else(|| neighbour_s.or(neighbour_t).or(chart_s));
             let across = if f == fl {
                 value_at(state, fr, v)
             } else {
