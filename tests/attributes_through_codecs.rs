@@ -217,3 +217,77 @@ fn pm_carries_appearance_at_every_level_with_either_rule() {
         }
     }
 }
+
+#[test]
+fn a_pm_geomorph_carries_appearance_from_the_coarse_corners_to_the_fine_ones() {
+    use meshcodec::codecs::pm::iter::{Geomorph, PMeshIter};
+    use meshcodec::codecs::AttributeFit;
+    let mesh = read_attributed(&resolve("spot").unwrap()).unwrap();
+    let codec = codecs::by_name("pm").unwrap();
+    let mut options = codec.default_options();
+    options.quant_bits = 12;
+    let (canonical, appearance) =
+        codecs::canonical_attributed_for(&mesh, &options, AttributeBits::default()).unwrap();
+    let encoded = codecs::encode_attributed_with(
+        codec,
+        &canonical,
+        Some(&appearance),
+        Some(AttributeFit::Fit),
+    )
+    .unwrap();
+    let mut iter = PMeshIter::from_stream(&encoded.bytes).unwrap();
+    iter.goto_nvertices(iter.nvertices() + 200).unwrap();
+    let coarse_mesh = iter.level_mesh();
+    let coarse = coarse_mesh.attributes.unwrap();
+    let coarse_faces = iter.nfaces();
+    let fine_n = iter.nvertices() * 3;
+    let morph = Geomorph::new(&mut iter, fine_n).unwrap();
+    let fine = iter.attributes().unwrap();
+    let uv_of = |a: &meshcodec::mesh::attributes::Attributes, f: usize, k: usize| {
+        a.uvs.as_ref().unwrap()[a.corners[f][k] as usize]
+    };
+    // Alpha 1: every corner has Mᶠ's value.
+    let at1 = morph.evaluate_appearance(1.0).unwrap();
+    assert_eq!(at1.corners.len(), fine.corners.len());
+    for f in 0..fine.corners.len() {
+        for k in 0..3 {
+            assert_eq!(uv_of(&at1, f, k), uv_of(&fine, f, k));
+        }
+    }
+    assert_eq!(at1.materials, fine.materials);
+    // Alpha 0: a face of Mᶜ has its Mᶜ values; a face created since has, at each corner, one of
+    // the values its ancestor vertex shows in Mᶜ.
+    let at0 = morph.evaluate_appearance(0.0).unwrap();
+    let ancestor_values = |p: glam::DVec3| -> Vec<glam::DVec2> {
+        let v = coarse_mesh
+            .mesh
+            .positions
+            .iter()
+            .position(|q| *q == p)
+            .unwrap() as u32;
+        (0..coarse.wedge_vertex.len())
+            .filter(|&w| coarse.wedge_vertex[w] == v)
+            .map(|w| coarse.uvs.as_ref().unwrap()[w])
+            .collect()
+    };
+    let mut moved = 0;
+    for f in 0..at0.corners.len() {
+        for k in 0..3 {
+            let uv = uv_of(&at0, f, k);
+            if f < coarse_faces {
+                assert_eq!(uv, uv_of(&coarse, f, k), "face {f} corner {k}");
+            } else {
+                let p = morph.coarse[morph.faces[f][k] as usize];
+                assert!(ancestor_values(p).contains(&uv), "face {f} corner {k}");
+            }
+            moved += usize::from(uv != uv_of(&fine, f, k));
+        }
+    }
+    assert!(moved > 0, "the two ends differ somewhere");
+    // Halfway, each uv lies between its ends.
+    let half = morph.evaluate_appearance(0.5).unwrap();
+    for (w, uv) in half.uvs.as_ref().unwrap().iter().enumerate() {
+        let (a, b) = (at0.uvs.as_ref().unwrap()[w], at1.uvs.as_ref().unwrap()[w]);
+        assert!((*uv - (a + b) * 0.5).length() < 1e-12);
+    }
+}

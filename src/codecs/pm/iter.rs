@@ -7,9 +7,11 @@ use super::wedges::{self, SplitWedges, WedgeContexts, WedgeState};
 use super::PmParams;
 use crate::codecs::LevelMesh;
 use crate::coding::arith::ArithDecoder;
-use crate::container::{Header, LevelSource, ReadLevels, StreamReader};
+use crate::container::{AppearanceSpec, Header, LevelSource, ReadLevels, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::pmesh::{PmMesh, Vsplit};
+use crate::mesh::attributes::Attributes;
+use crate::mesh::canonical_attributes::CornerCode;
 use crate::mesh::{Grid, TriMesh};
 use glam::DVec3;
 
@@ -361,22 +363,39 @@ impl<'a> PMeshIter<'a> {
 
     /// The current mesh's appearance, when the stream carries one: its wedges welded from the
     /// corners' values.
-    pub fn attributes(&self) -> Option<crate::mesh::attributes::Attributes> {
+    pub fn attributes(&self) -> Option<Attributes> {
         let (w, spec) = (self.wedges.as_ref()?, self.header.appearance.as_ref()?);
         let (corners, wedge_vertex, codes) = wedges::weld(&w.state, &self.mesh);
-        let appearance = crate::codecs::appearance::Appearance {
+        Some(decoded_attributes(
             corners,
             wedge_vertex,
             codes,
-            materials: w.state.materials.clone(),
-        };
-        Some(crate::codecs::appearance::to_attributes(&appearance, spec))
+            &w.state,
+            spec,
+        ))
     }
 
     /// The stream's header.
     pub fn header(&self) -> &Header {
         &self.header
     }
+}
+
+/// The values of welded corner codes, with the state's face materials.
+fn decoded_attributes(
+    corners: Vec<[u32; 3]>,
+    wedge_vertex: Vec<u32>,
+    codes: Vec<CornerCode>,
+    state: &WedgeState,
+    spec: &AppearanceSpec,
+) -> Attributes {
+    let appearance = crate::codecs::appearance::Appearance {
+        corners,
+        wedge_vertex,
+        codes,
+        materials: state.materials.clone(),
+    };
+    crate::codecs::appearance::to_attributes(&appearance, spec)
 }
 
 fn cell_centre(grid: &Grid, c: [i32; 3]) -> DVec3 {
@@ -395,7 +414,9 @@ pub fn to_trimesh(mesh: &PmMesh, grid: &Grid) -> TriMesh {
 }
 
 /// A smooth transition between a coarser mesh Mᶜ and a finer Mᶠ: Mᶠ's faces, each vertex moving
-/// from its ancestor's position in Mᶜ (alpha 0) to its own (alpha 1).
+/// from its ancestor's position in Mᶜ (alpha 0) to its own (alpha 1), and, when the stream
+/// carries appearance in its splits, each corner's values from its ancestor corner's in Mᶜ to
+/// its own (Hoppe 1996 §5: wedge attributes morph with the positions).
 pub struct Geomorph {
     /// Faces of Mᶠ.
     pub faces: Vec<[u32; 3]>,
@@ -403,6 +424,18 @@ pub struct Geomorph {
     pub coarse: Vec<DVec3>,
     /// Positions at alpha = 1.
     pub fine: Vec<DVec3>,
+    /// The appearance at both ends, when the stream carries it in its splits.
+    pub appearance: Option<AppearanceMorph>,
+}
+
+/// A geomorph's appearance: the wedges of Mᶠ, split where corners sharing a value in Mᶠ come
+/// from different values in Mᶜ, with their values at alpha 0 and at alpha 1. Materials are
+/// Mᶠ's at every alpha (an id does not blend).
+pub struct AppearanceMorph {
+    /// Values at alpha = 0: each corner's ancestor in Mᶜ.
+    pub coarse: Attributes,
+    /// Values at alpha = 1: Mᶠ's own.
+    pub fine: Attributes,
 }
 
 impl Geomorph {
@@ -411,6 +444,9 @@ impl Geomorph {
     pub fn new(iter: &mut PMeshIter, nvertices: usize) -> Result<Geomorph> {
         let grid = iter.header.grid;
         let mut ancestor: Vec<[i32; 3]> = iter.mesh.positions.clone();
+        // Each face's corners' values in Mᶜ: a face of Mᶜ keeps its own (a corner that moved
+        // from vs to vt keeps its index), a face a split creates takes its neighbours'.
+        let mut ancestor_values = iter.wedges.as_ref().map(|w| w.state.corners.clone());
         while iter.nvertices() < nvertices {
             let Some(split) = iter.peek_record(true)? else {
                 break;
@@ -421,9 +457,37 @@ impl Geomorph {
                 .get(split.flclw as usize)
                 .ok_or_else(|| Error::malformed(iter.levels_read(), 0, "flclw out of range"))?;
             let vs = face.v[(split.vs_index as usize).min(2)];
+            let created = iter.mesh.faces.len() as u32;
             iter.apply(split)?;
             ancestor.push(ancestor[vs as usize]);
+            if let (Some(values), Some(w)) = (ancestor_values.as_mut(), iter.wedges.as_ref()) {
+                for f in created..iter.mesh.faces.len() as u32 {
+                    let own = w.state.corners[f as usize];
+                    values.push(created_face_ancestors(&iter.mesh, values, f, created, own));
+                }
+            }
         }
+        let appearance = match (ancestor_values, &iter.wedges, &iter.header.appearance) {
+            (Some(coarse), Some(w), Some(spec)) => {
+                let pairs: Vec<[(CornerCode, CornerCode); 3]> = w
+                    .state
+                    .corners
+                    .iter()
+                    .zip(&coarse)
+                    .map(|(f, c)| std::array::from_fn(|k| (f[k], c[k])))
+                    .collect();
+                let (corners, wedge_vertex, codes) = wedges::weld_values(&iter.mesh, &pairs);
+                let end = |pick: fn(&(CornerCode, CornerCode)) -> CornerCode| {
+                    let codes = codes.iter().map(pick).collect();
+                    decoded_attributes(corners.clone(), wedge_vertex.clone(), codes, &w.state, spec)
+                };
+                Some(AppearanceMorph {
+                    coarse: end(|p| p.1),
+                    fine: end(|p| p.0),
+                })
+            }
+            _ => None,
+        };
         Ok(Geomorph {
             faces: iter.mesh.triangles(),
             coarse: ancestor.iter().map(|&c| cell_centre(&grid, c)).collect(),
@@ -433,6 +497,7 @@ impl Geomorph {
                 .iter()
                 .map(|&c| cell_centre(&grid, c))
                 .collect(),
+            appearance,
         })
     }
 
@@ -442,10 +507,67 @@ impl Geomorph {
             self.coarse
                 .iter()
                 .zip(&self.fine)
-                // Weighted sum, not c + (f − c)·alpha: exact at both ends.
-                .map(|(c, f)| *c * (1.0 - alpha) + *f * alpha)
+                .map(|(c, f)| blend(*c, *f, alpha))
                 .collect(),
             self.faces.clone(),
         )
     }
+
+    /// The appearance at `alpha` in [0, 1], when the geomorph has one: uvs and colours blended
+    /// linearly, normals blended and renormalized, materials Mᶠ's.
+    pub fn evaluate_appearance(&self, alpha: f64) -> Option<Attributes> {
+        let morph = self.appearance.as_ref()?;
+        let mut out = morph.fine.clone();
+        if let (Some(fine), Some(coarse)) = (out.uvs.as_mut(), &morph.coarse.uvs) {
+            for (f, c) in fine.iter_mut().zip(coarse) {
+                *f = *c * (1.0 - alpha) + *f * alpha;
+            }
+        }
+        if let (Some(fine), Some(coarse)) = (out.normals.as_mut(), &morph.coarse.normals) {
+            for (f, c) in fine.iter_mut().zip(coarse) {
+                // Opposite normals blend to zero halfway; the fine one stands in there.
+                *f = blend(*c, *f, alpha).try_normalize().unwrap_or(*f);
+            }
+        }
+        if let (Some(fine), Some(coarse)) = (out.colours.as_mut(), &morph.coarse.colours) {
+            for (f, c) in fine.iter_mut().zip(coarse) {
+                for (x, y) in f.iter_mut().zip(c) {
+                    *x = *y * (1.0 - alpha) + *x * alpha;
+                }
+            }
+        }
+        Some(out)
+    }
+}
+
+/// Weighted sum, not c + (f − c)·alpha: exact at both ends.
+fn blend(c: DVec3, f: DVec3, alpha: f64) -> DVec3 {
+    c * (1.0 - alpha) + f * alpha
+}
+
+/// The Mᶜ values of the corners of face `f`, which the split that just applied created (its
+/// faces start at `created`): each corner takes the ancestor value of the same vertex in a face
+/// across one of its two edges, a face older than the split first (so that fr's vs corner
+/// follows the face beyond vr rather than fl); `own` where no neighbour has one.
+fn created_face_ancestors(
+    mesh: &PmMesh,
+    ancestors: &[[CornerCode; 3]],
+    f: u32,
+    created: u32,
+    own: [CornerCode; 3],
+) -> [CornerCode; 3] {
+    let face = &mesh.faces[f as usize];
+    std::array::from_fn(|k| {
+        let across = [face.nei[k], face.nei[(k + 2) % 3]];
+        let from = |limit: u32| {
+            across.iter().find_map(|&g| {
+                if g >= limit {
+                    return None; // NIL included
+                }
+                let c = mesh.corner(g, face.v[k])?;
+                Some(ancestors[g as usize][c])
+            })
+        };
+        from(created).or_else(|| from(f)).unwrap_or(own[k])
+    })
 }

@@ -619,14 +619,24 @@ pub fn code_base(
 /// Faces' values around the mesh's wedges, for the codec's level meshes: wedge ids in order of
 /// first corner, face by face.
 pub fn weld(state: &WedgeState, mesh: &PmMesh) -> (Vec<[u32; 3]>, Vec<u32>, Vec<CornerCode>) {
-    let mut ids: std::collections::HashMap<(u32, CornerCode), u32> =
+    weld_values(mesh, &state.corners)
+}
+
+/// Wedges of `mesh` whose corners carry `values` (any value that tells wedges apart, such as a
+/// pair of codes): the corners equal at one vertex are one wedge, numbered in order of first
+/// corner, face by face.
+pub fn weld_values<T: Copy + Eq + std::hash::Hash>(
+    mesh: &PmMesh,
+    values: &[[T; 3]],
+) -> (Vec<[u32; 3]>, Vec<u32>, Vec<T>) {
+    let mut ids: std::collections::HashMap<(u32, T), u32> =
         std::collections::HashMap::with_capacity(mesh.positions.len() * 2);
     let mut wedge_vertex = Vec::new();
     let mut codes = Vec::new();
     let corners = mesh
         .faces
         .iter()
-        .zip(&state.corners)
+        .zip(values)
         .map(|(face, values)| {
             std::array::from_fn(|k| {
                 *ids.entry((face.v[k], values[k])).or_insert_with(|| {
