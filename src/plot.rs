@@ -104,6 +104,10 @@ fn run_label(run: &RunResult, all: &[RunResult]) -> String {
     if quants_differ {
         label.push_str(&format!(" q{}", run.quant_bits));
     }
+    let rule = |r: &RunResult| r.appearance.as_ref().and_then(|a| a.in_levels.clone());
+    if all.iter().any(|r| rule(r) != rule(run)) {
+        label.push_str(&format!(" {}", rule(run).unwrap_or_else(|| "unit".into())));
+    }
     label
 }
 

@@ -166,6 +166,10 @@ struct ExperimentSet {
     uv_bits: Option<u8>,
     /// Qn when coding appearance; absent: the default.
     normal_bits: Option<u8>,
+    /// Rules for appearance inside the levels ("fit", "keep"), each a run of its own; absent:
+    /// the appearance unit.
+    #[serde(default)]
+    attributes: Vec<String>,
 }
 
 fn main() -> ExitCode {
@@ -301,6 +305,8 @@ struct Job<'a> {
     path: &'a Path,
     codec: &'static dyn Codec,
     quant: Option<u8>,
+    /// The in-level appearance rule, if any.
+    rule: Option<&'a str>,
 }
 
 /// An experiment set read and resolved: its name, codecs, meshes and quantizations.
@@ -310,6 +316,7 @@ struct Set {
     codecs: Vec<&'static dyn Codec>,
     paths: Vec<PathBuf>,
     quants: Vec<Option<u8>>,
+    rules: Vec<Option<String>>,
     settings: Settings,
 }
 
@@ -347,30 +354,43 @@ impl Set {
             normal_bits: set.normal_bits.unwrap_or(settings.normal_bits),
             ..settings.clone()
         };
+        for rule in &set.attributes {
+            meshcodec::codecs::AttributeFit::by_name(rule)
+                .with_context(|| format!("{}: attributes", file.display()))?;
+        }
+        let rules = if set.attributes.is_empty() {
+            vec![settings.attributes.clone()]
+        } else {
+            set.attributes.into_iter().map(Some).collect()
+        };
         Ok(Set {
             name: mesh_name(file),
             description: set.description,
             codecs,
             paths,
             quants,
+            rules,
             settings,
         })
     }
 
-    /// Every job in order (meshes, then codecs, then quantizations), numbered from 0, with the
-    /// index of its mesh.
+    /// Every job in order (meshes, then codecs, then quantizations, then appearance rules),
+    /// numbered from 0, with the index of its mesh.
     fn jobs(&self) -> Vec<Job<'_>> {
         let mut jobs = Vec::new();
         for (mesh, path) in self.paths.iter().enumerate() {
             for &codec in &self.codecs {
                 for &quant in &self.quants {
-                    jobs.push(Job {
-                        number: jobs.len(),
-                        mesh,
-                        path,
-                        codec,
-                        quant,
-                    });
+                    for rule in &self.rules {
+                        jobs.push(Job {
+                            number: jobs.len(),
+                            mesh,
+                            path,
+                            codec,
+                            quant,
+                            rule: rule.as_deref(),
+                        });
+                    }
                 }
             }
         }
@@ -394,12 +414,17 @@ fn run_set(file: &Path, shard: Option<Shard>, settings: &Settings) -> Result<()>
         path,
         codec,
         quant,
+        rule,
     } in &jobs
     {
         if shard.is_some_and(|s| !s.owns(job)) {
             continue;
         }
-        let options = run_options(settings, quant);
+        let options = RunOptions {
+            appearance_in_levels: rule
+                .and_then(|r| meshcodec::codecs::AttributeFit::by_name(r).ok()),
+            ..run_options(settings, quant)
+        };
         let mesh = mesh_name(path);
         let (refused, files) = match run_codec(codec, path, &options, out, settings.keep_stream) {
             Ok((run, files)) => {

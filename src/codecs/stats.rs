@@ -48,6 +48,44 @@ impl PmField {
     }
 }
 
+/// A wedge field of a PM vertex split (Hoppe 1998 Table 3's corners, fl/fr matid and wedge
+/// deltas), as `pm` codes appearance inside its splits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WedgeField {
+    /// Which value each changed corner takes (Hoppe's `corners`).
+    Corners,
+    /// uv residuals.
+    Uv,
+    /// Normal residuals.
+    Normal,
+    /// Colour residuals.
+    Colour,
+    /// Materials of fl and fr.
+    Material,
+}
+
+impl WedgeField {
+    /// The field's name in the coder's per-field bit count.
+    pub fn name(self) -> &'static str {
+        match self {
+            WedgeField::Corners => "wedge",
+            WedgeField::Uv => "uv",
+            WedgeField::Normal => "normal",
+            WedgeField::Colour => "colour",
+            WedgeField::Material => "material",
+        }
+    }
+
+    /// Every field.
+    pub const ALL: [WedgeField; 5] = [
+        WedgeField::Corners,
+        WedgeField::Uv,
+        WedgeField::Normal,
+        WedgeField::Colour,
+        WedgeField::Material,
+    ];
+}
+
 /// A part of a CAME stream, as Table 3 of the paper splits it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum CameField {

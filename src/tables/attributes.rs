@@ -17,14 +17,19 @@ pub const ATTRIBUTE_MESHES: [(&str, &str); 4] = [
     ("dragon-res3", "per-vertex normals; non-manifold"),
 ];
 
-/// Our codecs in the table, and the stem suffix of their 12-bit results (`pm`'s default is
-/// 16 bits, so its stem names the quantization).
-const OURS: [(&str, &str); 5] = [
-    ("emc", ""),
-    ("pm", "-q12"),
-    ("pm-reordered", "-q12"),
-    ("came", ""),
-    ("raw", ""),
+/// Our codecs in the table, the stem suffix of their 12-bit results (`pm`'s default is 16 bits,
+/// so its stem names the quantization), and the rule of appearance inside the levels, if any
+/// (`experiments/attributes-in-splits.toml`; otherwise the appearance unit).
+const OURS: [(&str, &str, Option<&str>); 9] = [
+    ("emc", "", None),
+    ("pm", "-q12", None),
+    ("pm", "-q12", Some("fit")),
+    ("pm", "-q12", Some("keep")),
+    ("pm-reordered", "-q12", None),
+    ("pm-reordered", "-q12", Some("fit")),
+    ("pm-reordered", "-q12", Some("keep")),
+    ("came", "", None),
+    ("raw", "", None),
 ];
 
 /// Draco's figures that its result file keeps beyond the common schema.
@@ -85,7 +90,7 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
     let mut md = String::new();
     let _ = writeln!(md, "# Appearance: whole meshes against Draco\n");
     let _ = writeln!(md, "Regenerate: `{ATTRIBUTES_COMMAND}` (our codecs with `--appearance`, then Draco through DracoPy in the same run, then this table).\n");
-    let _ = writeln!(md, "Positions at 12 bits (docs/CONTRACT.md §1), uvs at Qt = 12 bits over their bounding box, normals octahedral at Qn = 10 bits a coordinate, colours 8 bits a channel (§2.1), for us and for Draco (DracoPy, compression_level 10, quantization_bits 12, tex_coord_quantization_bits 12, normal_quantization_bits 10; colours as 8-bit channels). Bits per vertex are over the canonical mesh's vertex count. Our streams are progressive and their full decode is checked lossless, appearance included (§3); the appearance unit follows the last level. Draco is single-rate, fed the mesh with its vertices split at every seam (one vertex per wedge, as Draco needs; written by `meshcodec convert` as glTF), and its decode is not checked for losslessness. Draco's geometry column is a second file of the welded geometry alone; its appearance column is the difference. Appearance error (§5.1) is the mean over sample points of the original surface: uv distance in texels of a 1024² texture, normal angle, colour steps; it is the cost of quantization, since both full decodes keep every wedge. Draco carries no material ids here (DracoPy has no per-face attribute).\n");
+    let _ = writeln!(md, "Positions at 12 bits (docs/CONTRACT.md §1), uvs at Qt = 12 bits over their bounding box, normals octahedral at Qn = 10 bits a coordinate, colours 8 bits a channel (§2.1), for us and for Draco (DracoPy, compression_level 10, quantization_bits 12, tex_coord_quantization_bits 12, normal_quantization_bits 10; colours as 8-bit channels). Bits per vertex are over the canonical mesh's vertex count. Our streams are progressive and their full decode is checked lossless, appearance included (§3); the appearance unit follows the last level, except in the rows *in the splits*, where `pm`'s vertex splits carry the appearance so that every level has it (docs/FORMAT.md §6.1; `fit` gives a collapsed wedge the values interpolated to where the vertex went, `keep` the survivor's) and the simplifier keeps seams, which costs geometry bits too. Draco is single-rate, fed the mesh with its vertices split at every seam (one vertex per wedge, as Draco needs; written by `meshcodec convert` as glTF), and its decode is not checked for losslessness. Draco's geometry column is a second file of the welded geometry alone; its appearance column is the difference. Appearance error (§5.1) is the mean over sample points of the original surface: uv distance in texels of a 1024² texture, normal angle, colour steps; it is the cost of quantization, since both full decodes keep every wedge. Draco carries no material ids here (DracoPy has no per-face attribute).\n");
     for (mesh, what) in ATTRIBUTE_MESHES {
         let draco_path = results::path(
             results_dir,
@@ -102,16 +107,23 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
         let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---|---|---:|");
         let draco_total = draco.bits_per_vertex();
         let mut rows: Vec<(String, RunResult)> = Vec::new();
-        for (codec, suffix) in OURS {
-            let stem = format!("{mesh}{suffix}{APPEARANCE_SUFFIX}");
+        for (codec, suffix, rule) in OURS {
+            let rule_suffix = rule.map_or(String::new(), |r| format!("-{r}"));
+            let stem = format!("{mesh}{suffix}{APPEARANCE_SUFFIX}{rule_suffix}");
             let path = results::path(results_dir, codec, &stem, ".json");
+            let label = match rule {
+                Some(rule) => format!("`{codec}`, in the splits, {rule}"),
+                None => format!("`{codec}`"),
+            };
             let Ok(r) = read_result(&path) else {
                 let reason = super::refused(results_dir, codec, mesh)
                     .ok_or_else(|| missing(&path, "no result and no refusal"))?;
-                let _ = writeln!(md, "| `{codec}` | refused: {reason} | | | | | | | |");
+                if rule.is_none() {
+                    let _ = writeln!(md, "| {label} | refused: {reason} | | | | | | | |");
+                }
                 continue;
             };
-            rows.push((codec.to_string(), r.clone()));
+            rows.push((label.clone(), r.clone()));
             let codec = &codec.to_string();
             let Some(appearance) = &r.appearance else {
                 return Err(Error::Unsupported(format!(
@@ -125,7 +137,7 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             })?;
             let _ = writeln!(
                 md,
-                "| `{codec}` | {} | {:.2} | {:.2} | {} | {:+.1}% | {} | {} | {:.1} |",
+                "| {label} | {} | {:.2} | {:.2} | {} | {:+.1}% | {} | {} | {:.1} |",
                 if *codec == "raw" { "no" } else { "yes" },
                 (r.bytes as f64 * 8.0 - appearance.bits as f64) / v,
                 appearance.bits as f64 / appearance.wedges.max(1) as f64,
@@ -153,14 +165,51 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             error_cell(last),
             draco.decode_seconds * 1e3,
         );
+        for (label, r) in rows.iter().filter(|(l, _)| l.contains("in the splits")) {
+            let last: Vec<String> = r
+                .levels
+                .iter()
+                .rev()
+                .take(5)
+                .rev()
+                .map(|l| {
+                    let a = &l.appearance;
+                    a.uv_texels
+                        .or(a.normal_degrees)
+                        .or(a.colour_steps)
+                        .map_or("—".into(), |e| format!("{e:.2}"))
+                })
+                .collect();
+            let unit = if r
+                .levels
+                .last()
+                .is_some_and(|l| l.appearance.uv_texels.is_some())
+            {
+                "texels"
+            } else if r
+                .levels
+                .last()
+                .is_some_and(|l| l.appearance.normal_degrees.is_some())
+            {
+                "degrees"
+            } else {
+                "colour steps"
+            };
+            let _ = writeln!(
+                md,
+                "Appearance error of the last {} levels of {label} ({unit}): {}.\n",
+                last.len(),
+                last.join(" / ")
+            );
+        }
         let best = rows
             .iter()
-            .filter(|(c, _)| c != "raw")
+            .filter(|(c, _)| c != "`raw`")
             .min_by(|a, b| a.1.bytes.cmp(&b.1.bytes));
         if let Some((codec, r)) = best {
             let _ = writeln!(
                 md,
-                "Smallest progressive stream: `{codec}`, {} bytes against Draco's {} ({:+.1}%); {} wedges on {} vertices.\n",
+                "Smallest progressive stream: {codec}, {} bytes against Draco's {} ({:+.1}%); {} wedges on {} vertices.\n",
                 r.bytes,
                 draco.bytes,
                 (r.bytes as f64 / draco.bytes as f64 - 1.0) * 100.0,
@@ -169,6 +218,10 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             );
         }
     }
+    let _ = writeln!(md, "## Pictures\n");
+    let _ = writeln!(md, "![bunny-10k-textured and spot with a checker through the file's uvs and through emc's full decode](attributes-checker.png)\n");
+    let _ = writeln!(md, "Intermediate levels of `pm-reordered` with appearance in its splits, each level textured through its own uvs; rows: bunny-10k-textured `fit`, `keep`, spot `fit`, `keep`. `keep` stretches the checker where a collapsed vertex's uv stays put while its position moves:\n");
+    let _ = writeln!(md, "![intermediate levels of pm-reordered in the splits, fit and keep, with a checker](attributes-levels.png)");
     std::fs::create_dir_all(out)?;
     let path = out.join("attributes.md");
     crate::mesh::io::write_atomically(&path, md.as_bytes())?;
@@ -239,6 +292,69 @@ pub fn attributes_checker(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             let (x0, y0) = (col as u32 * PANEL, row as u32 * (PANEL + CAPTION));
             super::draw_panel(&root, &picture.pixels, PANEL, (x0, y0))?;
             super::draw_caption(&root, &caption, 20, (x0 + 12, y0 + PANEL + 2))?;
+        }
+    }
+    root.present().map_err(|e| fail(&e))?;
+    drop(root);
+    Ok(path)
+}
+
+/// Shares of the full vertex count at which the levels figure shows each in-split stream.
+const LEVEL_SHARES: [f64; 3] = [0.12, 0.25, 0.5];
+
+/// Writes paper-tables/attributes-levels.png: intermediate levels of `pm-reordered` with
+/// appearance in its splits, by either collapse rule, textured with a checker through the
+/// level's own uvs, so that what each rule does to the charts and the seams shows.
+pub fn attributes_levels(results_dir: &Path, out: &Path) -> Result<PathBuf> {
+    use crate::codecs::pm::iter::PMeshIter;
+    use crate::render::{render_textured, View};
+    use plotters::prelude::*;
+    const PANEL: u32 = 300;
+    const CAPTION: u32 = 26;
+    const CODEC: &str = "pm-reordered";
+    let rows: Vec<(&str, &str)> = CHECKER_MESHES
+        .iter()
+        .flat_map(|m| ["fit", "keep"].map(|rule| (*m, rule)))
+        .collect();
+    let width = PANEL * LEVEL_SHARES.len() as u32;
+    let height = (PANEL + CAPTION) * rows.len() as u32;
+    std::fs::create_dir_all(out)?;
+    let path = out.join("attributes-levels.png");
+    let root = BitMapBackend::new(&path, (width, height)).into_drawing_area();
+    let fail = |e: &dyn std::fmt::Display| Error::Io(std::io::Error::other(format!("plot: {e}")));
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    for (row, (mesh, rule)) in rows.iter().enumerate() {
+        let view = View {
+            up: 1,
+            yaw: if *mesh == "spot" { 210.0 } else { 30.0 },
+            pitch: 20.0,
+        };
+        let stem = format!("{mesh}-q12{APPEARANCE_SUFFIX}-{rule}");
+        let stream_path = results::path(results_dir, CODEC, &stem, ".mc");
+        let stream = std::fs::read(&stream_path).map_err(|e| missing(&stream_path, e))?;
+        let mut iter = PMeshIter::from_stream(&stream)?;
+        let full = iter.header().vertices as f64;
+        let mut frame = None;
+        for (col, share) in LEVEL_SHARES.iter().enumerate() {
+            iter.goto_nvertices((full * share).round() as usize)?;
+            let level = iter.level_mesh();
+            // Every panel of a row in the frame of its first level, so that they line up.
+            let frame = *frame.get_or_insert(
+                level
+                    .mesh
+                    .referenced_bounds()
+                    .ok_or_else(|| Error::mesh("empty mesh"))?,
+            );
+            let uvs = level
+                .attributes
+                .as_ref()
+                .and_then(corner_uvs)
+                .ok_or_else(|| Error::Unsupported(format!("{stem}: a level without uvs")))?;
+            let picture = render_textured(&level.mesh, &uvs, &frame, view, PANEL, PANEL);
+            let (x0, y0) = (col as u32 * PANEL, row as u32 * (PANEL + CAPTION));
+            super::draw_panel(&root, &picture.pixels, PANEL, (x0, y0))?;
+            let caption = format!("{rule}: {} / {} vertices", iter.nvertices(), full as u64);
+            super::draw_caption(&root, &caption, 17, (x0 + 8, y0 + PANEL + 2))?;
         }
     }
     root.present().map_err(|e| fail(&e))?;

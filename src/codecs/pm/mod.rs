@@ -38,7 +38,7 @@ pub mod syntax;
 pub mod wedge_levels;
 pub mod wedges;
 
-use super::stats::PmField;
+use super::stats::{PmField, WedgeField};
 use super::{
     names, AttributeFit, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, Stat,
     Stats,
@@ -55,6 +55,9 @@ use crate::mesh::quantize::GridShape;
 use crate::mesh::topology::analyze;
 use crate::mesh::{CanonicalMesh, TriMesh};
 use iter::PMeshIter;
+
+/// The statistic of the bits that code the base mesh's appearance.
+pub const BASE_APPEARANCE_BITS: &str = "bits_base_appearance";
 use syntax::{FlclwCoding, SplitContexts};
 
 /// Ordering of the vertex splits.
@@ -460,9 +463,18 @@ fn encode_pm(
             .expect("the encoder codes its own values")
     });
     let mut wedge_contexts = wedges::WedgeContexts::default();
+    // The base mesh's appearance is counted apart, so that the wedge fields are the splits'.
+    let mut pushed = 0usize;
     let mut push = |enc: ArithEncoder, vertices: usize, triangles: usize, stats: &mut Stats| {
+        let base = pushed == 0;
+        pushed += 1;
         for (field, bits) in &enc.field_bits {
-            stats.add_named(&format!("bits_{field}"), *bits);
+            let wedge = WedgeField::ALL.iter().any(|w| w.name() == *field);
+            if base && wedge {
+                stats.add_named(BASE_APPEARANCE_BITS, *bits);
+            } else {
+                stats.add_named(&format!("bits_{field}"), *bits);
+            }
         }
         let (payload, ledger) = enc.finish();
         writer.push_level(
@@ -522,9 +534,10 @@ fn encode_pm(
     }
     let (bytes, levels) = writer.finish();
     if appearance.is_some() {
-        let bits: f64 = ["wedge", "uv", "normal", "colour", "material"]
+        let bits: f64 = WedgeField::ALL
             .iter()
-            .filter_map(|f| stats.get_named(&format!("bits_{f}")))
+            .filter_map(|f| stats.get_named(&format!("bits_{}", f.name())))
+            .chain(stats.get_named(BASE_APPEARANCE_BITS))
             .sum();
         stats.add_named("appearance_bits", bits);
     }

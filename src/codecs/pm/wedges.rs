@@ -16,6 +16,7 @@
 
 use crate::codecs::appearance::coder::Symbols;
 use crate::codecs::appearance::predict::{face_normal, uv_by_fit};
+use crate::codecs::stats::WedgeField;
 use crate::coding::arith::{BitContext, IntContext, UintContext};
 use crate::container::AppearanceSpec;
 use crate::error::{Error, Result};
@@ -382,11 +383,19 @@ fn code_material(
             continue;
         }
         tried.push(*m);
-        if symbols.bit(&mut contexts.material_same[i], value == *m, "material")? {
+        if symbols.bit(
+            &mut contexts.material_same[i],
+            value == *m,
+            WedgeField::Material.name(),
+        )? {
             return Ok(*m);
         }
     }
-    let id = symbols.uint(&mut contexts.material, value as u64, "material")?;
+    let id = symbols.uint(
+        &mut contexts.material,
+        value as u64,
+        WedgeField::Material.name(),
+    )?;
     if id >= names as u64 {
         return Err(malformed("material id beyond the names"));
     }
@@ -404,18 +413,26 @@ fn code_corner(
     let class = corner.class as usize;
     let candidates = &corner.candidates;
     for (i, &c) in candidates.iter().take(2).enumerate() {
-        if symbols.bit(&mut contexts.same[class][i], value == c, "wedge")? {
+        if symbols.bit(
+            &mut contexts.same[class][i],
+            value == c,
+            WedgeField::Corners.name(),
+        )? {
             return Ok(c);
         }
     }
     if candidates.len() > 2 {
         let rest = &candidates[2..];
         let index = rest.iter().position(|&c| c == value);
-        if symbols.bit(&mut contexts.other[class], index.is_some(), "wedge")? {
+        if symbols.bit(
+            &mut contexts.other[class],
+            index.is_some(),
+            WedgeField::Corners.name(),
+        )? {
             let i = symbols.uint(
                 &mut contexts.other_index,
                 index.unwrap_or(0) as u64,
-                "wedge",
+                WedgeField::Corners.name(),
             )?;
             return rest
                 .get(i as usize)
@@ -481,7 +498,7 @@ fn code_value(
             let d = symbols.int(
                 &mut contexts.normal[axis],
                 t[axis] as i64 - p[axis] as i64,
-                "normal",
+                WedgeField::Normal.name(),
             )?;
             n[axis] = within(p[axis] as i64 + d, max + 1, "normal")?;
         }
@@ -497,7 +514,7 @@ fn code_value(
             let d = symbols.int(
                 &mut contexts.uv[axis],
                 t[axis] as i64 - p[axis] as i64,
-                "uv",
+                WedgeField::Uv.name(),
             )?;
             uv[axis] = within(p[axis] as i64 + d, 1i64 << grid.bits, "uv")?;
         }
@@ -513,7 +530,7 @@ fn code_value(
             let d = symbols.int(
                 &mut contexts.colour[channel],
                 t[channel].wrapping_sub(p[channel]) as i8 as i64,
-                "colour",
+                WedgeField::Colour.name(),
             )?;
             if !(-128..=127).contains(&d) {
                 return Err(malformed("colour residual out of range"));
@@ -591,10 +608,16 @@ pub fn code_base(
             let value = truth.map_or(CornerCode::default(), |t| t.corners[f][k]);
             let index = known[v].iter().position(|&c| c == value);
             let code = if !known[v].is_empty()
-                && symbols.bit(&mut contexts.base_known, index.is_some(), "wedge")?
-            {
-                let i =
-                    symbols.uint(&mut contexts.base_index, index.unwrap_or(0) as u64, "wedge")?;
+                && symbols.bit(
+                    &mut contexts.base_known,
+                    index.is_some(),
+                    WedgeField::Corners.name(),
+                )? {
+                let i = symbols.uint(
+                    &mut contexts.base_index,
+                    index.unwrap_or(0) as u64,
+                    WedgeField::Corners.name(),
+                )?;
                 *known[v]
                     .get(i as usize)
                     .ok_or_else(|| malformed("base wedge index beyond the vertex's wedges"))?
