@@ -151,10 +151,18 @@ fn streams_of_another_format_version_are_refused_in_one_line() {
     }
 }
 
-#[test]
-fn the_appearance_golden_stream_is_reproduced_and_decodes_exactly() {
-    let codec = codecs::by_name("emc").unwrap();
-    let path = resolve("spot").unwrap();
+/// Encodes `mesh` with its appearance by `codec` (inside the levels by `fit`, else in the
+/// appearance unit), checks the stream's version, compares it with the pinned stream `file` of
+/// that version and decodes the pinned stream losslessly, appearance included.
+fn appearance_golden(
+    codec: &str,
+    mesh: &str,
+    fit: Option<codecs::AttributeFit>,
+    version: u8,
+    file: &str,
+) {
+    let codec = codecs::by_name(codec).unwrap();
+    let path = resolve(mesh).unwrap();
     let original = meshcodec::mesh::io::read_attributed(&path).unwrap();
     let (canonical, appearance) = codecs::canonical_attributed_for(
         &original,
@@ -162,14 +170,14 @@ fn the_appearance_golden_stream_is_reproduced_and_decodes_exactly() {
         meshcodec::mesh::attribute_quantization::AttributeBits::default(),
     )
     .unwrap();
-    let bytes = codecs::encode_attributed(codec, &canonical, Some(&appearance))
+    let bytes = codecs::encode_attributed_with(codec, &canonical, Some(&appearance), fit)
         .unwrap()
         .bytes;
-    assert_eq!(bytes[4], APPEARANCE_UNIT_VERSION);
+    assert_eq!(bytes[4], version);
     let golden = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/golden")
-        .join(format!("v{APPEARANCE_UNIT_VERSION}"))
-        .join("emc-spot-appearance.mc");
+        .join(format!("v{version}"))
+        .join(file);
     if updating() {
         std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
         std::fs::write(&golden, &bytes).unwrap();
@@ -182,7 +190,7 @@ fn the_appearance_golden_stream_is_reproduced_and_decodes_exactly() {
     });
     assert!(
         pinned == bytes,
-        "emc's appearance stream of spot changed ({} bytes, pinned {}): a syntax change needs a new format version and UPDATE_GOLDEN=1",
+        "{file} changed ({} bytes, pinned {}): a syntax change needs a new format version and UPDATE_GOLDEN=1",
         bytes.len(),
         pinned.len()
     );
@@ -194,6 +202,28 @@ fn the_appearance_golden_stream_is_reproduced_and_decodes_exactly() {
             decoded.attributes.as_ref().unwrap(),
         )
         .unwrap();
+}
+
+#[test]
+fn the_appearance_golden_stream_is_reproduced_and_decodes_exactly() {
+    appearance_golden(
+        "emc",
+        "spot",
+        None,
+        APPEARANCE_UNIT_VERSION,
+        "emc-spot-appearance.mc",
+    );
+}
+
+#[test]
+fn the_golden_stream_with_appearance_in_pm_splits_is_reproduced_and_decodes_exactly() {
+    appearance_golden(
+        "pm-reordered",
+        "spot",
+        Some(codecs::AttributeFit::Fit),
+        FORMAT_VERSION,
+        "pm-reordered-spot-appearance-fit.mc",
+    );
 }
 
 /// (codec, mesh, bits per vertex) rows of the pin file.
