@@ -30,6 +30,8 @@ pub enum PmField {
     VadL,
     /// Small position delta.
     VadS,
+    /// Which faces of a mesh cut to a manifold were flipped (`pm::repair`).
+    Repair,
 }
 
 impl PmField {
@@ -44,6 +46,7 @@ impl PmField {
             PmField::Ii => "ii",
             PmField::VadL => "vad_l",
             PmField::VadS => "vad_s",
+            PmField::Repair => "repair",
         }
     }
 }

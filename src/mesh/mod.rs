@@ -8,6 +8,7 @@ pub mod canonical;
 pub mod canonical_attributes;
 pub mod generate;
 pub mod io;
+pub mod manifold;
 pub mod quantize;
 pub mod topology;
 

@@ -85,10 +85,16 @@ struct Wedges {
     splits: Vec<SplitWedges>,
 }
 
-/// An iterator over the meshes M⁰ … Mⁿ of a progressive mesh.
+/// An iterator over the meshes M⁰ … Mⁿ of a progressive mesh. For a mesh cut to a manifold
+/// ([`super::repair`]) these are the manifold's meshes; the level mesh of Mⁿ is the mesh
+/// itself, copies welded and flipped faces turned back.
 pub struct PMeshIter<'a> {
     base: PmMesh,
     mesh: PmMesh,
+    /// Whether the stream's mesh was cut to a manifold.
+    repaired: bool,
+    /// Which faces of Mⁿ are flipped, once read.
+    flips: Option<Vec<bool>>,
     wedges: Option<Wedges>,
     records: Vec<Vsplit>,
     applied: usize,
@@ -115,18 +121,20 @@ impl<'a> PMeshIter<'a> {
         let base = stream
             .next_owned_level()?
             .ok_or_else(|| Error::Truncated("the stream ends before its base mesh".into()))?;
-        let (mesh, values) = super::read_base(&header, &base.bytes)
+        let (mesh, values, flips) = super::read_base(&header, &base.bytes)
             .ok_or_else(|| Error::malformed(1, base.start, "base mesh cannot be read"))?;
         Ok(PMeshIter {
             base: mesh.clone(),
             mesh,
+            repaired: params.copies.is_some(),
+            flips,
             wedges: values.map(|state| Wedges {
                 state,
                 splits: Vec::new(),
             }),
             records: Vec::new(),
             applied: 0,
-            full_vertices: header.vertices,
+            full_vertices: params.full_vertices(&header),
             header,
             reader: Some(SplitReader {
                 source: stream,
@@ -145,10 +153,13 @@ impl<'a> PMeshIter<'a> {
         })
     }
 
-    /// An iterator over records held in memory (a PMesh), at M⁰; geometry only.
+    /// An iterator over records held in memory (a PMesh), at M⁰; geometry only, and the
+    /// manifold's meshes only for a mesh cut to one.
     pub fn from_records(base: PmMesh, records: Vec<Vsplit>, header: Header) -> PMeshIter<'static> {
         PMeshIter {
             full_vertices: (base.positions.len() + records.len()) as u64,
+            repaired: false,
+            flips: None,
             mesh: base.clone(),
             wedges: None,
             base,
@@ -291,6 +302,28 @@ impl<'a> PMeshIter<'a> {
                 w.splits.push(read);
             }
         }
+        if self.repaired
+            && self.flips.is_none()
+            && self.mesh.positions.len() as u64 == self.full_vertices
+        {
+            // Mⁿ of a mesh cut to a manifold: its flips close the last level.
+            let flips = self
+                .reader
+                .as_mut()
+                .and_then(|r| r.coder.as_mut())
+                .and_then(|coder| super::repair::get_flips(coder, &self.mesh));
+            match flips {
+                Some(flips) => self.flips = Some(flips),
+                None => {
+                    self.mesh.ecol(&split);
+                    return Err(Error::malformed(
+                        self.levels_read(),
+                        0,
+                        "the flipped faces of the last level cannot be read",
+                    ));
+                }
+            }
+        }
         self.applied += 1;
         Ok(())
     }
@@ -352,10 +385,17 @@ impl<'a> PMeshIter<'a> {
         Ok(())
     }
 
-    /// The current mesh with positions at cell centres.
+    /// The current mesh with positions at cell centres; at Mⁿ of a mesh cut to a manifold, the
+    /// mesh itself (copies welded, flipped faces turned back).
     pub fn level_mesh(&self) -> LevelMesh {
+        let mesh = match &self.flips {
+            Some(flips) if self.mesh.positions.len() as u64 == self.full_vertices => {
+                super::repair::restore(&self.mesh, flips, &self.header.grid)
+            }
+            _ => to_trimesh(&self.mesh, &self.header.grid),
+        };
         LevelMesh {
-            mesh: to_trimesh(&self.mesh, &self.header.grid),
+            mesh,
             loose_edges: Vec::new(),
             attributes: self.attributes(),
         }

@@ -34,6 +34,7 @@
 //! ([`wedge_levels`]).
 
 pub mod iter;
+pub mod repair;
 pub mod syntax;
 pub mod wedge_levels;
 pub mod wedges;
@@ -51,6 +52,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::pmesh::PmMesh;
 use crate::hierarchy::simplify::{self, Placement};
 use crate::mesh::canonical_attributes::CanonicalAttributes;
+use crate::mesh::manifold::ManifoldCut;
 use crate::mesh::quantize::GridShape;
 use crate::mesh::topology::analyze;
 use crate::mesh::{CanonicalMesh, TriMesh};
@@ -75,23 +77,70 @@ pub enum Ordering {
 pub struct PmParams {
     /// Split order.
     pub ordering: Ordering,
+    /// For a mesh cut to a manifold ([`repair`]): how many vertices the cut copied, so that
+    /// Mⁿ has the header's vertices plus these; `None` for a mesh that was one already.
+    pub copies: Option<u64>,
 }
+
+/// The flag byte of a stream whose mesh was cut to a manifold.
+const REPAIRED: u8 = 1;
 
 impl PmParams {
     fn to_bytes(self) -> Vec<u8> {
-        vec![match self.ordering {
+        let mut out = vec![match self.ordering {
             Ordering::Natural => 0,
             Ordering::Reordered => 1,
-        }]
+        }];
+        if let Some(copies) = self.copies {
+            out.push(REPAIRED);
+            crate::coding::varint::put(&mut out, copies);
+        }
+        out
     }
 
     fn from_header(header: &Header) -> Result<PmParams> {
-        let ordering = match header.params.as_slice() {
-            [0] => Ordering::Natural,
-            [1] => Ordering::Reordered,
-            _ => return Err(Error::malformed(0, 6, "pm parameters of unknown syntax")),
+        let unknown = || Error::malformed(0, 6, "pm parameters of unknown syntax");
+        let ordering = match header.params.first() {
+            Some(0) => Ordering::Natural,
+            Some(1) => Ordering::Reordered,
+            _ => return Err(unknown()),
         };
-        Ok(PmParams { ordering })
+        let copies = match header.params.get(1) {
+            None if header.params.len() == 1 => None,
+            Some(&REPAIRED) => {
+                let mut pos = 2;
+                let copies =
+                    crate::coding::varint::get(&header.params, &mut pos).map_err(|_| unknown())?;
+                if pos != header.params.len() {
+                    return Err(unknown());
+                }
+                // A copy is a corner's vertex given to another fan: fewer than the corners.
+                if copies > 3 * header.triangles
+                    || header.vertices + copies > crate::limits::MAX_VERTICES
+                {
+                    return Err(Error::malformed(
+                        0,
+                        6,
+                        "pm parameters declare more vertex copies than the mesh has corners",
+                    ));
+                }
+                if header.appearance.as_ref().is_some_and(|a| a.in_levels) {
+                    return Err(Error::malformed(
+                        0,
+                        6,
+                        "a pm stream of a mesh cut to a manifold does not carry appearance in its splits",
+                    ));
+                }
+                Some(copies)
+            }
+            _ => return Err(unknown()),
+        };
+        Ok(PmParams { ordering, copies })
+    }
+
+    /// Vertices of Mⁿ: the header's, plus the copies of a mesh cut to a manifold.
+    fn full_vertices(self, header: &Header) -> u64 {
+        header.vertices + self.copies.unwrap_or(0)
     }
 
     fn layout(self) -> syntax::Layout {
@@ -128,15 +177,14 @@ impl Pm {
     }
 }
 
-/// Refuses meshes that are not oriented 2-manifolds, with the counts that say why.
-fn check_manifold(mesh: &CanonicalMesh) -> Result<()> {
+/// Refuses face sets that are not oriented 2-manifolds, with the counts that say why.
+fn check_manifold(vertex_count: usize, faces: &[[u32; 3]]) -> Result<()> {
     let report = analyze(&TriMesh::new(
-        vec![glam::DVec3::ZERO; mesh.vertex_count()],
-        mesh.faces.clone(),
+        vec![glam::DVec3::ZERO; vertex_count],
+        faces.to_vec(),
     ));
     let mut directed = std::collections::HashSet::new();
-    let twice = mesh
-        .faces
+    let twice = faces
         .iter()
         .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])))
         .filter(|e| !directed.insert(*e))
@@ -150,8 +198,21 @@ fn check_manifold(mesh: &CanonicalMesh) -> Result<()> {
     Ok(())
 }
 
-/// Reads a base-mesh level: the mesh and, when the stream carries appearance, its values.
-fn read_base(header: &Header, bytes: &[u8]) -> Option<(PmMesh, Option<wedges::WedgeState>)> {
+/// What the decoder needs of a mesh cut to a manifold ([`repair`]).
+struct RepairPlan {
+    /// Vertices the cut copied.
+    copies: u64,
+    /// Whether each face of Mⁿ (in the decoder's face order) was flipped.
+    flips: Vec<bool>,
+}
+
+/// A base-mesh level as read: the mesh, its values when the stream carries appearance, and
+/// its flipped faces when it is already Mⁿ of a mesh cut to a manifold.
+type Base = (PmMesh, Option<wedges::WedgeState>, Option<Vec<bool>>);
+
+/// Reads a base-mesh level.
+fn read_base(header: &Header, bytes: &[u8]) -> Option<Base> {
+    let params = PmParams::from_header(header).ok()?;
     let mut dec = ArithDecoder::new(bytes)?;
     let mut ctx = SplitContexts::default();
     let v = syntax::get_count(&mut dec, &mut ctx)?;
@@ -159,7 +220,7 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<(PmMesh, Option<wedges::We
     let q = header.grid.bits as u64;
     let b = index_bits(v) as u64;
     // Raw bits cost one bit each: the payload must hold them before anything is allocated.
-    if v > header.vertices
+    if v > params.full_vertices(header)
         || f > header.triangles
         || 3 * q * v + 3 * b * f > bytes.len() as u64 * 8 + 64
     {
@@ -191,6 +252,10 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<(PmMesh, Option<wedges::We
     // manifold (two fans meeting at one vertex) links but is no mesh PM can split.
     let mesh =
         PmMesh::from_triangles(positions, &faces).filter(|mesh| mesh.check_invariants().is_ok())?;
+    let flips = match params.copies {
+        Some(_) if v == params.full_vertices(header) => Some(repair::get_flips(&mut dec, &mesh)?),
+        _ => None,
+    };
     let state = match header.appearance.as_ref().filter(|a| a.in_levels) {
         Some(spec) => {
             let mut reader = crate::codecs::appearance::coder::Reader {
@@ -203,7 +268,12 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<(PmMesh, Option<wedges::We
         }
         None => None,
     };
-    Some((mesh, state))
+    Some((mesh, state, flips))
+}
+
+/// The canonical mesh's cells as the simplifier takes them.
+fn cells_of(mesh: &CanonicalMesh) -> Vec<[i32; 3]> {
+    mesh.cells.iter().map(|c| c.map(|x| x as i32)).collect()
 }
 
 /// Seams of the canonical mesh's appearance: edges whose two faces differ in material or in
@@ -242,28 +312,73 @@ impl Pm {
     fn params(&self) -> PmParams {
         PmParams {
             ordering: self.ordering,
+            copies: None,
         }
     }
 
-    /// The progressive mesh of `mesh`, keeping `seams` when given.
+    /// The progressive mesh of the oriented manifold (`cells`, `faces`), under `constraints`
+    /// when given.
     fn progressive_mesh(
         &self,
-        mesh: &CanonicalMesh,
-        seams: Option<&[[u32; 2]]>,
+        cells: &[[i32; 3]],
+        faces: &[[u32; 3]],
+        constraints: Option<simplify::Constraints>,
     ) -> simplify::ProgressiveMesh {
-        let cells: Vec<[i32; 3]> = mesh.cells.iter().map(|c| c.map(|x| x as i32)).collect();
         let placement = match self.ordering {
             Ordering::Natural => Placement::Optimal,
             Ordering::Reordered => Placement::EndpointOrMidpoint,
         };
-        let simplified = match seams {
-            Some(seams) => simplify::simplify_keeping_seams(&cells, &mesh.faces, placement, seams),
-            None => simplify::simplify(&cells, &mesh.faces, placement),
+        let simplified = match constraints {
+            Some(c) => simplify::simplify_constrained(cells, faces, placement, c),
+            None => simplify::simplify(cells, faces, placement),
         };
         match self.ordering {
-            Ordering::Natural => simplify::progressive_mesh(&mesh.faces, &simplified),
-            Ordering::Reordered => simplify::reordered_progressive_mesh(&mesh.faces, &simplified),
+            Ordering::Natural => simplify::progressive_mesh(faces, &simplified),
+            Ordering::Reordered => simplify::reordered_progressive_mesh(faces, &simplified),
         }
+    }
+
+    /// Encodes a mesh that is no oriented manifold: the progressive mesh of its cut
+    /// ([`ManifoldCut`]), copied vertices pinned, and the flips at the last level ([`repair`]).
+    fn encode_cut(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
+        let n = mesh.vertex_count();
+        let cut = ManifoldCut::new(n, &mesh.faces);
+        let mut cells = cells_of(mesh);
+        for &v in &cut.copy_of {
+            cells.push(cells[v as usize]);
+        }
+        // The cut is a manifold by construction; checked again, so that a fault is an error.
+        check_manifold(cells.len(), &cut.faces)?;
+        let pinned = cut.copied(n);
+        let pm = self.progressive_mesh(
+            &cells,
+            &cut.faces,
+            Some(simplify::Constraints {
+                seams: &[],
+                pinned: &pinned,
+            }),
+        );
+        let plan = RepairPlan {
+            copies: cut.copy_of.len() as u64,
+            flips: pm
+                .face_origin
+                .iter()
+                .map(|&f| cut.flipped[f as usize])
+                .collect(),
+        };
+        let params = PmParams {
+            copies: Some(plan.copies),
+            ..self.params()
+        };
+        let mut encoded = encode_pm(self.id(), params, mesh, &pm, None, Some(&plan));
+        encoded.stats.add_named("repair_copies", plan.copies as f64);
+        encoded
+            .stats
+            .add_named("repair_flips", cut.flip_count() as f64);
+        encoded
+            .stats
+            .add_named("repair_cut_edges", cut.cut_edges as f64);
+        Ok(encoded)
     }
 
     /// Encodes with the appearance inside the vertex splits ([`wedges`]).
@@ -273,9 +388,20 @@ impl Pm {
         appearance: &CanonicalAttributes,
         fit: AttributeFit,
     ) -> Result<Encoded> {
-        check_manifold(mesh)?;
+        check_manifold(mesh.vertex_count(), &mesh.faces).map_err(|_| {
+            Error::Unsupported(
+                "pm carries appearance in its splits only on an oriented 2-manifold; without --attributes, its appearance unit carries it".into(),
+            )
+        })?;
         let seams = seams_of(mesh, appearance);
-        let pm = self.progressive_mesh(mesh, Some(&seams));
+        let pm = self.progressive_mesh(
+            &cells_of(mesh),
+            &mesh.faces,
+            Some(simplify::Constraints {
+                seams: &seams,
+                pinned: &[],
+            }),
+        );
         let mut full = pm.base.clone();
         for split in &pm.vsplits {
             full.vsplit(split).expect("the encoder's own splits apply");
@@ -318,6 +444,7 @@ impl Pm {
             mesh,
             &pm,
             Some((&spec, &levels)),
+            None,
         ))
     }
 }
@@ -350,9 +477,13 @@ impl Codec for Pm {
     }
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
-        check_manifold(mesh)?;
-        let pm = self.progressive_mesh(mesh, None);
-        Ok(encode_pm(self.id(), self.params(), mesh, &pm, None))
+        // An oriented manifold is coded as it is (its streams as they always were); any other
+        // mesh through its cut.
+        if check_manifold(mesh.vertex_count(), &mesh.faces).is_err() {
+            return self.encode_cut(mesh);
+        }
+        let pm = self.progressive_mesh(&cells_of(mesh), &mesh.faces, None);
+        Ok(encode_pm(self.id(), self.params(), mesh, &pm, None, None))
     }
 
     fn encode_with_appearance(
@@ -416,6 +547,7 @@ fn encode_pm(
     mesh: &CanonicalMesh,
     pm: &simplify::ProgressiveMesh,
     appearance: Option<(&AppearanceSpec, &wedge_levels::WedgeLevels)>,
+    repair: Option<&RepairPlan>,
 ) -> Encoded {
     let base = &pm.base;
     let mut schedule = Vec::new();
@@ -456,6 +588,9 @@ fn encode_pm(
             enc.raw(v as u64, b, SyntaxClass::Connectivity, field);
         }
     }
+    if let (Some(plan), true) = (repair, pm.vsplits.is_empty()) {
+        repair::put_flips(&mut enc, base, &plan.flips);
+    }
     // The base level's contexts are its own, as the decoder reads it apart.
     let mut wedge_state = appearance.map(|(spec, levels)| {
         let mut contexts = wedges::WedgeContexts::default();
@@ -487,7 +622,11 @@ fn encode_pm(
             },
         );
     };
-    push(enc, base.positions.len(), base.faces.len(), &mut stats);
+    let vertices = match (repair, pm.vsplits.is_empty()) {
+        (Some(_), true) => mesh.vertex_count(),
+        _ => base.positions.len(),
+    };
+    push(enc, vertices, base.faces.len(), &mut stats);
 
     // Further levels: batches of vsplits, coded against the mesh as the decoder will hold it.
     let mut state = base.clone();
@@ -530,7 +669,12 @@ fn encode_pm(
             }
         }
         next += n;
-        push(enc, state.positions.len(), state.faces.len(), &mut stats);
+        let mut vertices = state.positions.len();
+        if let (Some(plan), true) = (repair, next == pm.vsplits.len()) {
+            repair::put_flips(&mut enc, &state, &plan.flips);
+            vertices = mesh.vertex_count(); // copies welded
+        }
+        push(enc, vertices, state.faces.len(), &mut stats);
     }
     let (bytes, levels) = writer.finish();
     if appearance.is_some() {

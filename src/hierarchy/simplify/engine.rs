@@ -45,8 +45,11 @@ pub(super) struct State {
     pub(super) placement: Placement,
     /// Box of the input cells: placements stay inside it, hence on the grid.
     pub(super) bounds: ([i32; 3], [i32; 3]),
-    /// Whether each edge is a seam to keep (empty: none; see `simplify_keeping_seams`).
+    /// Whether each edge is a seam to keep (empty: none; see `Constraints::seams`).
     pub(super) seam: Vec<bool>,
+    /// Vertices that may survive a collapse, where they stay, but never vanish (empty: none;
+    /// see `Constraints::pinned`).
+    pub(super) pinned: Vec<bool>,
 }
 
 /// What the seams allow of a collapse of an edge.
@@ -84,7 +87,12 @@ impl State {
             placement,
             bounds,
             seam: Vec::new(),
+            pinned: Vec::new(),
         }
+    }
+
+    fn is_pinned(&self, v: u32) -> bool {
+        self.pinned.get(v as usize).copied().unwrap_or(false)
     }
 
     /// The edge between `a` and `b`, if any.
@@ -111,12 +119,19 @@ impl State {
 
     /// Which end of (a, b) may vanish without moving or joining seams: an end on no seam when
     /// the edge is none, an end on exactly two when the edge is one of them.
+    /// A pinned end never vanishes.
     pub(super) fn seam_rule(&self, a: u32, b: u32) -> SeamRule {
-        if self.seam.is_empty() {
+        if self.seam.is_empty() && self.pinned.is_empty() {
             return SeamRule::Free;
         }
         let along = self.is_seam(a, b);
         let may_vanish = |v: u32| {
+            if self.is_pinned(v) {
+                return false;
+            }
+            if self.seam.is_empty() {
+                return true;
+            }
             let s = self.seams_at(v);
             if along {
                 s == 2
@@ -172,8 +187,8 @@ impl State {
             SeamRule::Refused => return (self.cells[a as usize], f64::INFINITY),
         };
         let forced = self.seam_rule(a, b) != SeamRule::Free;
-        // A survivor on a seam the edge does not follow stays where it is.
-        let pinned = forced && !self.is_seam(a, b);
+        // A survivor on a seam the edge does not follow stays where it is; so does a pinned one.
+        let pinned = forced && (!self.is_seam(a, b) || self.is_pinned(a));
         let q = Quadric::sum(&self.quadrics[a as usize], &self.quadrics[b as usize]);
         let (ca, cb) = (self.cells[a as usize], self.cells[b as usize]);
         let mut best = (ca, q.error(to_f(ca)));
@@ -190,7 +205,7 @@ impl State {
         if !forced {
             consider(anchor(1, cb, ca));
         }
-        if self.placement == Placement::Optimal {
+        if self.placement == Placement::Optimal && !self.is_pinned(a) {
             if let Some(p) = q.minimizer() {
                 let lo = to_f(ca).min(to_f(cb));
                 let hi = to_f(ca).max(to_f(cb));

@@ -120,23 +120,35 @@ fn simplify_with_regions(
     if regions {
         return simplify_in_regions(cells, faces, placement, bounds);
     }
-    simplify_whole(cells, faces, placement, bounds, &[])
+    simplify_whole(cells, faces, placement, bounds, Constraints::default())
 }
 
-/// [`simplify`] keeping `seams` (edges as sorted vertex pairs, the list sorted): a seam edge
-/// gets constraint planes as a boundary does, and a collapse may neither move a seam nor join
-/// two (Hoppe 1996 §4.3, on discontinuity curves): its removed vertex lies on no seam, or on
-/// exactly two with the collapsed edge one of them. Seams are attribute discontinuities —
-/// uv charts, normal creases, material boundaries — which collapses across would smear. The
-/// single greedy loop only: meshes with seams are simplified without the parallel phase.
-pub fn simplify_keeping_seams(
+/// What a simplification keeps besides the rules every collapse obeys.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Constraints<'a> {
+    /// Seams to keep (edges as sorted vertex pairs, the list sorted): a seam edge gets
+    /// constraint planes as a boundary does, and a collapse may neither move a seam nor join
+    /// two (Hoppe 1996 §4.3, on discontinuity curves): its removed vertex lies on no seam, or
+    /// on exactly two with the collapsed edge one of them. Seams are attribute discontinuities
+    /// — uv charts, normal creases, material boundaries — which collapses across would smear.
+    pub seams: &'a [[u32; 2]],
+    /// Vertices that never vanish and, when they survive a collapse, stay where they are
+    /// (empty: none). A mesh cut to a manifold (`mesh::manifold`) pins every vertex that was
+    /// copied and its copies: they start in one cell and so stay at every level, and the cut
+    /// never opens into a crack.
+    pub pinned: &'a [bool],
+}
+
+/// [`simplify`] under `constraints`. The single greedy loop only: constrained meshes are
+/// simplified without the parallel phase.
+pub fn simplify_constrained(
     cells: &[[i32; 3]],
     faces: &[[u32; 3]],
     placement: Placement,
-    seams: &[[u32; 2]],
+    constraints: Constraints,
 ) -> Simplified {
     let bounds = bounds_of(cells);
-    simplify_whole(cells, faces, placement, bounds, seams)
+    simplify_whole(cells, faces, placement, bounds, constraints)
 }
 
 /// The box of `cells`.
@@ -151,14 +163,15 @@ fn bounds_of(cells: &[[i32; 3]]) -> ([i32; 3], [i32; 3]) {
         })
 }
 
-/// The single greedy loop over the whole mesh, keeping `seams` (none when empty).
+/// The single greedy loop over the whole mesh, under `constraints`.
 fn simplify_whole(
     cells: &[[i32; 3]],
     faces: &[[u32; 3]],
     placement: Placement,
     bounds: ([i32; 3], [i32; 3]),
-    seams: &[[u32; 2]],
+    constraints: Constraints,
 ) -> Simplified {
+    let seams = constraints.seams;
     let n = cells.len();
     let t = topology(n, faces, &vec![true; faces.len()]);
     let seam: Vec<bool> = if seams.is_empty() {
@@ -183,6 +196,7 @@ fn simplify_whole(
         t,
     );
     state.seam = seam;
+    state.pinned = constraints.pinned.to_vec();
     // When a pass runs dry, every remaining edge is queued again, until a pass collapses nothing.
     let (mut collapses, mut costs) = (Vec::new(), Vec::new());
     while state.collapse_greedily(f32::INFINITY, &mut collapses, &mut costs) > 0 {}

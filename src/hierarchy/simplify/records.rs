@@ -14,6 +14,8 @@ pub struct ProgressiveMesh {
     pub vsplits: Vec<Vsplit>,
     /// Original vertex of each vertex of Mⁿ, in creation order.
     pub vertex_origin: Vec<u32>,
+    /// Original face of each face of Mⁿ, in creation order.
+    pub face_origin: Vec<u32>,
 }
 
 /// Builds the progressive mesh of a simplification: base mesh from what remains, then the
@@ -127,9 +129,16 @@ pub(super) fn build(
             assert_eq!(mesh.positions[vt as usize], c.before[1]);
         }
     }
+    let mut face_origin = vec![NIL; next_face as usize];
+    for (f, &id) in face_id.iter().enumerate() {
+        if id != NIL {
+            face_origin[id as usize] = f as u32;
+        }
+    }
     ProgressiveMesh {
         base,
         vsplits,
         vertex_origin,
+        face_origin,
     }
 }
