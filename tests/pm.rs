@@ -1,5 +1,8 @@
 //! Progressive meshes: lossless round trips on random manifold meshes (boundaries, several
-//! components), next/prev symmetry, goto, invariants after every step, geomorphs, cut streams.
+//! components), next/prev symmetry, goto, invariants after every step, geomorphs, cut streams;
+//! and the same on random meshes that are no oriented manifold (fins, bow-ties, repeated,
+//! reversed and flipped faces, coincident vertices, several components), which pm cuts to one,
+//! with no crack at any level.
 
 use meshcodec::codecs::pm::iter::{Geomorph, PMeshIter};
 use meshcodec::codecs::{self, EncodeOptions, Stop};
@@ -44,12 +47,42 @@ fn encode(seed: u64, codec: &str, bits: u8) -> Option<(CanonicalMesh, codecs::En
         grid: GridShape::Cubic,
     };
     let canonical = codecs::canonical_for(&mesh, &options).ok()?;
+    Some(encode_canonical(canonical, codec))
+}
+
+fn encode_canonical(canonical: CanonicalMesh, codec: &str) -> (CanonicalMesh, codecs::Encoded) {
+    // Any mesh goes through: one that is no oriented manifold is cut to one.
     match codecs::by_name(codec).unwrap().encode(&canonical) {
-        Ok(e) => Some((canonical, e)),
-        // Coarse grids can weld a manifold into a non-manifold: refused, not a failure here.
-        Err(Error::Unsupported(_)) => None,
+        Ok(e) => (canonical, e),
         Err(e) => panic!("{e}"),
     }
+}
+
+/// A mesh that is no oriented manifold, from a seed: `generate::messy` (fins, a bow-tie,
+/// repeated and reversed faces, coincident vertices, components), with some faces flipped
+/// against their neighbours.
+fn non_manifold(seed: u64) -> TriMesh {
+    let mut mesh = generate::messy(seed);
+    let n = mesh.faces.len();
+    for k in 0..(seed % 4) as usize {
+        let f = (seed as usize / 4 + 7 * k) % n;
+        mesh.faces[f].swap(1, 2);
+    }
+    mesh
+}
+
+fn encode_non_manifold(
+    seed: u64,
+    codec: &str,
+    bits: u8,
+) -> Option<(CanonicalMesh, codecs::Encoded)> {
+    let options = EncodeOptions {
+        quant_bits: bits,
+        grid: GridShape::Cubic,
+    };
+    // Coarse grids can weld every face away: nothing to code then.
+    let canonical = codecs::canonical_for(&non_manifold(seed), &options).ok()?;
+    Some(encode_canonical(canonical, codec))
 }
 
 proptest! {
@@ -136,17 +169,55 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases() / 2))]
+
+    #[test]
+    fn a_mesh_that_is_no_oriented_manifold_decodes_losslessly(seed in any::<u64>(), reordered in any::<bool>(), bits in 6u8..=20) {
+        let codec = if reordered { "pm-reordered" } else { "pm" };
+        let Some((canonical, encoded)) = encode_non_manifold(seed, codec, bits) else { return Ok(()) };
+        let (decoded, levels) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
+        prop_assert_eq!(levels, encoded.levels.len());
+        prop_assert_eq!(canonical.check_lossless(&decoded.mesh), Ok(()));
+        prop_assert_eq!(decoded.mesh.vertex_count(), encoded.levels.last().unwrap().vertices);
+        let (_, again) = encode_non_manifold(seed, codec, bits).unwrap();
+        prop_assert_eq!(encoded.bytes, again.bytes);
+    }
+
+    #[test]
+    fn a_cut_mesh_iterates_with_invariants_and_without_cracks(seed in any::<u64>(), reordered in any::<bool>()) {
+        let codec = if reordered { "pm-reordered" } else { "pm" };
+        let Some((_, encoded)) = encode_non_manifold(seed, codec, 16) else { return Ok(()) };
+        common::walk_without_cracks(&encoded.bytes, true);
+        // goto, and a geomorph between two levels of the manifold.
+        let mut iter = PMeshIter::from_stream(&encoded.bytes).unwrap();
+        let base = iter.nvertices();
+        iter.goto_nvertices(usize::MAX).unwrap();
+        let full = iter.nvertices();
+        iter.goto_nvertices(base).unwrap();
+        prop_assert_eq!(iter.nvertices(), base);
+        let fine_n = (base + full) / 2;
+        let morph = Geomorph::new(&mut iter, fine_n).unwrap();
+        prop_assert!(morph.evaluate(1.0) == meshcodec::codecs::pm::iter::to_trimesh(iter.mesh(), &iter.header().grid));
+        // The prefix of every level decodes.
+        for k in 1..=encoded.levels.len() {
+            let (level, got) = codecs::decode(&encoded.bytes[..encoded.levels[k - 1].end_byte], Stop::All).unwrap();
+            prop_assert_eq!(got, k);
+            prop_assert_eq!(level.mesh.vertex_count(), encoded.levels[k - 1].vertices);
+        }
+    }
+}
+
 #[test]
-fn non_manifold_meshes_are_refused_with_counts() {
-    let mesh = generate::messy(4);
-    let options = EncodeOptions {
-        quant_bits: 16,
-        grid: GridShape::Cubic,
-    };
-    let canonical = codecs::canonical_for(&mesh, &options).unwrap();
-    match codecs::by_name("pm").unwrap().encode(&canonical) {
-        Err(Error::Unsupported(why)) => assert!(why.contains("non-manifold"), "{why}"),
-        other => panic!("expected a refusal, got {:?}", other.map(|e| e.bytes.len())),
+fn a_cut_mesh_corrupted_fails_cleanly() {
+    let (_, encoded) = encode_non_manifold(4, "pm", 16).unwrap();
+    let mut x = 0x9e37_79b9_u32;
+    for _ in 0..1000 {
+        let bytes = common::flip_bits(&encoded.bytes, &mut x, 3);
+        if let Ok((level, _)) = codecs::decode(&bytes, Stop::All) {
+            let n = level.mesh.positions.len() as u32;
+            assert!(level.mesh.faces.iter().flatten().all(|&v| v < n));
+        }
     }
 }
 
@@ -204,4 +275,33 @@ fn an_input_stream_gives_the_same_sequence_as_bytes_in_memory() {
     let mut partial = PMeshIter::from_reader(&encoded.bytes[..cut]).unwrap();
     while partial.next().unwrap() {}
     assert_eq!(partial.nvertices(), encoded.levels[k].vertices);
+}
+
+#[test]
+fn the_generated_meshes_need_copies_and_flips() {
+    let (mut copies, mut flips, mut whole) = (0.0, 0.0, 0);
+    for seed in 0..16 {
+        let (_, encoded) = encode_non_manifold(seed, "pm", 16).unwrap();
+        let stat = |name: &str| encoded.stats.get_named(name);
+        match (stat("repair_copies"), stat("repair_flips")) {
+            (Some(c), Some(f)) => {
+                copies += c;
+                flips += f;
+            }
+            _ => whole += 1,
+        }
+        // Vertices of Mⁿ sharing a cell are a vertex and its copies, nothing else.
+        let c = stat("repair_copies").unwrap_or(0.0) as usize;
+        let together = common::walk_without_cracks(&encoded.bytes, false);
+        assert!(
+            together == 0 || (together > c && together <= 2 * c),
+            "{together} {c}"
+        );
+        assert_eq!(together == 0, c == 0);
+    }
+    assert!(
+        copies > 0.0 && flips > 0.0,
+        "{copies} copies, {flips} flips"
+    );
+    assert!(whole < 16, "every generated mesh was an oriented manifold");
 }

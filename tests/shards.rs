@@ -68,21 +68,24 @@ fn tree(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
 fn three_shards_merged_are_one_run() {
     let dir = tempfile::tempdir().unwrap();
     let set = dir.path().join("tiny.toml");
-    // 2 meshes × 3 codecs × 2 quantizations = 12 jobs; pm refuses the non-manifold bunny-res4.
+    // 2 meshes × 3 codecs × 2 quantizations = 12 jobs; spot's uvs in the levels are for pm
+    // alone: raw and emc refuse them.
     std::fs::write(
         &set,
         r#"description = "sharding test"
 codecs = ["raw", "emc", "pm"]
-meshes = ["bunny-res4", "bunny-3k-libigl"]
+meshes = ["bunny-res4", "spot"]
 quant = [10, 12]
 samples = 2
 keep_streams = true
+appearance = true
+attributes = ["fit"]
 "#,
     )
     .unwrap();
     let set = set.to_str().unwrap();
     let one = experiment(&["run", set, "--out", "one"], dir.path());
-    assert!(one.contains("pm refused bunny-res4"), "{one}");
+    assert!(one.contains("emc refused spot"), "{one}");
     for i in 1..=3 {
         let shard = format!("{i}/3");
         let out = format!("shard{i}");
@@ -112,9 +115,10 @@ keep_streams = true
         assert!(bytes == &merged_files[path], "{} differs", path.display());
     }
     for expected in [
-        "compare/tiny/bunny-3k-libigl-rate-distortion.png",
-        "pm/bunny-res4.refused.txt",
-        "emc/bunny-3k-libigl-q10.mc",
+        "compare/tiny/spot-rate-distortion.png",
+        "emc/spot.refused.txt",
+        "pm/bunny-res4-q10.mc",
+        "pm/spot-q10-appearance-fit.mc",
     ] {
         assert!(
             one_files.contains_key(Path::new(expected)),

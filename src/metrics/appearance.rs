@@ -75,18 +75,27 @@ impl AppearanceReference {
             return AppearanceError::default();
         };
         let index = SurfaceIndex::of_mesh(level, &[]);
-        let sums = self
+        // Fixed chunks summed in order: the same floating-point sum however rayon schedules
+        // them (a fold's splits vary from run to run, and so did the last bits).
+        const CHUNK: usize = 1024;
+        let chunks: Vec<Sums> = self
             .points
-            .par_iter()
-            .zip(&self.values)
-            .fold(Sums::default, |mut sums, (&p, original)| {
-                if let Some((face, w)) = index.nearest_face(p) {
-                    sums.add(original, &interpolate(attributes, face, w));
+            .par_chunks(CHUNK)
+            .zip(self.values.par_chunks(CHUNK))
+            .map(|(points, values)| {
+                let mut sums = Sums::default();
+                for (&p, original) in points.iter().zip(values) {
+                    if let Some((face, w)) = index.nearest_face(p) {
+                        sums.add(original, &interpolate(attributes, face, w));
+                    }
                 }
                 sums
             })
-            .reduce(Sums::default, Sums::merge);
-        sums.error()
+            .collect();
+        chunks
+            .into_iter()
+            .fold(Sums::default(), Sums::merge)
+            .error()
     }
 }
 
