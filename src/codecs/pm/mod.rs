@@ -198,6 +198,111 @@ fn check_manifold(vertex_count: usize, faces: &[[u32; 3]]) -> Result<()> {
     Ok(())
 }
 
+/// The oriented 2-manifold pm builds its progressive mesh on: the canonical mesh itself when it
+/// is one, else its cut ([`ManifoldCut`]: copies of vertices where fans meet, faces flipped to
+/// agree with their component) with every copied vertex pinned, so that a vertex and its
+/// copies stay in one cell at every level (`simplify::Constraints::pinned`).
+pub struct ManifoldInput {
+    /// Cells of the manifold's vertices: the canonical mesh's, then the copies'.
+    pub cells: Vec<[i32; 3]>,
+    /// The manifold's faces, in the canonical mesh's order.
+    pub faces: Vec<[u32; 3]>,
+    /// The cut, when the canonical mesh was no oriented manifold.
+    pub cut: Option<ManifoldCut>,
+    /// Vertices that must stay where they are (none for a mesh that was not cut).
+    pub pinned: Vec<bool>,
+}
+
+impl ManifoldInput {
+    /// The manifold of `mesh`.
+    pub fn of(mesh: &CanonicalMesh) -> Result<ManifoldInput> {
+        let mut cells = cells_of(mesh);
+        if check_manifold(mesh.vertex_count(), &mesh.faces).is_ok() {
+            return Ok(ManifoldInput {
+                cells,
+                faces: mesh.faces.clone(),
+                cut: None,
+                pinned: Vec::new(),
+            });
+        }
+        let n = mesh.vertex_count();
+        let cut = ManifoldCut::new(n, &mesh.faces);
+        for &v in &cut.copy_of {
+            cells.push(cells[v as usize]);
+        }
+        // The cut is a manifold by construction; checked again, so that a fault is an error.
+        check_manifold(cells.len(), &cut.faces)?;
+        Ok(ManifoldInput {
+            cells,
+            faces: cut.faces.clone(),
+            pinned: cut.copied(n),
+            cut: Some(cut),
+        })
+    }
+
+    /// What the simplifier must keep: the pinned vertices.
+    pub fn constraints(&self) -> simplify::Constraints<'_> {
+        simplify::Constraints {
+            seams: &[],
+            pinned: &self.pinned,
+        }
+    }
+}
+
+/// What cutting a mesh to a manifold costs a pm stream, against the progressive mesh of the
+/// same manifold coded as if it were the input (no vertex pinned, no flips coded, its full
+/// decode the manifold rather than the mesh): the price of getting the mesh back.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RepairCost {
+    /// Bytes of the stream `encode` writes.
+    pub repaired_bytes: usize,
+    /// Bytes of the manifold's own stream.
+    pub manifold_bytes: usize,
+    /// Bits of the flips field.
+    pub flip_bits: f64,
+    /// Vertices copied, faces flipped, edges cut.
+    pub copies: usize,
+    /// See `copies`.
+    pub flips: usize,
+    /// See `copies`.
+    pub cut_edges: usize,
+    /// Vertices of the base mesh, repaired and not.
+    pub base_vertices: [usize; 2],
+}
+
+impl Pm {
+    /// What the cut costs on `mesh`; `None` when it is an oriented manifold (nothing cut).
+    pub fn repair_cost(&self, mesh: &CanonicalMesh) -> Result<Option<RepairCost>> {
+        let input = ManifoldInput::of(mesh)?;
+        let Some(cut) = &input.cut else {
+            return Ok(None);
+        };
+        let repaired = self.encode_cut(mesh, &input, cut)?;
+        let plain = self.progressive_mesh(&input.cells, &input.faces, None);
+        // The manifold as a mesh of its own: its cells are not all distinct, which only the
+        // weld at the decoder's last level would need.
+        let manifold = CanonicalMesh {
+            grid: mesh.grid,
+            cells: input.cells.iter().map(|c| c.map(|x| x as u32)).collect(),
+            faces: input.faces.clone(),
+        };
+        let manifold_stream = encode_pm(self.id(), self.params(), &manifold, &plain, None, None);
+        let stat = |s: &Stats, name: &str| s.get_named(name).unwrap_or(0.0);
+        Ok(Some(RepairCost {
+            repaired_bytes: repaired.bytes.len(),
+            manifold_bytes: manifold_stream.bytes.len(),
+            flip_bits: stat(&repaired.stats, "bits_repair"),
+            copies: cut.copy_of.len(),
+            flips: cut.flip_count(),
+            cut_edges: cut.cut_edges,
+            base_vertices: [
+                stat(&repaired.stats, &Stat::BaseVertices.key()) as usize,
+                plain.base.positions.len(),
+            ],
+        }))
+    }
+}
+
 /// What the decoder needs of a mesh cut to a manifold ([`repair`]).
 struct RepairPlan {
     /// Vertices the cut copied.
@@ -340,24 +445,13 @@ impl Pm {
 
     /// Encodes a mesh that is no oriented manifold: the progressive mesh of its cut
     /// ([`ManifoldCut`]), copied vertices pinned, and the flips at the last level ([`repair`]).
-    fn encode_cut(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
-        let n = mesh.vertex_count();
-        let cut = ManifoldCut::new(n, &mesh.faces);
-        let mut cells = cells_of(mesh);
-        for &v in &cut.copy_of {
-            cells.push(cells[v as usize]);
-        }
-        // The cut is a manifold by construction; checked again, so that a fault is an error.
-        check_manifold(cells.len(), &cut.faces)?;
-        let pinned = cut.copied(n);
-        let pm = self.progressive_mesh(
-            &cells,
-            &cut.faces,
-            Some(simplify::Constraints {
-                seams: &[],
-                pinned: &pinned,
-            }),
-        );
+    fn encode_cut(
+        &self,
+        mesh: &CanonicalMesh,
+        input: &ManifoldInput,
+        cut: &ManifoldCut,
+    ) -> Result<Encoded> {
+        let pm = self.progressive_mesh(&input.cells, &input.faces, Some(input.constraints()));
         let plan = RepairPlan {
             copies: cut.copy_of.len() as u64,
             flips: pm
@@ -479,10 +573,11 @@ impl Codec for Pm {
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         // An oriented manifold is coded as it is (its streams as they always were); any other
         // mesh through its cut.
-        if check_manifold(mesh.vertex_count(), &mesh.faces).is_err() {
-            return self.encode_cut(mesh);
+        let input = ManifoldInput::of(mesh)?;
+        if let Some(cut) = &input.cut {
+            return self.encode_cut(mesh, &input, cut);
         }
-        let pm = self.progressive_mesh(&cells_of(mesh), &mesh.faces, None);
+        let pm = self.progressive_mesh(&input.cells, &input.faces, None);
         Ok(encode_pm(self.id(), self.params(), mesh, &pm, None, None))
     }
 
