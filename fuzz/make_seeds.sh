@@ -126,11 +126,36 @@ with open('read_m/torus.m', 'w') as f:
     for k, p in enumerate(pts): f.write('Vertex %d %f %f %f {normal=(0 0 1)}\n' % ((k + 1,) + p))
     for k, t in enumerate(tris): f.write('Face %d %d %d %d\n' % ((k + 1,) + tuple(x + 1 for x in t)))
 EOF
+# No oriented manifold: two tetrahedra sharing a vertex (a bow-tie), one face turned over, and
+# a fin on an edge; pm cuts it to a manifold (docs/FORMAT.md §6.2).
+cat > $seeds/read_obj/bowtie-fin.obj <<'OBJ'
+v 0 0 0
+v 1 0 0
+v 0 1 0
+v 0 0 1
+v -1 0 0
+v 0 -1 0
+v 0 0 -1
+v 1 1 1
+f 1 3 2
+f 1 2 4
+f 1 4 3
+f 2 4 3
+f 1 6 5
+f 1 5 7
+f 1 7 6
+f 5 6 7
+f 2 3 8
+OBJ
+# The torus with a fin on the edge of its first face and its second face turned over: cut, and
+# refined over several levels.
+awk '/^v /{n++} /^f /{f++; if (f == 2) {printf "f"; for (i = NF; i > 1; i--) printf " %s", $i; print ""; next}} {print} END {print "v 0 0 3"; print "f 1 2", n + 1}' \
+  $seeds/read_obj/torus.obj | sed 's|/[0-9/]*||g' > $seeds/read_obj/torus-fin.obj
 stream=$(mktemp)
 for codec in raw emc emc-paper pm pm-reordered came came-paper; do
   dir=$seeds/decode_${codec//-/_}
   mkdir -p "$dir"
-  for mesh in $seeds/read_obj/torus.obj $seeds/read_off/colour.off; do
+  for mesh in $seeds/read_obj/torus.obj $seeds/read_off/colour.off $seeds/read_obj/bowtie-fin.obj $seeds/read_obj/torus-fin.obj; do
     name=$(basename "$mesh"); name=${name%.*}
     target/release/meshcodec encode --codec "$codec" --quant 10 --drop-attributes "$mesh" "$stream" >/dev/null 2>&1
     tail -c +7 "$stream" > "$dir/$name.body"

@@ -758,6 +758,7 @@ fn decimation(out: &Path) -> Result<()> {
         let canonical = codecs::canonical_for(&mesh, &options)?;
         let started = std::time::Instant::now();
         let input = ManifoldInput::of(&canonical)?;
+        let manifold_seconds = started.elapsed().as_secs_f64();
         let simplified = match &input.cut {
             None => simplify(&input.cells, &input.faces, Placement::Optimal),
             Some(_) => simplify_constrained(
@@ -772,7 +773,7 @@ fn decimation(out: &Path) -> Result<()> {
         let total_seconds = started.elapsed().as_secs_f64();
         let faces = canonical.face_count();
         meshcodec::outln!(
-            "{name} x{}: {faces} faces -> base {} vertices; simplify {simplify_seconds:.2} s, with PM construction {total_seconds:.2} s ({:.0} faces/s)",
+            "{name} x{}: {faces} faces -> base {} vertices; manifold check or cut {manifold_seconds:.2} s, with simplification {simplify_seconds:.2} s, with PM construction {total_seconds:.2} s ({:.0} faces/s)",
             4u32.pow(times),
             pm.base.positions.len(),
             faces as f64 / total_seconds
@@ -785,6 +786,7 @@ fn decimation(out: &Path) -> Result<()> {
             "vertices": canonical.vertex_count(),
             "base_vertices": pm.base.positions.len(),
             "vsplits": pm.vsplits.len(),
+            "manifold_seconds": manifold_seconds,
             "simplify_seconds": simplify_seconds,
             "total_seconds": total_seconds,
             "faces_per_second": faces as f64 / total_seconds,

@@ -385,6 +385,16 @@ pub fn open(bytes: &[u8]) -> Result<Box<dyn LevelDecoder + '_>> {
     })
 }
 
+/// The most vertices any level of a stream with `header` may decode to: the header's, but for
+/// the meshes of a `pm` stream cut to a manifold before its last level, which hold the copies
+/// too (docs/FORMAT.md §6.2).
+pub fn most_level_vertices(header: &Header) -> u64 {
+    if header.codec_id == names::PM.id || header.codec_id == names::PM_REORDERED.id {
+        return pm::most_vertices(header);
+    }
+    header.vertices
+}
+
 /// The bytes each level of a stream needs ([`Codec::level_ends`]), from a prefix holding at
 /// least its header and index ([`Error::Truncated`] when it does not yet). The full level of a
 /// stream with appearance ends with its appearance unit.

@@ -26,6 +26,7 @@
 
 use super::topology::DisjointSets;
 use super::VertexId;
+use rayon::prelude::*;
 
 /// An oriented 2-manifold made from a face set, with how to get back.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -75,7 +76,7 @@ impl ManifoldCut {
                 })
             })
             .collect();
-        halves.sort_unstable_by_key(|h| (h.key, h.face, h.k));
+        halves.par_sort_unstable_by_key(|h| (h.key, h.face, h.k));
         // Edges as runs of `halves`; each face's three edges.
         let mut edge_start = Vec::with_capacity(halves.len() / 2 + 1);
         let mut face_edge = vec![[0u32; 3]; faces.len()];
@@ -95,7 +96,12 @@ impl ManifoldCut {
         loop {
             let (out, copy_of) =
                 split_fans(vertex_count, faces, &halves, &edge_start, &cut, &flipped);
-            let bad = faces_on_bad_edges(&out);
+            // Only an edge that joins no faces can leave two sharing both its ends.
+            let bad = if cut.contains(&true) {
+                faces_on_bad_edges(&out)
+            } else {
+                Vec::new()
+            };
             if bad.is_empty() {
                 return ManifoldCut {
                     faces: out,
@@ -174,8 +180,8 @@ fn orient(
         while next < component.len() {
             let f = component[next] as usize;
             next += 1;
-            for k in 0..3 {
-                let e = face_edge[f][k] as usize;
+            for &e in &face_edge[f] {
+                let e = e as usize;
                 if cut[e] {
                     continue;
                 }
@@ -275,7 +281,7 @@ fn faces_on_bad_edges(faces: &[[VertexId; 3]]) -> Vec<(u32, VertexId)> {
             })
         })
         .collect();
-    sides.sort_unstable();
+    sides.par_sort_unstable();
     let mut bad = Vec::new();
     for run in sides.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
         if run.len() > 2 || (run.len() == 2 && run[0].3 == run[1].3) {

@@ -18,6 +18,16 @@
 //! | wedge, corners field, wedge deltas, matid | [`wedges`]: a corner's value is a candidate choice or a predicted residual |
 //! | Δflclw, reordering by a dependency graph | `pm-reordered` (Table 4); `pm` keeps the collapse order (Table 3) |
 //!
+//! # Any mesh
+//! Hoppe's PM needs an oriented 2-manifold. A canonical mesh that is none is first cut to one
+//! ([`ManifoldInput`], `mesh::manifold`: vertex copies where fans meet, faces flipped to agree
+//! with their component), with every copied vertex and its copies pinned in the simplifier, so
+//! that they stay in M⁰ at their one cell and no level opens a crack along the cut. The stream's
+//! parameters say how many copies there are; the last level ends with the flipped faces, and
+//! its decoded mesh welds the vertices that share a cell and turns those faces back
+//! ([`repair`], docs/FORMAT.md §6.2): the canonical mesh, exactly. An oriented manifold is coded
+//! as it always was. `experiment repair-cost` measures the price of the cut.
+//!
 //! # Stream
 //! Level 1 is M⁰: vertex and face counts, cells as Q raw bits a coordinate, corners as
 //! ⌈log2 V⁰⌉ raw bits. Each further level holds a batch of vsplits, the vertex count about
@@ -216,22 +226,22 @@ pub struct ManifoldInput {
 impl ManifoldInput {
     /// The manifold of `mesh`.
     pub fn of(mesh: &CanonicalMesh) -> Result<ManifoldInput> {
+        let n = mesh.vertex_count();
+        // The cut leaves an oriented manifold as it is, and only one: nothing copied and
+        // nothing flipped is exactly the case `check_manifold` accepts.
+        let cut = ManifoldCut::new(n, &mesh.faces);
         let mut cells = cells_of(mesh);
-        if check_manifold(mesh.vertex_count(), &mesh.faces).is_ok() {
+        if cut.is_identity() {
             return Ok(ManifoldInput {
                 cells,
-                faces: mesh.faces.clone(),
+                faces: cut.faces,
                 cut: None,
                 pinned: Vec::new(),
             });
         }
-        let n = mesh.vertex_count();
-        let cut = ManifoldCut::new(n, &mesh.faces);
         for &v in &cut.copy_of {
             cells.push(cells[v as usize]);
         }
-        // The cut is a manifold by construction; checked again, so that a fault is an error.
-        check_manifold(cells.len(), &cut.faces)?;
         Ok(ManifoldInput {
             cells,
             faces: cut.faces.clone(),
@@ -309,6 +319,11 @@ struct RepairPlan {
     copies: u64,
     /// Whether each face of Mⁿ (in the decoder's face order) was flipped.
     flips: Vec<bool>,
+}
+
+/// The most vertices a level of a pm stream with `header` has: Mⁿ's, copies included.
+pub fn most_vertices(header: &Header) -> u64 {
+    PmParams::from_header(header).map_or(header.vertices, |p| p.full_vertices(header))
 }
 
 /// A base-mesh level as read: the mesh, its values when the stream carries appearance, and
