@@ -69,6 +69,9 @@ macro_rules! regressions {
 regressions! {
     emc_header_declaring_no_vertices_is_refused: "decode_emc" / "header-declares-no-vertices";
     pm_base_mesh_with_a_non_manifold_vertex_is_refused: "decode_pm" / "non-manifold-base-mesh";
+    pm_last_level_welding_a_face_into_a_degenerate_one_is_refused: "decode_pm" / "last-level-welds-a-face-into-a-degenerate-one";
+    a_mutated_cut_pm_stream_welding_a_face_is_refused: "decode_mutated" / "cut-pm-stream-whose-last-level-welds-a-face";
+    came_contraction_of_a_tiny_lattice_mesh_ends: "roundtrip" / "came-contraction-slow-on-a-tiny-lattice";
     obj_texture_index_past_the_list_is_refused: "read_obj" / "texture-index-overflows-in-tobj";
     ply_element_with_records_but_no_properties_is_refused: "read_ply" / "element-without-properties";
     gltf_primitive_naming_an_accessor_past_the_list_is_refused: "read_gltf" / "position-accessor-past-the-list";

@@ -312,16 +312,24 @@ impl<'a> PMeshIter<'a> {
                 .as_mut()
                 .and_then(|r| r.coder.as_mut())
                 .and_then(|coder| super::repair::get_flips(coder, &self.mesh));
-            match flips {
-                Some(flips) => self.flips = Some(flips),
-                None => {
-                    self.mesh.ecol(&split);
-                    return Err(Error::malformed(
-                        self.levels_read(),
-                        0,
-                        "the flipped faces of the last level cannot be read",
-                    ));
+            let fault = match flips {
+                Some(_) if !super::repair::welds_cleanly(&self.mesh) => {
+                    Some("the last level welds two corners of a face into one vertex")
                 }
+                Some(flips) => {
+                    self.flips = Some(flips);
+                    None
+                }
+                None => Some("the flipped faces of the last level cannot be read"),
+            };
+            if let Some(what) = fault {
+                self.mesh.ecol(&split);
+                if let Some(w) = self.wedges.as_mut() {
+                    if let Some(done) = w.splits.pop() {
+                        w.state.undo(&done);
+                    }
+                }
+                return Err(Error::malformed(self.levels_read(), 0, what));
             }
         }
         self.applied += 1;
@@ -388,11 +396,9 @@ impl<'a> PMeshIter<'a> {
     /// The current mesh with positions at cell centres; at Mⁿ of a mesh cut to a manifold, the
     /// mesh itself (copies welded, flipped faces turned back).
     pub fn level_mesh(&self) -> LevelMesh {
-        let mesh = match &self.flips {
-            Some(flips) if self.mesh.positions.len() as u64 == self.full_vertices => {
-                super::repair::restore(&self.mesh, flips, &self.header.grid)
-            }
-            _ => to_trimesh(&self.mesh, &self.header.grid),
+        let mesh = match self.restored_faces() {
+            Some((mesh, _)) => mesh,
+            None => to_trimesh(&self.mesh, &self.header.grid),
         };
         LevelMesh {
             mesh,
@@ -401,11 +407,30 @@ impl<'a> PMeshIter<'a> {
         }
     }
 
+    /// At Mⁿ of a mesh cut to a manifold, the mesh itself and the flips that turned it.
+    fn restored_faces(&self) -> Option<(TriMesh, &[bool])> {
+        let flips = self.flips.as_ref()?;
+        (self.mesh.positions.len() as u64 == self.full_vertices).then(|| {
+            (
+                super::repair::restore(&self.mesh, flips, &self.header.grid),
+                &flips[..],
+            )
+        })
+    }
+
     /// The current mesh's appearance, when the stream carries one: its wedges welded from the
     /// corners' values.
     pub fn attributes(&self) -> Option<Attributes> {
         let (w, spec) = (self.wedges.as_ref()?, self.header.appearance.as_ref()?);
-        let (corners, wedge_vertex, codes) = wedges::weld(&w.state, &self.mesh);
+        let (corners, wedge_vertex, codes) = match self.restored_faces() {
+            // Mⁿ of a mesh cut to a manifold: the wedges of the mesh itself.
+            Some((faces, flips)) => wedges::weld_face_values(
+                faces.faces.iter().copied(),
+                &super::repair::restore_corners(&w.state.corners, flips),
+                faces.positions.len(),
+            ),
+            None => wedges::weld(&w.state, &self.mesh),
+        };
         Some(decoded_attributes(
             corners,
             wedge_vertex,

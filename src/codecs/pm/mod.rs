@@ -61,11 +61,10 @@ use crate::container::{AppearanceSpec, Header, LevelCost, StreamReader, StreamWr
 use crate::error::{Error, Result};
 use crate::hierarchy::pmesh::PmMesh;
 use crate::hierarchy::simplify::{self, Placement};
-use crate::mesh::canonical_attributes::CanonicalAttributes;
+use crate::mesh::canonical_attributes::{CanonicalAttributes, CornerCode};
 use crate::mesh::manifold::ManifoldCut;
 use crate::mesh::quantize::GridShape;
-use crate::mesh::topology::analyze;
-use crate::mesh::{CanonicalMesh, TriMesh};
+use crate::mesh::CanonicalMesh;
 use iter::PMeshIter;
 
 /// The statistic of the bits that code the base mesh's appearance.
@@ -134,13 +133,6 @@ impl PmParams {
                         "pm parameters declare more vertex copies than the mesh has corners",
                     ));
                 }
-                if header.appearance.as_ref().is_some_and(|a| a.in_levels) {
-                    return Err(Error::malformed(
-                        0,
-                        6,
-                        "a pm stream of a mesh cut to a manifold does not carry appearance in its splits",
-                    ));
-                }
                 Some(copies)
             }
             _ => return Err(unknown()),
@@ -187,27 +179,6 @@ impl Pm {
     }
 }
 
-/// Refuses face sets that are not oriented 2-manifolds, with the counts that say why.
-fn check_manifold(vertex_count: usize, faces: &[[u32; 3]]) -> Result<()> {
-    let report = analyze(&TriMesh::new(
-        vec![glam::DVec3::ZERO; vertex_count],
-        faces.to_vec(),
-    ));
-    let mut directed = std::collections::HashSet::new();
-    let twice = faces
-        .iter()
-        .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])))
-        .filter(|e| !directed.insert(*e))
-        .count();
-    if !report.is_manifold() || twice > 0 {
-        return Err(Error::Unsupported(format!(
-            "pm needs an oriented 2-manifold; this mesh has {} non-manifold edges, {} non-manifold vertices and {} edges used twice in one direction",
-            report.non_manifold_edges, report.non_manifold_vertices, twice
-        )));
-    }
-    Ok(())
-}
-
 /// The oriented 2-manifold pm builds its progressive mesh on: the canonical mesh itself when it
 /// is one, else its cut ([`ManifoldCut`]: copies of vertices where fans meet, faces flipped to
 /// agree with their component) with every copied vertex pinned, so that a vertex and its
@@ -228,7 +199,8 @@ impl ManifoldInput {
     pub fn of(mesh: &CanonicalMesh) -> Result<ManifoldInput> {
         let n = mesh.vertex_count();
         // The cut leaves an oriented manifold as it is, and only one: nothing copied and
-        // nothing flipped is exactly the case `check_manifold` accepts.
+        // nothing flipped means every edge has one face or two running it both ways, and every
+        // vertex one fan.
         let cut = ManifoldCut::new(n, &mesh.faces);
         let mut cells = cells_of(mesh);
         if cut.is_identity() {
@@ -317,6 +289,8 @@ impl Pm {
 struct RepairPlan {
     /// Vertices the cut copied.
     copies: u64,
+    /// Edges the cut made join no faces.
+    cut_edges: usize,
     /// Whether each face of Mⁿ (in the decoder's face order) was flipped.
     flips: Vec<bool>,
 }
@@ -373,7 +347,9 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<Base> {
     let mesh =
         PmMesh::from_triangles(positions, &faces).filter(|mesh| mesh.check_invariants().is_ok())?;
     let flips = match params.copies {
-        Some(_) if v == params.full_vertices(header) => Some(repair::get_flips(&mut dec, &mesh)?),
+        Some(_) if v == params.full_vertices(header) => {
+            Some(repair::get_flips(&mut dec, &mesh).filter(|_| repair::welds_cleanly(&mesh))?)
+        }
         _ => None,
     };
     let state = match header.appearance.as_ref().filter(|a| a.in_levels) {
@@ -396,18 +372,20 @@ fn cells_of(mesh: &CanonicalMesh) -> Vec<[i32; 3]> {
     mesh.cells.iter().map(|c| c.map(|x| x as i32)).collect()
 }
 
-/// Seams of the canonical mesh's appearance: edges whose two faces differ in material or in
-/// the values at either end (sorted vertex pairs, sorted).
-fn seams_of(mesh: &CanonicalMesh, appearance: &CanonicalAttributes) -> Vec<[u32; 2]> {
+/// Seams of a manifold's appearance: edges whose two faces differ in material or in the values
+/// at either end (sorted vertex pairs, sorted). `code(f, k)` is the value of corner k of face f.
+fn seams_of(
+    faces: &[[u32; 3]],
+    code: impl Fn(usize, usize) -> CornerCode,
+    material: impl Fn(usize) -> Option<u32>,
+) -> Vec<[u32; 2]> {
     let mut directed: std::collections::HashMap<(u32, u32), (usize, usize)> =
-        std::collections::HashMap::with_capacity(mesh.faces.len() * 3);
-    for (f, t) in mesh.faces.iter().enumerate() {
+        std::collections::HashMap::with_capacity(faces.len() * 3);
+    for (f, t) in faces.iter().enumerate() {
         for k in 0..3 {
             directed.insert((t[k], t[(k + 1) % 3]), (f, k));
         }
     }
-    let code = |f: usize, k: usize| appearance.code(appearance.corners[f][k]);
-    let material = |f: usize| appearance.materials.as_ref().map(|m| m.face[f]);
     let mut seams = Vec::new();
     for (&(u, w), &(f, k)) in &directed {
         if u > w {
@@ -469,6 +447,7 @@ impl Pm {
         let pm = self.progressive_mesh(&input.cells, &input.faces, Some(input.constraints()));
         let plan = RepairPlan {
             copies: cut.copy_of.len() as u64,
+            cut_edges: cut.cut_edges,
             flips: pm
                 .face_origin
                 .iter()
@@ -479,15 +458,7 @@ impl Pm {
             copies: Some(plan.copies),
             ..self.params()
         };
-        let mut encoded = encode_pm(self.id(), params, mesh, &pm, None, Some(&plan));
-        encoded.stats.add_named("repair_copies", plan.copies as f64);
-        encoded
-            .stats
-            .add_named("repair_flips", cut.flip_count() as f64);
-        encoded
-            .stats
-            .add_named("repair_cut_edges", cut.cut_edges as f64);
-        Ok(encoded)
+        Ok(encode_pm(self.id(), params, mesh, &pm, None, Some(&plan)))
     }
 
     /// Encodes with the appearance inside the vertex splits ([`wedges`]).
@@ -497,47 +468,44 @@ impl Pm {
         appearance: &CanonicalAttributes,
         fit: AttributeFit,
     ) -> Result<Encoded> {
-        check_manifold(mesh.vertex_count(), &mesh.faces).map_err(|_| {
-            Error::Unsupported(
-                "pm carries appearance in its splits only on an oriented 2-manifold; without --attributes, its appearance unit carries it".into(),
-            )
-        })?;
-        let seams = seams_of(mesh, appearance);
+        let input = ManifoldInput::of(mesh)?;
+        let flipped = |f: usize| input.cut.as_ref().is_some_and(|c| c.flipped[f]);
+        // Corner k of manifold face f is the canonical face's corner k, or for a flipped face
+        // (its last two corners swapped) the other of the last two.
+        let code = |f: usize, k: usize| {
+            let k = if flipped(f) { [0, 2, 1][k] } else { k };
+            appearance.code(appearance.corners[f][k])
+        };
+        let material = |f: usize| appearance.materials.as_ref().map(|m| m.face[f]);
+        let seams = seams_of(&input.faces, code, material);
         let pm = self.progressive_mesh(
-            &cells_of(mesh),
-            &mesh.faces,
+            &input.cells,
+            &input.faces,
             Some(simplify::Constraints {
                 seams: &seams,
-                pinned: &[],
+                pinned: &input.pinned,
             }),
         );
         let mut full = pm.base.clone();
         for split in &pm.vsplits {
             full.vsplit(split).expect("the encoder's own splits apply");
         }
-        // Each face of Mⁿ is a canonical face: its values, rotated to its first corner.
-        let mut canonical_face: std::collections::HashMap<[u32; 3], usize> =
-            std::collections::HashMap::with_capacity(mesh.faces.len());
-        for (f, t) in mesh.faces.iter().enumerate() {
-            canonical_face.insert(*t, f);
-        }
+        // Each face of Mⁿ is a manifold face: its values, rotated to its first corner.
         let mut state = wedges::WedgeState {
             corners: Vec::with_capacity(full.faces.len()),
             materials: appearance.materials.as_ref().map(|_| Vec::new()),
         };
-        for face in &full.faces {
+        for (face, &f) in full.faces.iter().zip(&pm.face_origin) {
+            let f = f as usize;
             let t = face.v.map(|v| pm.vertex_origin[v as usize]);
-            let (f, r) = (0..3)
-                .find_map(|r| {
-                    canonical_face
-                        .get(&[t[r], t[(r + 1) % 3], t[(r + 2) % 3]])
-                        .map(|&f| (f, r))
-                })
+            let m = input.faces.get(f);
+            let r = (0..3)
+                .find(|&r| m == Some(&[t[r], t[(r + 1) % 3], t[(r + 2) % 3]]))
                 .ok_or_else(|| Error::Unsupported("pm rebuilt a face the mesh lacks".into()))?;
-            // Canonical corner i is our corner (i + r).
+            // Manifold corner i is our corner (i + r).
             let mut codes = [Default::default(); 3];
-            for (i, &w) in appearance.corners[f].iter().enumerate() {
-                codes[(i + r) % 3] = appearance.code(w);
+            for i in 0..3 {
+                codes[(i + r) % 3] = code(f, i);
             }
             state.corners.push(codes);
             if let (Some(out), Some(m)) = (state.materials.as_mut(), &appearance.materials) {
@@ -547,13 +515,26 @@ impl Pm {
         let mut spec = super::appearance::spec_of(appearance);
         spec.in_levels = true;
         let levels = wedge_levels::derive(&full, state, &pm.vsplits, fit, &spec);
+        let plan = input.cut.as_ref().map(|cut| RepairPlan {
+            copies: cut.copy_of.len() as u64,
+            cut_edges: cut.cut_edges,
+            flips: pm
+                .face_origin
+                .iter()
+                .map(|&f| cut.flipped[f as usize])
+                .collect(),
+        });
+        let params = PmParams {
+            copies: plan.as_ref().map(|p| p.copies),
+            ..self.params()
+        };
         Ok(encode_pm(
             self.id(),
-            self.params(),
+            params,
             mesh,
             &pm,
             Some((&spec, &levels)),
-            None,
+            plan.as_ref(),
         ))
     }
 }
@@ -794,6 +775,12 @@ fn encode_pm(
             .chain(stats.get_named(BASE_APPEARANCE_BITS))
             .sum();
         stats.add_named("appearance_bits", bits);
+    }
+    if let Some(plan) = repair {
+        stats.add_named("repair_copies", plan.copies as f64);
+        let flips = plan.flips.iter().filter(|&&f| f).count();
+        stats.add_named("repair_flips", flips as f64);
+        stats.add_named("repair_cut_edges", plan.cut_edges as f64);
     }
     stats.set(Stat::Vsplits, pm.vsplits.len() as f64);
     stats.set(Stat::BaseVertices, base.positions.len() as f64);

@@ -72,13 +72,22 @@ pub fn get_flips(dec: &mut ArithDecoder, mesh: &PmMesh) -> Option<Vec<bool>> {
     Some(flips)
 }
 
-/// The mesh the manifold Mⁿ stands for: vertices sharing a cell welded (the first keeps its
-/// place), flipped faces turned back.
-pub fn restore(mesh: &PmMesh, flips: &[bool], grid: &Grid) -> TriMesh {
+/// Whether welding the vertices of `mesh` that share a cell leaves every face three distinct
+/// corners: what the encoder's Mⁿ always does, and a corrupt stream's may not.
+pub fn welds_cleanly(mesh: &PmMesh) -> bool {
+    let welded = weld(mesh).0;
+    mesh.faces.iter().all(|face| {
+        let [a, b, c] = face.v.map(|v| welded[v as usize]);
+        a != b && b != c && a != c
+    })
+}
+
+/// The vertex each vertex of `mesh` welds into, and the cells of the welded vertices.
+fn weld(mesh: &PmMesh) -> (Vec<u32>, Vec<[i32; 3]>) {
     let mut index: std::collections::HashMap<[i32; 3], u32> =
         std::collections::HashMap::with_capacity(mesh.positions.len());
     let mut cells = Vec::with_capacity(mesh.positions.len());
-    let welded: Vec<u32> = mesh
+    let welded = mesh
         .positions
         .iter()
         .map(|&c| {
@@ -88,6 +97,23 @@ pub fn restore(mesh: &PmMesh, flips: &[bool], grid: &Grid) -> TriMesh {
             })
         })
         .collect();
+    (welded, cells)
+}
+
+/// The values of each face's corners once flipped faces are turned back (their last two
+/// corners swapped), as [`restore`] turns the faces.
+pub fn restore_corners<T: Copy>(values: &[[T; 3]], flips: &[bool]) -> Vec<[T; 3]> {
+    values
+        .iter()
+        .zip(flips)
+        .map(|(&[a, b, c], &flipped)| if flipped { [a, c, b] } else { [a, b, c] })
+        .collect()
+}
+
+/// The mesh the manifold Mⁿ stands for: vertices sharing a cell welded (the first keeps its
+/// place), flipped faces turned back.
+pub fn restore(mesh: &PmMesh, flips: &[bool], grid: &Grid) -> TriMesh {
+    let (welded, cells) = weld(mesh);
     let faces = mesh
         .faces
         .iter()
