@@ -315,7 +315,7 @@ pub struct MutatedStream {
 }
 
 /// Valid streams of every codec for a few small meshes (a torus, a sphere, a bumpy terrain with
-/// a boundary, and a non-manifold mesh for the codecs that take one), encoded once.
+/// a boundary, and a non-manifold mesh, which pm cuts to a manifold), encoded once.
 pub fn valid_streams() -> &'static [Vec<u8>] {
     static STREAMS: OnceLock<Vec<Vec<u8>>> = OnceLock::new();
     STREAMS.get_or_init(|| {

@@ -295,6 +295,21 @@ struct RepairPlan {
     flips: Vec<bool>,
 }
 
+impl RepairPlan {
+    /// The plan of `cut` for the progressive mesh `pm` built on it.
+    fn of(cut: &ManifoldCut, pm: &simplify::ProgressiveMesh) -> RepairPlan {
+        RepairPlan {
+            copies: cut.copy_of.len() as u64,
+            cut_edges: cut.cut_edges,
+            flips: pm
+                .face_origin
+                .iter()
+                .map(|&f| cut.flipped[f as usize])
+                .collect(),
+        }
+    }
+}
+
 /// The most vertices a level of a pm stream with `header` has: Mⁿ's, copies included.
 pub fn most_vertices(header: &Header) -> u64 {
     PmParams::from_header(header).map_or(header.vertices, |p| p.full_vertices(header))
@@ -408,9 +423,14 @@ fn seams_of(
 
 impl Pm {
     fn params(&self) -> PmParams {
+        self.params_with(None)
+    }
+
+    /// The parameters of a stream, of a mesh cut to a manifold when `plan` is given.
+    fn params_with(&self, plan: Option<&RepairPlan>) -> PmParams {
         PmParams {
             ordering: self.ordering,
-            copies: None,
+            copies: plan.map(|p| p.copies),
         }
     }
 
@@ -445,19 +465,8 @@ impl Pm {
         cut: &ManifoldCut,
     ) -> Result<Encoded> {
         let pm = self.progressive_mesh(&input.cells, &input.faces, Some(input.constraints()));
-        let plan = RepairPlan {
-            copies: cut.copy_of.len() as u64,
-            cut_edges: cut.cut_edges,
-            flips: pm
-                .face_origin
-                .iter()
-                .map(|&f| cut.flipped[f as usize])
-                .collect(),
-        };
-        let params = PmParams {
-            copies: Some(plan.copies),
-            ..self.params()
-        };
+        let plan = RepairPlan::of(cut, &pm);
+        let params = self.params_with(Some(&plan));
         Ok(encode_pm(self.id(), params, mesh, &pm, None, Some(&plan)))
     }
 
@@ -515,19 +524,8 @@ impl Pm {
         let mut spec = super::appearance::spec_of(appearance);
         spec.in_levels = true;
         let levels = wedge_levels::derive(&full, state, &pm.vsplits, fit, &spec);
-        let plan = input.cut.as_ref().map(|cut| RepairPlan {
-            copies: cut.copy_of.len() as u64,
-            cut_edges: cut.cut_edges,
-            flips: pm
-                .face_origin
-                .iter()
-                .map(|&f| cut.flipped[f as usize])
-                .collect(),
-        });
-        let params = PmParams {
-            copies: plan.as_ref().map(|p| p.copies),
-            ..self.params()
-        };
+        let plan = input.cut.as_ref().map(|cut| RepairPlan::of(cut, &pm));
+        let params = self.params_with(plan.as_ref());
         Ok(encode_pm(
             self.id(),
             params,
