@@ -172,6 +172,16 @@ for codec in raw emc pm came; do
     fi
   done
 done
+# Appearance in pm's splits on a mesh pm cuts to a manifold (a fin and a quad turned over), with
+# the magic and version cut off: decode_pm_wedges's input.
+mkdir -p $seeds/decode_pm_wedges
+for codec in pm pm-reordered; do
+  for rule in fit keep; do
+    target/release/meshcodec encode --codec "$codec" --quant 10 --uv-bits 8 --normal-bits 6 \
+      --attributes "$rule" $seeds/read_obj/torus-fin.obj "$stream" >/dev/null 2>&1
+    tail -c +6 "$stream" > "$seeds/decode_pm_wedges/$codec-torus-fin-$rule.body"
+  done
+done
 # One meta-node alone takes the CAME codecs' streams too.
 for codec in came came_paper; do
   mkdir -p $seeds/decode_${codec}_unit

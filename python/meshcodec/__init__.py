@@ -248,8 +248,10 @@ def encode(
             is then format version :data:`FORMAT_VERSION`, else :data:`APPEARANCE_UNIT_VERSION`.
 
     Raises:
-        MeshcodecError: bad arrays, an unknown codec or option, a mesh the codec refuses
-            (``pm`` takes oriented manifolds only), or appearance it cannot carry.
+        MeshcodecError: bad arrays, an unknown codec or option, or appearance the codec
+            cannot carry (``came-paper``). Every codec takes any mesh: ``pm`` and
+            ``pm-reordered`` cut one that is no oriented 2-manifold to one and weld it back at
+            the full level.
     """
     appearance = codec_options.pop("appearance", None)
     if appearance is not None and not isinstance(appearance, Appearance):

@@ -21,8 +21,9 @@
 //!
 //! Getting back needs no list of copies: a copy lies in its original's cell, and the canonical
 //! mesh has one vertex a cell (docs/CONTRACT.md §2), so welding equal cells undoes step 3. What
-//! must be told is which faces were flipped. Vertices no face uses stay as they are: a manifold
-//! may have isolated points.
+//! must be told is which faces were flipped. Vertices no face uses (a canonical mesh keeps a
+//! vertex all of whose faces became degenerate) stay as they are, isolated points of the
+//! manifold that a progressive mesh keeps in its base mesh; a face set has no dangling edges.
 
 use super::topology::DisjointSets;
 use super::VertexId;
