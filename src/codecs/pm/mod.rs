@@ -40,7 +40,7 @@
 //! [`AttributeFit`] (`--attributes fit|keep`), inside the splits so that every level carries it
 //! ([`wedges`], docs/FORMAT.md §6.1): Hoppe's `corners` / wedge-delta / `matid` fields as
 //! candidate choices and predicted residuals, the simplifier keeping seams
-//! ([`simplify::simplify_keeping_seams`]) and the encoder valuing collapsed wedges by the rule
+//! ([`simplify::Constraints::seams`]) and the encoder valuing collapsed wedges by the rule
 //! ([`wedge_levels`]).
 
 pub mod iter;
