@@ -264,6 +264,7 @@ fn emc_commands_work_on_every_shared_mesh() {
         assert_eq!(json["levels_present"], bits, "{f}");
         assert_eq!(json["bits"], bits);
         assert_eq!(json["cell"].as_array().unwrap().len(), 3);
+        assert!(json["vertex_copies"].is_null(), "{f}: only pm cuts");
         ok(&["decode", "m.mc", "full.ply"]);
         ok(&["decode", "m.mc", "level8.obj", "--level", "8"]);
         ok(&[
@@ -477,4 +478,34 @@ fn convert_keeps_appearance_and_distance_measures_it() {
     let out = run(MESHCODEC, &["convert", "spot", "s.xyz"], d);
     assert_clean_failure(&out, "s.xyz");
     assert!(!d.join("s.xyz").exists());
+}
+
+#[test]
+fn pm_encodes_a_mesh_that_is_no_manifold_and_info_says_it_was_cut() {
+    let dir = scratch();
+    let d = dir.path();
+    let mesh = meshcodec::mesh::io::resolve("bunny-res4").unwrap();
+    let mesh = mesh.to_str().unwrap();
+    for codec in ["pm", "pm-reordered"] {
+        let out = run(MESHCODEC, &["encode", "--codec", codec, mesh, "b.mc"], d);
+        assert_eq!(out.code, Some(0), "{}", out.stderr);
+        let text = run(MESHCODEC, &["info", "b.mc"], d);
+        assert!(
+            text.stdout
+                .contains("cut to an oriented 2-manifold: 175 vertex copies"),
+            "{}",
+            text.stdout
+        );
+        let json = run(MESHCODEC, &["info", "b.mc", "--json"], d);
+        let json: serde_json::Value = serde_json::from_str(&json.stdout).unwrap();
+        assert_eq!(json["vertex_copies"], 175);
+        // A level before the last holds the copies; the last is the mesh itself.
+        let levels = json["levels"].as_array().unwrap();
+        assert_eq!(levels.last().unwrap()["vertices"], json["vertices"]);
+        assert!(levels
+            .iter()
+            .any(|l| l["vertices"].as_u64() > json["vertices"].as_u64()));
+        let out = run(MESHCODEC, &["decode", "b.mc", "full.ply"], d);
+        assert_eq!(out.code, Some(0), "{}", out.stderr);
+    }
 }

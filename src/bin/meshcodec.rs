@@ -528,6 +528,12 @@ fn info(input: &Path, json: bool) -> Result<()> {
         })
     });
     let sizes = &levels;
+    // A pm stream of a mesh that was no oriented manifold: the levels before the last are the
+    // manifold's, copies included.
+    let copies = match codec.name() {
+        "pm" | "pm-reordered" => codecs::pm::vertex_copies(&header),
+        _ => None,
+    };
     let report = serde_json::json!({
         "file": input.display().to_string(),
         "bytes": stream.len(),
@@ -547,6 +553,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "levels": levels,
         "meta_nodes": meta_nodes,
         "appearance": appearance,
+        "vertex_copies": copies,
     });
     if json {
         meshcodec::outln!("{}", serde_json::to_string_pretty(&report)?);
@@ -584,6 +591,12 @@ fn info(input: &Path, json: bool) -> Result<()> {
             ""
         }
     );
+    if let Some(copies) = copies {
+        let _ = writeln!(
+            text,
+            "cut to an oriented 2-manifold: {copies} vertex copies, kept at their originals' cells by the levels before the last, which welds them back"
+        );
+    }
     if let Some(spec) = &header.appearance {
         let mut carried = Vec::new();
         if let Some(bits) = spec.normal_bits {

@@ -310,6 +310,12 @@ impl RepairPlan {
     }
 }
 
+/// How many vertices the cut to a manifold copied, for a pm stream of a mesh that was none
+/// (docs/FORMAT.md §6.2); `None` for other streams.
+pub fn vertex_copies(header: &Header) -> Option<u64> {
+    PmParams::from_header(header).ok()?.copies
+}
+
 /// The most vertices a level of a pm stream with `header` has: Mⁿ's, copies included.
 pub fn most_vertices(header: &Header) -> u64 {
     PmParams::from_header(header).map_or(header.vertices, |p| p.full_vertices(header))
