@@ -677,21 +677,13 @@ fn repair_cost(out: &Path) -> Result<()> {
             };
             let canonical = codecs::canonical_for(&mesh, &options)?;
             let report = meshcodec::mesh::topology::analyze(&canonical.to_mesh());
-            let mut directed = std::collections::HashSet::new();
-            let twice = canonical
-                .faces
-                .iter()
-                .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])))
-                .filter(|e| !directed.insert(*e))
-                .count();
-            let defects = report.non_manifold_edges + report.non_manifold_vertices + twice;
-            let edges = directed.len();
             for ordering in [Ordering::Natural, Ordering::Reordered] {
                 let pm = Pm { ordering };
                 let Some(cost) = pm.repair_cost(&canonical)? else {
                     continue;
                 };
-                let share = defects as f64 / (edges + canonical.vertex_count()) as f64;
+                let share =
+                    report.defects() as f64 / (report.edges + canonical.vertex_count()) as f64;
                 let extra = cost.repaired_bytes as f64 / cost.manifold_bytes as f64 - 1.0;
                 meshcodec::outln!(
                     "{:<22} {:>4} {:<13} {:>7.3}% {:>7} {:>6} {:>6} {:>10} {:>10} {:>+7.2}%",
@@ -714,7 +706,7 @@ fn repair_cost(out: &Path) -> Result<()> {
                     "faces": canonical.face_count(),
                     "non_manifold_edges": report.non_manifold_edges,
                     "non_manifold_vertices": report.non_manifold_vertices,
-                    "edges_used_twice_one_way": twice,
+                    "edges_used_twice_one_way": report.edges_used_twice_one_way,
                     "defect_share": share,
                     "cost": cost,
                     "extra_share": extra,

@@ -7,6 +7,8 @@ use std::collections::HashMap;
 /// Topology counts of a mesh, as MANIFEST.md of the shared meshes states them.
 #[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize)]
 pub struct TopologyReport {
+    /// Edges (each counted once, whatever its faces).
+    pub edges: usize,
     /// Edges used by exactly one face.
     pub boundary_edges: usize,
     /// Edges used by more than two faces.
@@ -15,12 +17,25 @@ pub struct TopologyReport {
     pub non_manifold_vertices: usize,
     /// Edge-connected components over referenced vertices.
     pub components: usize,
+    /// Directed edges that a second face runs the same way (faces that disagree in orientation).
+    pub edges_used_twice_one_way: usize,
 }
 
 impl TopologyReport {
     /// True when every edge has one or two faces and every vertex one fan.
     pub fn is_manifold(&self) -> bool {
         self.non_manifold_edges == 0 && self.non_manifold_vertices == 0
+    }
+
+    /// True when the mesh is a manifold whose faces agree in orientation: what Hoppe's
+    /// progressive meshes take without a cut (`mesh::manifold`).
+    pub fn is_oriented_manifold(&self) -> bool {
+        self.is_manifold() && self.edges_used_twice_one_way == 0
+    }
+
+    /// Edges and vertices that keep the mesh from being an oriented manifold.
+    pub fn defects(&self) -> usize {
+        self.non_manifold_edges + self.non_manifold_vertices + self.edges_used_twice_one_way
     }
 }
 
@@ -68,6 +83,12 @@ pub fn analyze(mesh: &TriMesh) -> TopologyReport {
         }
     }
     let boundary_edges = edge_faces.values().filter(|&&n| n == 1).count();
+    let mut directed = std::collections::HashSet::with_capacity(faces.len() * 3);
+    let edges_used_twice_one_way = faces
+        .iter()
+        .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])))
+        .filter(|e| !directed.insert(*e))
+        .count();
     let non_manifold_edges = edge_faces.values().filter(|&&n| n > 2).count();
 
     let n = mesh.positions.len();
@@ -119,9 +140,11 @@ pub fn analyze(mesh: &TriMesh) -> TopologyReport {
         }
     }
     TopologyReport {
+        edges: edge_faces.len(),
         boundary_edges,
         non_manifold_edges,
         non_manifold_vertices,
         components: roots.len(),
+        edges_used_twice_one_way,
     }
 }

@@ -93,8 +93,8 @@ pub struct PMeshIter<'a> {
     mesh: PmMesh,
     /// Whether the stream's mesh was cut to a manifold.
     repaired: bool,
-    /// Which faces of Mⁿ are flipped, once read.
-    flips: Option<Vec<bool>>,
+    /// How Mⁿ turns back into the mesh, once its last level is read.
+    restoration: Option<super::repair::Restoration>,
     wedges: Option<Wedges>,
     records: Vec<Vsplit>,
     applied: usize,
@@ -121,13 +121,13 @@ impl<'a> PMeshIter<'a> {
         let base = stream
             .next_owned_level()?
             .ok_or_else(|| Error::Truncated("the stream ends before its base mesh".into()))?;
-        let (mesh, values, flips) = super::read_base(&header, &base.bytes)
+        let (mesh, values, restoration) = super::read_base(&header, &base.bytes)
             .ok_or_else(|| Error::malformed(1, base.start, "base mesh cannot be read"))?;
         Ok(PMeshIter {
             base: mesh.clone(),
             mesh,
             repaired: params.copies.is_some(),
-            flips,
+            restoration,
             wedges: values.map(|state| Wedges {
                 state,
                 splits: Vec::new(),
@@ -159,7 +159,7 @@ impl<'a> PMeshIter<'a> {
         PMeshIter {
             full_vertices: (base.positions.len() + records.len()) as u64,
             repaired: false,
-            flips: None,
+            restoration: None,
             mesh: base.clone(),
             wedges: None,
             base,
@@ -303,24 +303,20 @@ impl<'a> PMeshIter<'a> {
             }
         }
         if self.repaired
-            && self.flips.is_none()
+            && self.restoration.is_none()
             && self.mesh.positions.len() as u64 == self.full_vertices
         {
             // Mⁿ of a mesh cut to a manifold: its flips close the last level.
-            let flips = self
-                .reader
-                .as_mut()
-                .and_then(|r| r.coder.as_mut())
-                .and_then(|coder| super::repair::get_flips(coder, &self.mesh));
-            let fault = match flips {
-                Some(_) if !super::repair::welds_cleanly(&self.mesh) => {
-                    Some("the last level welds two corners of a face into one vertex")
-                }
-                Some(flips) => {
-                    self.flips = Some(flips);
+            let read = match self.reader.as_mut().and_then(|r| r.coder.as_mut()) {
+                Some(coder) => super::repair::Restoration::read(coder, &self.mesh),
+                None => Err("the flipped faces of the last level cannot be read"),
+            };
+            let fault = match read {
+                Ok(restoration) => {
+                    self.restoration = Some(restoration);
                     None
                 }
-                None => Some("the flipped faces of the last level cannot be read"),
+                Err(what) => Some(what),
             };
             if let Some(what) = fault {
                 self.mesh.ecol(&split);
@@ -396,8 +392,8 @@ impl<'a> PMeshIter<'a> {
     /// The current mesh with positions at cell centres; at Mⁿ of a mesh cut to a manifold, the
     /// mesh itself (copies welded, flipped faces turned back).
     pub fn level_mesh(&self) -> LevelMesh {
-        let mesh = match self.restored_faces() {
-            Some((mesh, _)) => mesh,
+        let mesh = match self.restoration() {
+            Some(r) => r.mesh(&self.mesh, &self.header.grid),
             None => to_trimesh(&self.mesh, &self.header.grid),
         };
         LevelMesh {
@@ -407,27 +403,23 @@ impl<'a> PMeshIter<'a> {
         }
     }
 
-    /// At Mⁿ of a mesh cut to a manifold, the mesh itself and the flips that turned it.
-    fn restored_faces(&self) -> Option<(TriMesh, &[bool])> {
-        let flips = self.flips.as_ref()?;
-        (self.mesh.positions.len() as u64 == self.full_vertices).then(|| {
-            (
-                super::repair::restore(&self.mesh, flips, &self.header.grid),
-                &flips[..],
-            )
-        })
+    /// At Mⁿ of a mesh cut to a manifold, how it turns back into the mesh.
+    fn restoration(&self) -> Option<&super::repair::Restoration> {
+        self.restoration
+            .as_ref()
+            .filter(|_| self.mesh.positions.len() as u64 == self.full_vertices)
     }
 
     /// The current mesh's appearance, when the stream carries one: its wedges welded from the
     /// corners' values.
     pub fn attributes(&self) -> Option<Attributes> {
         let (w, spec) = (self.wedges.as_ref()?, self.header.appearance.as_ref()?);
-        let (corners, wedge_vertex, codes) = match self.restored_faces() {
+        let (corners, wedge_vertex, codes) = match self.restoration() {
             // Mⁿ of a mesh cut to a manifold: the wedges of the mesh itself.
-            Some((faces, flips)) => wedges::weld_face_values(
-                faces.faces.iter().copied(),
-                &super::repair::restore_corners(&w.state.corners, flips),
-                faces.positions.len(),
+            Some(r) => wedges::weld_face_values(
+                r.faces(&self.mesh).into_iter(),
+                &r.corners(&w.state.corners),
+                r.vertex_count(),
             ),
             None => wedges::weld(&w.state, &self.mesh),
         };

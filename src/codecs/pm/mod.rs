@@ -322,8 +322,12 @@ pub fn most_vertices(header: &Header) -> u64 {
 }
 
 /// A base-mesh level as read: the mesh, its values when the stream carries appearance, and
-/// its flipped faces when it is already Mⁿ of a mesh cut to a manifold.
-type Base = (PmMesh, Option<wedges::WedgeState>, Option<Vec<bool>>);
+/// its restoration when it is already Mⁿ of a mesh cut to a manifold.
+type Base = (
+    PmMesh,
+    Option<wedges::WedgeState>,
+    Option<repair::Restoration>,
+);
 
 /// Reads a base-mesh level.
 fn read_base(header: &Header, bytes: &[u8]) -> Option<Base> {
@@ -367,9 +371,9 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<Base> {
     // manifold (two fans meeting at one vertex) links but is no mesh PM can split.
     let mesh =
         PmMesh::from_triangles(positions, &faces).filter(|mesh| mesh.check_invariants().is_ok())?;
-    let flips = match params.copies {
+    let restoration = match params.copies {
         Some(_) if v == params.full_vertices(header) => {
-            Some(repair::get_flips(&mut dec, &mesh).filter(|_| repair::welds_cleanly(&mesh))?)
+            Some(repair::Restoration::read(&mut dec, &mesh).ok()?)
         }
         _ => None,
     };
@@ -385,7 +389,7 @@ fn read_base(header: &Header, bytes: &[u8]) -> Option<Base> {
         }
         None => None,
     };
-    Some((mesh, state, flips))
+    Some((mesh, state, restoration))
 }
 
 /// The canonical mesh's cells as the simplifier takes them.

@@ -59,8 +59,79 @@ pub fn put_flips(enc: &mut ArithEncoder, mesh: &PmMesh, flips: &[bool]) {
     }
 }
 
+/// Mⁿ of a mesh cut to a manifold with what turns it back into the mesh: which faces are
+/// flipped, and the weld of the vertices that share a cell (computed once, when read).
+#[derive(Clone, Debug)]
+pub struct Restoration {
+    flips: Vec<bool>,
+    /// The welded vertex of each vertex of Mⁿ (the first of a cell keeps its place).
+    welded: Vec<u32>,
+    /// Cell of each welded vertex.
+    cells: Vec<[i32; 3]>,
+}
+
+impl Restoration {
+    /// Reads which faces of `mesh` (the manifold Mⁿ) are flipped and welds it; an error when
+    /// the flips cannot be read or the weld leaves a face fewer than three corners (what the
+    /// encoder's Mⁿ never does, and a corrupt stream's may).
+    pub fn read(dec: &mut ArithDecoder, mesh: &PmMesh) -> Result<Restoration, &'static str> {
+        let flips =
+            get_flips(dec, mesh).ok_or("the flipped faces of the last level cannot be read")?;
+        let (welded, cells) = weld(mesh);
+        let restoration = Restoration {
+            flips,
+            welded,
+            cells,
+        };
+        let clean = restoration
+            .faces(mesh)
+            .iter()
+            .all(|&[a, b, c]| a != b && b != c && a != c);
+        if !clean {
+            return Err("the last level welds two corners of a face into one vertex");
+        }
+        Ok(restoration)
+    }
+
+    /// The mesh's faces: Mⁿ's over the welded vertices, flipped faces turned back.
+    pub fn faces(&self, mesh: &PmMesh) -> Vec<[u32; 3]> {
+        let faces: Vec<[u32; 3]> = mesh
+            .faces
+            .iter()
+            .map(|face| face.v.map(|v| self.welded[v as usize]))
+            .collect();
+        self.corners(&faces)
+    }
+
+    /// The values of each face's corners once flipped faces are turned back (their last two
+    /// corners swapped).
+    pub fn corners<T: Copy>(&self, values: &[[T; 3]]) -> Vec<[T; 3]> {
+        values
+            .iter()
+            .zip(&self.flips)
+            .map(|(&[a, b, c], &flipped)| if flipped { [a, c, b] } else { [a, b, c] })
+            .collect()
+    }
+
+    /// Number of vertices of the mesh.
+    pub fn vertex_count(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// The mesh the manifold Mⁿ stands for, on `grid`.
+    pub fn mesh(&self, mesh: &PmMesh, grid: &Grid) -> TriMesh {
+        TriMesh::new(
+            self.cells
+                .iter()
+                .map(|c| grid.dequantize(c.map(|x| x.max(0) as u32)))
+                .collect(),
+            self.faces(mesh),
+        )
+    }
+}
+
 /// Reads which faces of `mesh` (the manifold Mⁿ) are flipped.
-pub fn get_flips(dec: &mut ArithDecoder, mesh: &PmMesh) -> Option<Vec<bool>> {
+fn get_flips(dec: &mut ArithDecoder, mesh: &PmMesh) -> Option<Vec<bool>> {
     let mut ctx = FlipContexts::default();
     let mut flips = vec![false; mesh.faces.len()];
     if dec.bit(&mut ctx.any)? {
@@ -70,16 +141,6 @@ pub fn get_flips(dec: &mut ArithDecoder, mesh: &PmMesh) -> Option<Vec<bool>> {
         }
     }
     Some(flips)
-}
-
-/// Whether welding the vertices of `mesh` that share a cell leaves every face three distinct
-/// corners: what the encoder's Mⁿ always does, and a corrupt stream's may not.
-pub fn welds_cleanly(mesh: &PmMesh) -> bool {
-    let welded = weld(mesh).0;
-    mesh.faces.iter().all(|face| {
-        let [a, b, c] = face.v.map(|v| welded[v as usize]);
-        a != b && b != c && a != c
-    })
 }
 
 /// The vertex each vertex of `mesh` welds into, and the cells of the welded vertices.
@@ -98,40 +159,4 @@ fn weld(mesh: &PmMesh) -> (Vec<u32>, Vec<[i32; 3]>) {
         })
         .collect();
     (welded, cells)
-}
-
-/// The values of each face's corners once flipped faces are turned back (their last two
-/// corners swapped), as [`restore`] turns the faces.
-pub fn restore_corners<T: Copy>(values: &[[T; 3]], flips: &[bool]) -> Vec<[T; 3]> {
-    values
-        .iter()
-        .zip(flips)
-        .map(|(&[a, b, c], &flipped)| if flipped { [a, c, b] } else { [a, b, c] })
-        .collect()
-}
-
-/// The mesh the manifold Mⁿ stands for: vertices sharing a cell welded (the first keeps its
-/// place), flipped faces turned back.
-pub fn restore(mesh: &PmMesh, flips: &[bool], grid: &Grid) -> TriMesh {
-    let (welded, cells) = weld(mesh);
-    let faces = mesh
-        .faces
-        .iter()
-        .zip(flips)
-        .map(|(face, &flipped)| {
-            let [a, b, c] = face.v.map(|v| welded[v as usize]);
-            if flipped {
-                [a, c, b]
-            } else {
-                [a, b, c]
-            }
-        })
-        .collect();
-    TriMesh::new(
-        cells
-            .iter()
-            .map(|c| grid.dequantize(c.map(|x| x.max(0) as u32)))
-            .collect(),
-        faces,
-    )
 }

@@ -188,7 +188,7 @@ impl State {
         };
         let forced = self.seam_rule(a, b) != SeamRule::Free;
         // A survivor on a seam the edge does not follow stays where it is; so does a pinned one.
-        let pinned = forced && (!self.is_seam(a, b) || self.is_pinned(a));
+        let stays = forced && (!self.is_seam(a, b) || self.is_pinned(a));
         let q = Quadric::sum(&self.quadrics[a as usize], &self.quadrics[b as usize]);
         let (ca, cb) = (self.cells[a as usize], self.cells[b as usize]);
         let mut best = (ca, q.error(to_f(ca)));
@@ -198,7 +198,7 @@ impl State {
                 best = (c, e);
             }
         };
-        if !pinned {
+        if !stays {
             consider(cb);
             consider(anchor(1, ca, cb));
         }
