@@ -1,9 +1,11 @@
 //! The range coder's floor under the modelled EMC decoder: decoding 100,000 adaptive binary
 //! decisions, and 100,000 three-bit symbols ([`ArithDecoder::bits3`], a leaf's refinement of a
 //! level), each under contexts picked from 256, for bits as good as random and for bits that
-//! are nearly always 0.
+//! are nearly always 0; and the bits through constriction's own decoder, the anchor.
 //! Run: cargo bench --bench arith
 
+use constriction::stream::queue::DefaultRangeDecoder;
+use constriction::stream::Decode;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use meshcodec::coding::arith::{ArithDecoder, ArithEncoder, BitContext};
 use meshcodec::coding::SyntaxClass;
@@ -50,6 +52,28 @@ fn coder(c: &mut Criterion) {
                 ones
             })
         });
+        // The anchor: the same words through constriction's own range decoder, whose division
+        // per decision `ArithDecoder` does without.
+        group.bench_function(
+            BenchmarkId::new("decode bit, constriction's decoder", name),
+            |b| {
+                b.iter(|| {
+                    let words: Vec<u32> = bits
+                        .chunks_exact(4)
+                        .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                        .collect();
+                    let mut decoder = DefaultRangeDecoder::from_compressed(words).unwrap();
+                    let mut contexts = vec![BitContext::default(); CONTEXTS];
+                    let mut ones = 0;
+                    for &(i, _) in &decisions[..SYMBOLS] {
+                        let bit = decoder.decode_symbol(contexts[i]).unwrap();
+                        contexts[i].update(bit);
+                        ones += bit as usize;
+                    }
+                    ones
+                })
+            },
+        );
         let mut encoder = ArithEncoder::default();
         let mut contexts = vec![BitContext::default(); CONTEXTS];
         for triple in decisions.chunks(3) {
