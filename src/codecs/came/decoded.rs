@@ -21,6 +21,8 @@ pub struct Node {
     pub leaf: bool,
     /// Its children, once its split is decoded.
     pub children: Option<[u32; 2]>,
+    /// Its parent (`u32::MAX` for the root).
+    pub parent: u32,
     /// Its position (grid units).
     pub position: [f64; 3],
     /// Its error sphere's radius (grid units).
@@ -63,6 +65,9 @@ pub struct DecodedTree {
     pub dependencies: Vec<(NodeId, std::ops::Range<u32>)>,
     /// The dependencies of every split, in decoding order.
     pub dependency_nodes: Vec<NodeId>,
+    /// Once the hierarchy is checked complete: every triangle's corners as nodes, so that the
+    /// full mesh needs no lookup of its own.
+    leaf_corners: Option<Vec<[u32; 3]>>,
     max_nodes: usize,
     max_triangles: usize,
 }
@@ -80,6 +85,7 @@ impl DecodedTree {
             triangles: Vec::with_capacity(triangles.min(2 * stream_bytes as u64) as usize),
             dependencies: Vec::new(),
             dependency_nodes: Vec::new(),
+            leaf_corners: None,
             max_nodes: (2 * vertices).saturating_sub(1) as usize,
             max_triangles: triangles as usize,
         }
@@ -97,6 +103,7 @@ impl DecodedTree {
 
     /// Forgets everything decoded since `mark` (a unit that failed half-way).
     pub fn roll_back(&mut self, mark: Mark) {
+        self.leaf_corners = None;
         for i in mark.nodes.min(self.nodes.len())..self.nodes.len() {
             let id = self.nodes[i].id;
             self.lookup.remove(&id.packed());
@@ -121,6 +128,7 @@ impl DecodedTree {
             id: NodeId::ROOT,
             leaf: false,
             children: None,
+            parent: u32::MAX,
             position,
             radius,
             created_unit: NodeId::ROOT,
@@ -132,17 +140,6 @@ impl DecodedTree {
     /// The node at `id`, if decoded.
     pub fn get(&self, id: NodeId) -> Option<u32> {
         self.lookup.get(&id.packed()).copied()
-    }
-
-    /// The status of `id` from the unit rooted at `unit`, and the node if decoded.
-    pub fn status(&self, id: NodeId, unit: NodeId) -> (Status, Option<u32>) {
-        match self.get(id) {
-            None => (Status::Unknown, None),
-            Some(i) => {
-                let n = &self.nodes[i as usize];
-                (status(n.leaf, n.split_unit, n.created_unit, unit), Some(i))
-            }
-        }
     }
 
     /// The status of decoded node `i` from the unit rooted at `unit`.
@@ -186,6 +183,7 @@ impl DecodedTree {
                 id: child,
                 leaf: leaf[side],
                 children: None,
+                parent: s,
                 position: positions[side],
                 radius: radii[side],
                 created_unit: unit,
@@ -220,6 +218,7 @@ impl DecodedTree {
                 "more triangles than the header declares",
             ));
         }
+        self.leaf_corners = None;
         self.triangles.push(triangle);
         Ok(())
     }
@@ -227,6 +226,21 @@ impl DecodedTree {
     /// The mesh of the front at `depth`: every node at that depth and every leaf above it, at
     /// their positions mapped through `to_world`.
     pub fn mesh_at(&self, depth: u8, to_world: impl Fn([f64; 3]) -> DVec3) -> Result<TriMesh> {
+        let deepest = self.nodes.iter().all(|n| n.id.len() <= depth);
+        if let (true, Some(corners)) = (deepest, &self.leaf_corners) {
+            // The front is every leaf, and every triangle's corners are known nodes.
+            let mut index = vec![u32::MAX; self.nodes.len()];
+            let mut positions = Vec::new();
+            for (i, n) in self.nodes.iter().enumerate().filter(|(_, n)| n.leaf) {
+                index[i] = positions.len() as u32;
+                positions.push(to_world(n.position));
+            }
+            let faces = corners
+                .iter()
+                .map(|c| c.map(|i| index[i as usize]))
+                .collect();
+            return Ok(TriMesh { positions, faces });
+        }
         let mut index = vec![u32::MAX; self.nodes.len()];
         let mut positions = Vec::new();
         for (i, n) in self.nodes.iter().enumerate() {
@@ -560,7 +574,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         }
     }
 
-    fn check_complete(&self) -> Result<()> {
+    fn check_complete(&mut self) -> Result<()> {
         let at = self.payload_start;
         let header = &self.header;
         if self.child_roots.iter().any(Option::is_none) {
@@ -603,17 +617,24 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                 return Err(Error::malformed(0, at, "a vertex lies outside the grid"));
             }
         }
-        for t in &self.tree.triangles {
-            for c in t.corners {
-                if !self
-                    .tree
-                    .get(c)
-                    .is_some_and(|i| self.tree.nodes[i as usize].leaf)
-                {
-                    return Err(Error::malformed(0, at, "a triangle's corner is no vertex"));
+        let tree = &self.tree;
+        let corners = tree
+            .triangles
+            .iter()
+            .map(|t| {
+                let mut nodes = [0u32; 3];
+                for (node, c) in nodes.iter_mut().zip(t.corners) {
+                    *node = tree
+                        .get(c)
+                        .filter(|&i| tree.nodes[i as usize].leaf)
+                        .ok_or_else(|| {
+                            Error::malformed(0, at, "a triangle's corner is no vertex")
+                        })?;
                 }
-            }
-        }
+                Ok(nodes)
+            })
+            .collect::<Result<Vec<_>>>()?;
+        self.tree.leaf_corners = Some(corners);
         Ok(())
     }
 }

@@ -538,7 +538,10 @@ impl UnitReader<'_> {
     }
 
     /// The start of a relative path `up` levels above `s`: the junction's other child.
-    fn other_child(&self, sid: NodeId, up: u64) -> Result<NodeId> {
+    /// The other child of split `s`'s ancestor `up` levels above it (1: its sibling), by path
+    /// and node: decoded, since its parent is an ancestor of `s`, found by walking up the tree.
+    fn other_child(&self, s: u32, up: u64) -> Result<(NodeId, u32)> {
+        let sid = self.tree.nodes[s as usize].id;
         if up == 0 || up > sid.len() as u64 {
             return Err(Error::malformed(
                 0,
@@ -546,11 +549,16 @@ impl UnitReader<'_> {
                 "a relative path goes above the root",
             ));
         }
-        let junction = sid.ancestor(sid.len() - up as u8);
-        let side = sid.bit(junction.len());
-        junction
-            .child(!side)
-            .ok_or_else(|| Error::malformed(0, self.at, "a path is longer than 52 bits"))
+        let mut x = s;
+        for _ in 1..up {
+            x = self.tree.nodes[x as usize].parent;
+        }
+        let junction = self.tree.nodes[x as usize].parent;
+        let [a, b] = self.tree.nodes[junction as usize]
+            .children
+            .expect("an ancestor is split");
+        let other = if a == x { b } else { a };
+        Ok((self.tree.nodes[other as usize].id, other))
     }
 
     fn child(&self, x: NodeId, bit: bool) -> Result<NodeId> {
@@ -582,19 +590,16 @@ impl UnitReader<'_> {
         (self.tree.status_of(child, self.unit), Some(child))
     }
 
-    /// A leaf's path from `start` (its node, when the caller knows it decoded).
+    /// A leaf's path from `start` (decoded node `known`).
     fn leaf_path(
         &mut self,
         start: NodeId,
-        known: Option<u32>,
+        known: u32,
         target: [f64; 3],
         kind: Kind,
     ) -> Result<NodeId> {
         let mut x = start;
-        let (mut status, mut node) = match known {
-            Some(i) => (self.tree.status_of(i, self.unit), Some(i)),
-            None => self.tree.status(x, self.unit),
-        };
+        let (mut status, mut node) = (self.tree.status_of(known, self.unit), Some(known));
         loop {
             let depth = x.len() as usize;
             let ends_here = match status {
@@ -618,8 +623,8 @@ impl UnitReader<'_> {
         }
     }
 
-    fn dependency_path(&mut self, start: NodeId) -> Result<NodeId> {
-        let (mut status, mut node) = self.tree.status(start, self.unit);
+    fn dependency_path(&mut self, start: NodeId, known: u32) -> Result<NodeId> {
+        let (mut status, mut node) = (self.tree.status_of(known, self.unit), Some(known));
         let start_position = node.map(|i| self.tree.nodes[i as usize].position);
         let mut x = start;
         let mut steps = 0usize;
@@ -778,11 +783,11 @@ impl UnitDecoder for ModelledUnits {
             let mut thirds = Vec::with_capacity(count as usize);
             for _ in 0..count {
                 let [t, u] = children;
-                let n1 = r.leaf_path(r.child(sid, false)?, Some(t), positions[1], Kind::N1)?;
-                let n2 = r.leaf_path(r.child(sid, true)?, Some(u), positions[0], Kind::N2)?;
+                let n1 = r.leaf_path(r.child(sid, false)?, t, positions[1], Kind::N1)?;
+                let n2 = r.leaf_path(r.child(sid, true)?, u, positions[0], Kind::N2)?;
                 let up = r.uint(|c| &mut c.up, 52, "n3.up")? + 1;
-                let start = r.other_child(sid, up)?;
-                let n3 = r.leaf_path(start, None, ps, Kind::N3)?;
+                let (start, start_node) = r.other_child(s, up)?;
+                let n3 = r.leaf_path(start, start_node, ps, Kind::N3)?;
                 thirds.push((n3, start.len()));
                 let flipped = r.bit(|c| &mut c.orientation[previous])?;
                 previous = 1 + flipped as usize;
@@ -816,8 +821,8 @@ impl UnitDecoder for ModelledUnits {
                     continue;
                 }
                 let up = r.uint(|c| &mut c.dependency_up, 52, "a dependency's up")? + 1;
-                let start = r.other_child(sid, up)?;
-                let dependency = r.dependency_path(start)?;
+                let (start, start_node) = r.other_child(s, up)?;
+                let dependency = r.dependency_path(start, start_node)?;
                 r.tree.dependency_nodes.push(dependency);
             }
             r.tree.close_dependencies(sid, first);
