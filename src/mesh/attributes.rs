@@ -129,6 +129,10 @@ impl Attributes {
         let has_normals = presence(|c| c.normal.is_some(), "a normal")?;
         let has_uvs = presence(|c| c.uv.is_some(), "a texture coordinate")?;
         let has_colours = presence(|c| c.colour.is_some(), "a colour")?;
+        if !(has_normals || has_uvs || has_colours) {
+            // No scalar attribute: no wedges either (materials may still come).
+            return Ok(Attributes::default());
+        }
         let mut attributes = Attributes {
             normals: has_normals.then(Vec::new),
             uvs: has_uvs.then(Vec::new),
@@ -157,12 +161,6 @@ impl Attributes {
                 wedges[k] = w;
             }
             attributes.corners.push(wedges);
-        }
-        if attributes.normals.is_none() && attributes.uvs.is_none() && attributes.colours.is_none()
-        {
-            // No scalar attribute: no wedges either (materials may still come).
-            attributes.corners.clear();
-            attributes.wedge_vertex.clear();
         }
         Ok(attributes)
     }

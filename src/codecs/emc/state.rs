@@ -14,7 +14,6 @@ use crate::mesh::canonical::rotate_to_smallest;
 use crate::mesh::CanonicalMesh;
 use crate::mesh::{Grid, TriMesh};
 use glam::DVec3;
-use std::collections::HashMap;
 use std::ops::Range;
 
 /// What happens to an edge of a splitting vertex.
@@ -338,29 +337,47 @@ pub fn face_corrections(
         debug_assert_eq!(range.len(), 1);
         list_id[trie.vertices[range.start] as usize] = v as u32;
     }
-    // Oriented faces in list ids, keyed by their ascending triple.
-    let mut faces: HashMap<[u32; 3], u8> = HashMap::new(); // bit 0: unflipped, bit 1: flipped
-    for f in &mesh.faces {
-        let f = f.map(|u| list_id[u as usize]);
-        let mut sorted = f;
-        sorted.sort_unstable();
-        let unflipped = rotate_to_smallest(f) == sorted;
-        *faces.entry(sorted).or_default() |= if unflipped { 1 } else { 2 };
-    }
+    // Oriented faces in list ids by their ascending triple, sorted as the cliques are (a sort
+    // and one merge: a hash map of a million faces costs twice the memory and far more time).
+    let mut faces: Vec<([u32; 3], u8)> = mesh
+        .faces
+        .iter()
+        .map(|f| {
+            let f = f.map(|u| list_id[u as usize]);
+            let mut sorted = f;
+            sorted.sort_unstable();
+            let unflipped = rotate_to_smallest(f) == sorted;
+            (sorted, if unflipped { 1 } else { 2 }) // bit 0: unflipped, bit 1: flipped
+        })
+        .collect();
+    faces.sort_unstable();
     let cliques = state
         .cliques(mesh.face_count() as u64)
         .map_err(|why| crate::Error::Unsupported(format!("EMC cannot code this mesh: {why}")))?;
+    // Per clique: how the mesh has it (0: not at all).
+    let mut sides = vec![0u8; cliques.len()];
+    let mut next = faces.iter().peekable();
+    for (t, side) in cliques.tris.iter().zip(&mut sides) {
+        while let Some((key, flags)) = next.next_if(|(key, _)| key <= t) {
+            if key == t {
+                *side |= flags;
+            }
+        }
+    }
     let mut corrections = FaceCorrections::default();
-    for (i, t) in cliques.tris.iter().enumerate() {
-        match faces.get(t) {
-            None => corrections.false_triangles.push(i as u32),
-            Some(3) => corrections.double_sided.push(i as u32),
-            Some(_) => {}
+    for (i, side) in sides.iter().enumerate() {
+        match side {
+            0 => corrections.false_triangles.push(i as u32),
+            3 => corrections.double_sided.push(i as u32),
+            _ => {}
         }
     }
     debug_assert_eq!(
         cliques.len() - corrections.false_triangles.len(),
-        faces.len(),
+        {
+            faces.dedup_by_key(|(key, _)| *key);
+            faces.len()
+        },
         "every face is a 3-clique of its own edges"
     );
     let skipped = corrections.skipped(cliques.len());
@@ -368,7 +385,7 @@ pub fn face_corrections(
         .map(|v| mesh.grid.dequantize(state.cells[v]))
         .collect();
     // Let the propagation follow the true orientations and note where they were not predicted.
-    let is_flipped = |t: usize| faces.get(&cliques.tris[t]).copied() == Some(2);
+    let is_flipped = |t: usize| sides[t] == 2;
     let centre = centroid(&positions);
     propagate_orientation(
         &cliques,

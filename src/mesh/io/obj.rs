@@ -42,6 +42,14 @@ fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
     let mut corners: Vec<[Corner; 3]> = Vec::new();
     let mut by_position: HashMap<[u64; 3], u32> = HashMap::new();
     let single = models.len() == 1;
+    // Corners are gathered only from a file that has some attribute: a million faces of
+    // attribute-less corners would cost hundreds of megabytes to find nothing.
+    let carries = with_attributes
+        && models.iter().any(|m| {
+            !m.mesh.texcoord_indices.is_empty()
+                || !m.mesh.normal_indices.is_empty()
+                || !m.mesh.vertex_color.is_empty()
+        });
     for model in &models {
         let mesh = &model.mesh;
         if mesh.positions.len() % 3 != 0 || mesh.indices.len() % 3 != 0 {
@@ -73,7 +81,7 @@ fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
             }
             faces.push(face);
         }
-        if with_attributes {
+        if carries {
             corners_of(mesh, &mut corners)?;
         }
     }
@@ -84,7 +92,11 @@ fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
             attributes: Attributes::default(),
         });
     }
-    let mut attributes = Attributes::weld(&mesh.faces, &corners)?;
+    let mut attributes = if carries {
+        Attributes::weld(&mesh.faces, &corners)?
+    } else {
+        Attributes::default()
+    };
     attributes.materials = materials(bytes, mesh.faces.len())?;
     attributes.validate(&mesh)?;
     Ok(AttributedMesh { mesh, attributes })

@@ -14,19 +14,30 @@ use ply_rs_bw::parser::{Parser, Reader};
 use ply_rs_bw::ply::{
     Encoding, Header, Property, PropertyAccess, PropertyAccessResult, PropertyType, ScalarType,
 };
+use smallvec::SmallVec;
 
-/// One PLY element as we need it: a position and its attributes, an index list, or neither.
+/// A vertex as we need it: a position and its attributes. Each element is read into a record
+/// of its own kind (a million faces in records with room for a vertex's fields, and the other
+/// way round, cost hundreds of megabytes).
 #[derive(Default)]
-struct Record {
+struct VertexRecord {
     xyz: [f64; 3],
-    indices: Vec<i64>,
     normal: [f64; 3],
     /// RGBA in [0, 1]; alpha 1 unless the file gives it.
     colour: [f64; 4],
     uv: [f64; 2],
+}
+
+/// A face or a triangle strip: its index list (a triangle's held inline) and corner uvs.
+#[derive(Default)]
+struct FaceRecord {
+    indices: SmallVec<[i64; 4]>,
     /// A face's corner uvs, two numbers a corner.
     texcoord: Vec<f64>,
 }
+
+/// Any other element, read past.
+struct Skipped;
 
 /// A colour channel in [0, 1]: integers over their type's range, floats as they are.
 fn channel(p: &Property) -> Option<f64> {
@@ -61,8 +72,8 @@ fn scalar(p: &Property) -> Option<f64> {
     })
 }
 
-fn integer_list(p: Property) -> Option<Vec<i64>> {
-    fn widen<T: Copy + Into<i64>>(v: Vec<T>) -> Vec<i64> {
+fn integer_list(p: Property) -> Option<SmallVec<[i64; 4]>> {
+    fn widen<T: Copy + Into<i64>>(v: Vec<T>) -> SmallVec<[i64; 4]> {
         v.into_iter().map(Into::into).collect()
     }
     Some(match p {
@@ -76,11 +87,11 @@ fn integer_list(p: Property) -> Option<Vec<i64>> {
     })
 }
 
-impl PropertyAccess for Record {
+impl PropertyAccess for VertexRecord {
     fn new() -> Self {
-        Record {
+        VertexRecord {
             colour: [0.0, 0.0, 0.0, 1.0],
-            ..Record::default()
+            ..VertexRecord::default()
         }
     }
 
@@ -105,6 +116,18 @@ impl PropertyAccess for Record {
             "alpha" => set(&mut self.colour[3], channel(&property)),
             "s" | "u" | "texture_u" | "texture_s" => set(&mut self.uv[0], scalar(&property)),
             "t" | "v" | "texture_v" | "texture_t" => set(&mut self.uv[1], scalar(&property)),
+            _ => PropertyAccessResult::Ignored,
+        }
+    }
+}
+
+impl PropertyAccess for FaceRecord {
+    fn new() -> Self {
+        FaceRecord::default()
+    }
+
+    fn set_property(&mut self, name: &str, property: Property) -> PropertyAccessResult {
+        match name {
             "vertex_indices" | "vertex_index" => match integer_list(property) {
                 Some(list) => {
                     self.indices = list;
@@ -121,6 +144,16 @@ impl PropertyAccess for Record {
             },
             _ => PropertyAccessResult::Ignored,
         }
+    }
+}
+
+impl PropertyAccess for Skipped {
+    fn new() -> Self {
+        Skipped
+    }
+
+    fn set_property(&mut self, _: &str, _: Property) -> PropertyAccessResult {
+        PropertyAccessResult::Ignored
     }
 }
 
@@ -166,15 +199,41 @@ pub fn read_attributed(bytes: &[u8]) -> Result<AttributedMesh> {
 }
 
 fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
-    let parser = Parser::<Record>::new();
     // ply-rs reports over several lines; errors here are one line (docs/CONTRACT.md §7).
     let fault = |e: ply_rs_bw::parser::ParseError| {
         Error::mesh(format!("PLY: {}", one_line(&e.to_string())))
     };
     let mut reader = Reader::new(bytes);
-    let header = parser.read_header(&mut reader).map_err(fault)?;
+    let header = Parser::<Skipped>::new()
+        .read_header(&mut reader)
+        .map_err(fault)?;
     check_counts(&header, bytes)?;
-    let payload = parser.read_payload(&mut reader, &header).map_err(fault)?;
+    // The elements in file order, each into its own kind of record.
+    let (mut vertices, mut face_records, mut strips) = (Vec::new(), Vec::new(), Vec::new());
+    for (name, def) in &header.elements {
+        match name.as_str() {
+            "vertex" => {
+                vertices = Parser::<VertexRecord>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(fault)?
+            }
+            "face" | "tristrips" => {
+                let records = Parser::<FaceRecord>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(fault)?;
+                if name == "face" {
+                    face_records = records;
+                } else {
+                    strips = records;
+                }
+            }
+            _ => {
+                Parser::<Skipped>::new()
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(fault)?;
+            }
+        }
+    }
     let vertex_def = header
         .elements
         .get("vertex")
@@ -184,10 +243,7 @@ fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
             return Err(Error::mesh(format!("PLY: vertex has no '{axis}' property")));
         }
     }
-    let positions: Vec<DVec3> = payload
-        .get("vertex")
-        .map(|v| v.iter().map(|r| DVec3::from(r.xyz)).collect())
-        .unwrap_or_default();
+    let positions: Vec<DVec3> = vertices.iter().map(|r| DVec3::from(r.xyz)).collect();
     let n = positions.len() as i64;
     let index = |i: i64| -> Result<u32> {
         if (0..n).contains(&i) {
@@ -199,7 +255,10 @@ fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
         }
     };
     let declared = Declared::of(&header);
-    let vertices = payload.get("vertex").map(Vec::as_slice).unwrap_or_default();
+    // Corners are gathered only from a file that declares some attribute (a million faces of
+    // attribute-less corners would cost hundreds of megabytes to find nothing).
+    let with_attributes = with_attributes
+        && (declared.normals || declared.colours || declared.uvs || declared.face_uvs);
     // What a corner of vertex v carries from the vertex element.
     let vertex_corner = |v: u32| {
         let r = &vertices[v as usize];
@@ -211,7 +270,7 @@ fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
     };
     let mut faces = Vec::new();
     let mut corners: Vec<[Corner; 3]> = Vec::new();
-    for (f, record) in payload.get("face").into_iter().flatten().enumerate() {
+    for (f, record) in face_records.iter().enumerate() {
         let polygon = record
             .indices
             .iter()
@@ -245,7 +304,7 @@ fn load(bytes: &[u8], with_attributes: bool) -> Result<AttributedMesh> {
             corners.push([corner(0), corner(k), corner(k + 1)]);
         }
     }
-    for record in payload.get("tristrips").into_iter().flatten() {
+    for record in &strips {
         for strip in record.indices.split(|&i| i < 0) {
             let strip = strip
                 .iter()
