@@ -62,7 +62,7 @@ impl CanonicalMesh {
             });
         }
         let mut seen = HashSet::new();
-        let (faces, origins) = mesh
+        let (mut faces, mut origins): (Vec<_>, Vec<_>) = mesh
             .faces
             .iter()
             .enumerate()
@@ -70,6 +70,9 @@ impl CanonicalMesh {
             .filter(|([a, b, c], _)| a != b && b != c && a != c)
             .filter(|(f, _)| seen.insert(rotate_to_smallest(*f)))
             .unzip();
+        // Grown by doubling: give back what the dropped faces left unused.
+        faces.shrink_to_fit();
+        origins.shrink_to_fit();
         Ok((CanonicalMesh { grid, cells, faces }, origins))
     }
 

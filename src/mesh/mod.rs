@@ -70,7 +70,11 @@ impl Aabb {
 
 impl TriMesh {
     /// A mesh from positions and faces, unchecked (see [`TriMesh::validate`]).
-    pub fn new(positions: Vec<DVec3>, faces: Vec<[VertexId; 3]>) -> Self {
+    pub fn new(mut positions: Vec<DVec3>, mut faces: Vec<[VertexId; 3]>) -> Self {
+        // Readers and builders grow these by doubling; a mesh is kept long after (a million
+        // faces could hold 12 MB they never use).
+        positions.shrink_to_fit();
+        faces.shrink_to_fit();
         TriMesh { positions, faces }
     }
 

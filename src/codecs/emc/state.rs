@@ -65,6 +65,16 @@ impl EmcState {
         }
     }
 
+    /// Makes room for `vertices` in all, so that the per-vertex lists never grow by doubling
+    /// (the encoder knows the count; a decoder's header could lie).
+    pub fn reserve(&mut self, vertices: usize) {
+        let more = vertices.saturating_sub(self.len());
+        self.cells.reserve_exact(more);
+        self.depth.reserve_exact(more);
+        self.next_split.reserve_exact(more);
+        self.adjacency.reserve_exact(more);
+    }
+
     /// Number of vertices (never zero: the list starts with one).
     #[allow(clippy::len_without_is_empty)]
     pub fn len(&self) -> usize {

@@ -89,6 +89,7 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
     let order = params.order;
     let n = mesh.vertex_count() as u64;
     let mut walker = Walker::new(order, n);
+    walker.state.reserve(mesh.vertex_count());
     let mut side = EncoderSide {
         coder: ArithEncoder::default(),
         clusters: Clusters::new(mesh, KeyTrie::new(order, &mesh.cells)),

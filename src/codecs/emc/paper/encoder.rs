@@ -74,6 +74,7 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
     let mut clusters = Clusters::new(mesh, KeyTrie::new(order, &mesh.cells));
     let mut plan = SplitPlan::default();
     let mut state = EmcState::new(order, n as u64);
+    state.reserve(n);
     let mut tally = Tally {
         distances: vec![0; syntax::MAX_DISTANCE + 1],
         ..Tally::default()
