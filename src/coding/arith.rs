@@ -1,5 +1,5 @@
 //! Adaptive binary arithmetic coding over constriction's range coder (encoding; decoding by a
-//! division-free reader of the same streams, [`RangeState`]).
+//! division-free reader of the same streams, `RangeState`).
 //!
 //! Every symbol is binarized and each binary decision has its own adaptive probability (a
 //! context) that encoder and decoder update identically; the context is passed to the coder per
