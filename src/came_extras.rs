@@ -104,7 +104,8 @@ pub fn path(results: &Path) -> PathBuf {
     results.join("came").join("extras.json")
 }
 
-fn table_mesh(name: &str, subdivisions: u32) -> Result<(PathBuf, TriMesh)> {
+/// Shared mesh `name` read and subdivided `subdivisions` times at edge midpoints.
+pub fn table_mesh(name: &str, subdivisions: u32) -> Result<(PathBuf, TriMesh)> {
     let path = resolve(name)?;
     let mut mesh = read_mesh(&path)?;
     for _ in 0..subdivisions {

@@ -42,6 +42,8 @@ pub mod came_flythrough;
 #[cfg(feature = "lab")]
 pub mod cli;
 #[cfg(feature = "lab")]
+pub mod emc_scale;
+#[cfg(feature = "lab")]
 pub mod harness;
 #[cfg(feature = "metrics")]
 pub mod metrics;

@@ -136,6 +136,14 @@ enum Command {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// `emc` on bunny-closed-35k as shared and subdivided two and three times (35k → 557k →
+    /// 2.2 M vertices) and on bunny.ply, the anchor: encode and decode times and peak memory;
+    /// writes results/emc/scale.json.
+    EmcScale {
+        /// Folder for results.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+    },
     /// Regenerate the papers' tables and figures in paper-tables/ from results/.
     Tables {
         /// Folder of result files.
@@ -193,6 +201,7 @@ fn main() -> ExitCode {
         Some(Command::RepairCost { out }) => repair_cost(out),
         Some(Command::CameExtras { out }) => came_extras(out),
         Some(Command::CameFly { out }) => came_fly(out),
+        Some(Command::EmcScale { out }) => emc_scale(out),
         None => match (&cli.codec, &cli.mesh) {
             (Some(codec), Some(mesh)) => run_one(codec, mesh, &cli.settings).map(|_| ()),
             _ => Err(anyhow::anyhow!(
@@ -603,6 +612,12 @@ fn tables(results: &Path, out: &Path) -> Result<()> {
 
 fn came_extras(out: &Path) -> Result<()> {
     let path = meshcodec::came_extras::run(out, &mut |line| eprintln!("{line}"))?;
+    meshcodec::outln!("wrote {}", path.display());
+    Ok(())
+}
+
+fn emc_scale(out: &Path) -> Result<()> {
+    let path = meshcodec::emc_scale::run(out, &mut |line| eprintln!("{line}"))?;
     meshcodec::outln!("wrote {}", path.display());
     Ok(())
 }

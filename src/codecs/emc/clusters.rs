@@ -104,6 +104,16 @@ impl Clusters {
         }
     }
 
+    /// Frees what only splits need (the mesh's edges, the cluster of each vertex), once every
+    /// cluster is a single vertex: the face corrections that follow are the encoder's peak of
+    /// memory, and these are a third of it on a large mesh.
+    pub fn release_edges(&mut self) {
+        self.neighbours = Vec::new();
+        self.cluster_of = Vec::new();
+        self.stamp_lower = Vec::new();
+        self.stamp_upper = Vec::new();
+    }
+
     /// Records the split of `v` by `plan`: `v` keeps the lower half, the new vertex the upper.
     pub fn commit(&mut self, v: usize, plan: &SplitPlan) {
         self.ranges[v] = plan.lower.clone();

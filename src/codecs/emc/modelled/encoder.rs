@@ -103,6 +103,8 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
             .expect("the encoder's answers agree with the header");
         let mut coder = std::mem::take(&mut side.coder);
         if level == order.levels as usize {
+            side.clusters.release_edges();
+            walker.release_caches();
             let corrections = face_corrections(
                 mesh,
                 &walker.state,

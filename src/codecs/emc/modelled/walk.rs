@@ -262,6 +262,16 @@ impl Walker {
         walker
     }
 
+    /// Frees the caches only the levels' passes read (centres, marks, visit lists), once the
+    /// last level is coded: the face corrections that follow are the encoder's peak of memory.
+    pub fn release_caches(&mut self) {
+        self.centres = Vec::new();
+        self.marks = Vec::new();
+        self.active = Vec::new();
+        self.resting = Vec::new();
+        self.codes = Vec::new();
+    }
+
     /// Recomputes the cached centre of `v` from its cell.
     fn refresh(&mut self, v: usize) {
         let shifts = self.shifts[self.state.depth[v] as usize];

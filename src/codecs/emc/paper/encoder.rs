@@ -123,6 +123,7 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
             }
         }
         if level == order.levels as usize {
+            clusters.release_edges();
             let corrections = face_corrections(mesh, &state, &clusters.ranges, &clusters.trie)?;
             let cliques = mesh.face_count() - corrections.double_sided.len()
                 + corrections.false_triangles.len();
