@@ -3,9 +3,11 @@
 //! 12 bits, with bunny.ply measured in the same run as the anchor of the per-vertex rates.
 //! Writes results/emc/scale.json.
 //!
-//! Memory is the process's peak resident size over each phase (Linux: the peak is reset through
-//! /proc/self/clear_refs before the phase, read from /proc/self/status after it). It includes
-//! what the phase's caller holds: the canonical mesh during encoding, the stream during decoding.
+//! Memory is the process's peak resident size over each phase (Linux with glibc: the allocator
+//! gives back its free memory and the peak is reset through /proc/self/clear_refs before the
+//! phase, read from /proc/self/status after it; elsewhere none is reported). It includes what
+//! the phase's caller holds: the canonical mesh during encoding, the stream during decoding, and
+//! the program itself (about 20 MB).
 
 use crate::came_extras::table_mesh;
 use crate::codecs::{self, EncodeOptions, Stop};
@@ -68,9 +70,17 @@ pub struct ScaleResults {
     pub rows: Vec<ScaleRow>,
 }
 
-/// Resets the process's peak resident size; whether the system allows it.
+/// Resets the process's peak resident size to what is allocated now; whether the system allows
+/// it. The allocator first gives back the memory it kept from earlier phases (glibc), else the
+/// peak would start from that.
 fn reset_peak() -> bool {
-    std::fs::write("/proc/self/clear_refs", "5").is_ok()
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: malloc_trim only returns free memory of the allocator to the system.
+    unsafe {
+        libc::malloc_trim(0);
+    }
+    cfg!(all(target_os = "linux", target_env = "gnu"))
+        && std::fs::write("/proc/self/clear_refs", "5").is_ok()
 }
 
 /// The process's peak resident size since the last reset, in bytes.
