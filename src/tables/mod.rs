@@ -818,16 +818,75 @@ pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
         let _ = writeln!(md);
     }
     let _ = writeln!(md, "Connectivity and geometry of our arithmetic-coded streams are split in proportion to the coder's own estimate of each class's bits; `emc` books the split and leaf questions (which cells are occupied) as geometry, the edge questions and the face corrections as connectivity, as the paper books split distances and edge codes.\n");
-    let _ = writeln!(md, "Rate-distortion on bunny.ply (every level of the progressive coders, Draco at quantization 8 to 16): [emc-rate-distortion.png](emc-rate-distortion.png).");
+    let _ = writeln!(md, "Rate-distortion on bunny.ply (every level of the progressive coders, Draco at quantization 8 to 16): [emc-rate-distortion.png](emc-rate-distortion.png). The valence-driven coder's curve is MEPP2's Compression_Valence (commit d977d05, adaptive quantization on, 12 bits, base mesh of at most 100 vertices) measured on this bunny outside the project, read from `../shared/anchors/{VALENCE_ANCHOR}` (its provenance and how each level's bits and errors were measured are in that file).");
     std::fs::create_dir_all(out)?;
     let path = out.join("emc-vs-anchors.md");
     std::fs::write(&path, md)?;
     Ok(path)
 }
 
+/// The anchor file of the valence-driven coder's levels on bunny.ply (measured outside the
+/// project; looked up, never copied).
+const VALENCE_ANCHOR: &str = "valence-rd-bunny.json";
+
+/// The valence-driven progressive coder of Lee, Lavoué & Dupont 2012 measured on bunny.ply at
+/// 12 bits: each level's cumulative bits and Hausdorff error (relative to the bounding box's
+/// diagonal, as ours).
+struct ValenceAnchor {
+    /// MEPP2 commit measured (short).
+    commit: String,
+    /// (cumulative bits, Hausdorff) per level.
+    levels: Vec<(f64, f64)>,
+}
+
+/// Folders the anchor files are looked up in: `$MESHCODEC_ANCHORS`, then `anchors` beside each
+/// mesh folder of [`crate::mesh::io::data_dirs`] (../shared/anchors).
+fn anchor_dirs() -> Vec<PathBuf> {
+    let mut dirs: Vec<PathBuf> = std::env::var_os("MESHCODEC_ANCHORS")
+        .map(PathBuf::from)
+        .into_iter()
+        .collect();
+    dirs.extend(
+        crate::mesh::io::data_dirs()
+            .iter()
+            .filter_map(|d| d.parent().map(|p| p.join("anchors"))),
+    );
+    dirs
+}
+
+fn valence_anchor() -> Result<ValenceAnchor> {
+    let path = anchor_dirs()
+        .into_iter()
+        .map(|d| d.join(VALENCE_ANCHOR))
+        .find(|p| p.is_file())
+        .ok_or_else(|| {
+            Error::Unsupported(format!(
+                "no {VALENCE_ANCHOR} in ../shared/anchors (or $MESHCODEC_ANCHORS)"
+            ))
+        })?;
+    let bad = |what: &str| Error::Unsupported(format!("{}: {what}", path.display()));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path)?).map_err(|e| bad(&e.to_string()))?;
+    let levels = json["levels"]
+        .as_array()
+        .ok_or_else(|| bad("no levels"))?
+        .iter()
+        .map(|l| Some((l["bits"].as_f64()?, l["hausdorff_relative"].as_f64()?)))
+        .collect::<Option<Vec<_>>>()
+        .filter(|l| !l.is_empty())
+        .ok_or_else(|| bad("a level without bits or hausdorff_relative"))?;
+    let commit = json["commit"]
+        .as_str()
+        .unwrap_or("?")
+        .chars()
+        .take(7)
+        .collect();
+    Ok(ValenceAnchor { commit, levels })
+}
+
 /// Writes paper-tables/emc-rate-distortion.{png,svg}: bits against Hausdorff error on bunny.ply
-/// for every level of `emc`, `emc-paper` and `pm` at 12 bits, and Draco's single-rate points at
-/// quantization 8 to 16.
+/// for every level of `emc`, `emc-paper` and `pm` at 12 bits and of the valence-driven coder
+/// (the anchor file's measurement), and Draco's single-rate points at quantization 8 to 16.
 pub fn emc_rate_distortion(results: &Path, out: &Path) -> Result<Vec<PathBuf>> {
     let runs = ["emc", "emc-paper", "pm"]
         .iter()
@@ -851,6 +910,12 @@ pub fn emc_rate_distortion(results: &Path, out: &Path) -> Result<Vec<PathBuf>> {
         label: "Draco q8–q16 (single-rate)".into(),
         points: draco,
         mark: plot::Mark::Points,
+    });
+    let valence = valence_anchor()?;
+    chart.series.push(plot::Series {
+        label: format!("valence coder, Lee et al. 2012 (MEPP2 {})", valence.commit),
+        points: valence.levels,
+        mark: plot::Mark::Line,
     });
     chart.title =
         "Rate vs distortion — bunny.ply: progressive levels at 12 bits, Draco at 8–16 bits".into();
