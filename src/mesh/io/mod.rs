@@ -449,6 +449,36 @@ mod tests {
         }
     }
 
+    /// PLY elements are read in file order whatever it is, each into its own kind of record:
+    /// faces before vertices, an element we do not know between them (read past), strips and
+    /// faces together; the attributed reader of a file without attributes returns none.
+    #[test]
+    fn ply_elements_in_any_order_and_unknown_elements_read_past() {
+        let ply = "ply\nformat ascii 1.0\n\
+            element face 2\nproperty list uchar int vertex_indices\n\
+            element camera 1\nproperty float view_px\nproperty list uchar float extra\n\
+            element vertex 5\nproperty double x\nproperty double y\nproperty float z\n\
+            element tristrips 1\nproperty list int int vertex_indices\n\
+            end_header\n\
+            3 0 1 2\n4 0 2 3 4\n\
+            1.5 2 0.25 0.5\n\
+            0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 2 0\n\
+            4 2 3 4 -1\n";
+        let read = read_attributed_bytes(ply.as_bytes(), "ply").unwrap();
+        assert_eq!(read.mesh.positions.len(), 5);
+        assert_eq!(read.mesh.positions[4], glam::DVec3::new(0.5, 2.0, 0.0));
+        // The triangle, the quad's fan (0 2 3, 0 3 4), the strip's triangle.
+        assert_eq!(
+            read.mesh.faces,
+            vec![[0, 1, 2], [0, 2, 3], [0, 3, 4], [2, 3, 4]]
+        );
+        assert!(read.attributes.is_empty());
+        assert_eq!(
+            read_by_extension(ply.as_bytes(), "ply").unwrap().faces,
+            read.mesh.faces
+        );
+    }
+
     /// The mesh at single precision, as glTF holds it.
     fn single(mut m: AttributedMesh) -> AttributedMesh {
         let f = |x: f64| x as f32 as f64;
