@@ -80,6 +80,7 @@ regressions! {
     gltf_uvs_of_an_unsigned_int_type_are_refused: "read_gltf" / "texcoords-of-integer-component-type";
     gltf_indices_of_a_float_type_are_refused: "read_gltf" / "indices-of-float-component-type";
     positions_beyond_f32_are_refused_by_the_gltf_writer: "read_ply" / "positions-beyond-f32-written-as-gltf";
+    colours_beyond_f32_are_refused_by_the_gltf_writer: "read_obj" / "colours-beyond-f32-written-as-gltf";
 }
 
 #[test]

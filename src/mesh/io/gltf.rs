@@ -401,6 +401,9 @@ pub fn write_attributed(m: &AttributedMesh, binary: bool) -> Result<Vec<u8>> {
     if let Some(uvs) = &a.uvs {
         beyond_f32("texture", &mut uvs.iter().flat_map(|t| t.to_array()))?;
     }
+    if let Some(colours) = &a.colours {
+        beyond_f32("colour", &mut colours.iter().flatten().copied())?;
+    }
     let (mut min, mut max) = (vec![f64::INFINITY; 3], vec![f64::NEG_INFINITY; 3]);
     for p in &points {
         for (axis, x) in p.to_array().into_iter().enumerate() {
