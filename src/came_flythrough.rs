@@ -4,10 +4,14 @@
 //! faces, splits and collapses, adaptation time, bytes fetched so far, the share of the surface
 //! in view, and the measured screen-space error against the tolerance.
 //!
-//! The measured error of a frame: every vertex of the full mesh inside the view frustum and
-//! the vertex standing for it in the adapted mesh (the active node on its leaf path) are
-//! projected to the screen; the largest distance between the two, in pixels (no occlusion
-//! test: hidden vertices count too).
+//! The measured error of a frame: every vertex of the full mesh inside the view frustum with a
+//! face turned towards the eye, and the vertex standing for it in the adapted mesh (the active
+//! node on its leaf path), are projected to the screen; the largest distance between the two,
+//! in pixels (no occlusion test: hidden vertices count too). A vertex all of whose faces turn
+//! away is drawn by none of them on a one-sided surface, and back-face culling leaves it coarse.
+//!
+//! Beside the path's front, a second front follows the same views two-sided (no back-face
+//! culling), for its faces and bytes.
 //!
 //! Writes results/came/flythrough.{json,csv}, the series as a chart (flythrough.{png,svg}), and
 //! renders of the farthest and nearest frames, adapted and full.
@@ -49,6 +53,8 @@ pub struct Frame {
     /// Faces and vertices of the adapted mesh.
     pub faces: usize,
     pub vertices: usize,
+    /// Faces of the two-sided front (no back-face culling) in the same view.
+    pub faces_two_sided: usize,
     pub splits: usize,
     pub collapses: usize,
     /// Passes over the active nodes, and adaptations (one more after each wait for meta-nodes).
@@ -61,12 +67,15 @@ pub struct Frame {
     /// Bytes read from the stream's file so far, and meta-nodes decoded.
     pub bytes_fetched: u64,
     pub units_loaded: usize,
+    /// Bytes the two-sided front has read so far.
+    pub bytes_fetched_two_sided: u64,
     /// Share of the full mesh's surface (by area) inside the view frustum.
     pub surface_in_view: f64,
     /// Present faces turned over against the same triangle of the full mesh (their normals
     /// more than 90° apart): fold-overs, which nothing in the build prevents.
     pub fold_overs: usize,
-    /// Full-mesh vertices inside the frustum, and the measured screen-space error over them.
+    /// Full-mesh vertices inside the frustum with a face towards the eye, and the measured
+    /// screen-space error over them.
     pub visible_vertices: usize,
     pub max_error_px: f64,
     pub mean_error_px: f64,
@@ -82,6 +91,9 @@ pub struct ColdView {
     pub units_loaded: usize,
     /// Bytes read over the stream's bytes.
     pub share_of_stream: f64,
+    /// The same, two-sided (no back-face culling).
+    pub bytes_read_two_sided: u64,
+    pub share_of_stream_two_sided: f64,
 }
 
 /// The whole run.
@@ -200,14 +212,15 @@ fn surface_in_view(triangles: &[(DVec3, f64)], view: &View) -> f64 {
 /// the adapted mesh, and how many vertices are in view.
 fn measured_error(
     front: &ViewMesh,
-    leaves: &[(crate::hierarchy::came::NodeId, DVec3)],
+    leaves: &[Leaf],
+    facing: &[bool],
     camera: &Camera,
     view: &View,
 ) -> Result<(f64, f64, usize)> {
     let projection = Projection::new(camera);
     let (mut max, mut sum, mut count) = (0.0f64, 0.0, 0usize);
-    for &(id, p) in leaves {
-        if !view.sees(p, 0.0) {
+    for &(id, p, vertex) in leaves {
+        if !view.sees(p, 0.0) || !facing[vertex as usize] {
             continue;
         }
         let q = front
@@ -223,6 +236,26 @@ fn measured_error(
         count += 1;
     }
     Ok((max, sum / count.max(1) as f64, count))
+}
+
+/// A vertex of the full mesh: its leaf path, position and number in the full mesh.
+type Leaf = (crate::hierarchy::came::NodeId, DVec3, u32);
+
+/// Per vertex of `mesh`, whether a face of it turns towards `eye` (every vertex, if `two_sided`).
+fn facing_the_eye(mesh: &TriMesh, eye: DVec3, two_sided: bool, out: &mut Vec<bool>) {
+    out.clear();
+    out.resize(mesh.vertex_count(), two_sided);
+    if two_sided {
+        return;
+    }
+    for face in &mesh.faces {
+        let [a, b, c] = mesh.corners(*face);
+        if (a - eye).dot((b - a).cross(c - a)) < 0.0 {
+            for &v in face {
+                out[v as usize] = true;
+            }
+        }
+    }
 }
 
 /// Present faces of `front` whose normal points against their full-resolution counterpart's
@@ -268,17 +301,29 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
     ));
     // The reference: every vertex's leaf path and position, from the whole stream.
     let (header, tree) = codecs::came::decode_tree(&stream)?;
-    let leaves: Vec<_> = tree
+    let vertex_at: std::collections::HashMap<[u32; 3], u32> = canonical
+        .cells
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| (c, i as u32))
+        .collect();
+    let leaves: Vec<Leaf> = tree
         .nodes
         .iter()
         .filter(|n| n.leaf)
         .map(|n| {
-            (
+            let vertex = vertex_at
+                .get(&n.position.map(|x| x as u32))
+                .copied()
+                .ok_or_else(|| Error::mesh("a leaf of the stream is no vertex of the mesh"))?;
+            Ok((
                 n.id,
                 codecs::came::decoded::to_world(&header.grid, n.position),
-            )
+                vertex,
+            ))
         })
-        .collect();
+        .collect::<Result<_>>()?;
+    drop(vertex_at);
     // `came` is lossless: its full decode is the canonical mesh.
     let full = canonical.to_mesh();
     drop(tree);
@@ -304,7 +349,7 @@ fn fly(
     results: &Path,
     path: &Path,
     full: &TriMesh,
-    leaves: &[(crate::hierarchy::came::NodeId, DVec3)],
+    leaves: &[Leaf],
     stream_bytes: u64,
     log: &mut dyn FnMut(String),
 ) -> Result<Flythrough> {
@@ -325,9 +370,11 @@ fn fly(
         })
         .ok_or_else(|| Error::mesh("an empty mesh"))?;
     let at: std::collections::HashMap<u64, DVec3> =
-        leaves.iter().map(|&(id, p)| (id.packed(), p)).collect();
+        leaves.iter().map(|&(id, p, _)| (id.packed(), p)).collect();
     let triangles = centroids_and_areas(full);
+    let mut facing = Vec::new();
     let mut front = ViewMesh::open_file(path)?;
+    let mut two_sided = ViewMesh::open_file(path)?;
     let units = front.fetched().units;
     let mut frames = Vec::with_capacity(FRAMES);
     let (mut operations, mut adapting) = (0usize, 0.0f64);
@@ -354,8 +401,10 @@ fn fly(
         }
         operations += splits + collapses;
         adapting += adapt_s;
+        two_sided.settle(&view.clone().two_sided(true), Budget::UNLIMITED, 256);
+        facing_the_eye(full, camera.eye, view.is_two_sided(), &mut facing);
         let (max_error_px, mean_error_px, visible_vertices) =
-            measured_error(&front, leaves, &camera, &view)?;
+            measured_error(&front, leaves, &facing, &camera, &view)?;
         let fetched = front.fetched();
         let frame = Frame {
             frame: i,
@@ -363,6 +412,7 @@ fn fly(
             target: camera.target.to_array(),
             faces: front.face_count(),
             vertices: front.vertex_count(),
+            faces_two_sided: two_sided.face_count(),
             splits,
             collapses,
             passes,
@@ -371,6 +421,7 @@ fn fly(
             wait_ms: wait_s * 1e3,
             bytes_fetched: fetched.bytes_read,
             units_loaded: fetched.units_loaded,
+            bytes_fetched_two_sided: two_sided.fetched().bytes_read,
             surface_in_view: surface_in_view(&triangles, &view),
             fold_overs: fold_overs(&front, &at),
             visible_vertices,
@@ -379,8 +430,9 @@ fn fly(
         };
         if i % 10 == 0 || i + 1 == FRAMES {
             log(format!(
-                "frame {i}: {} faces ({} folded over), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
+                "frame {i}: {} faces ({} two-sided, {} folded over), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
                 frame.faces,
+                frame.faces_two_sided,
                 frame.fold_overs,
                 splits,
                 collapses,
@@ -408,6 +460,7 @@ fn fly(
         frames.push(frame);
     }
     drop(front);
+    drop(two_sided);
     // The view nearest a tenth of the surface, alone from a cold start.
     let tenth = frames
         .iter()
@@ -421,19 +474,27 @@ fn fly(
     let mut cold = ViewMesh::open_file(path)?;
     cold.settle(&View::new(&camera, TOLERANCE_PX)?, Budget::UNLIMITED, 256);
     let fetched = cold.fetched();
+    drop(cold);
+    let mut cold = ViewMesh::open_file(path)?;
+    let two = View::new(&camera, TOLERANCE_PX)?.two_sided(true);
+    cold.settle(&two, Budget::UNLIMITED, 256);
+    let bytes_read_two_sided = cold.fetched().bytes_read;
     let tenth_of_surface = ColdView {
         frame: tenth.frame,
         surface_in_view: tenth.surface_in_view,
         bytes_read: fetched.bytes_read,
         units_loaded: fetched.units_loaded,
         share_of_stream: fetched.bytes_read as f64 / stream_bytes as f64,
+        bytes_read_two_sided,
+        share_of_stream_two_sided: bytes_read_two_sided as f64 / stream_bytes as f64,
     };
     log(format!(
-        "frame {} alone ({:.1}% of the surface in view): {} bytes, {:.1}% of the stream",
+        "frame {} alone ({:.1}% of the surface in view): {} bytes, {:.1}% of the stream ({:.1}% two-sided)",
         tenth.frame,
         100.0 * tenth.surface_in_view,
         fetched.bytes_read,
-        100.0 * tenth_of_surface.share_of_stream
+        100.0 * tenth_of_surface.share_of_stream,
+        100.0 * tenth_of_surface.share_of_stream_two_sided
     ));
     Ok(Flythrough {
         command: COMMAND.to_string(),
@@ -456,14 +517,15 @@ fn fly(
 
 fn csv(report: &Flythrough) -> String {
     let mut out = String::from(
-        "frame,faces,vertices,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,surface_in_view,fold_overs,visible_vertices,max_error_px,mean_error_px\n",
+        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,visible_vertices,max_error_px,mean_error_px\n",
     );
     for f in &report.frames {
         out += &format!(
-            "{},{},{},{},{},{},{},{:.3},{:.3},{},{},{:.5},{},{},{:.4},{:.4}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{:.5},{},{},{:.4},{:.4}\n",
             f.frame,
             f.faces,
             f.vertices,
+            f.faces_two_sided,
             f.splits,
             f.collapses,
             f.passes,
@@ -472,6 +534,7 @@ fn csv(report: &Flythrough) -> String {
             f.wait_ms,
             f.bytes_fetched,
             f.units_loaded,
+            f.bytes_fetched_two_sided,
             f.surface_in_view,
             f.fold_overs,
             f.visible_vertices,
@@ -510,6 +573,9 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
             false,
             vec![
                 series("active faces", &|f| f.faces as f64),
+                series("two-sided (no back-face culling)", &|f| {
+                    f.faces_two_sided as f64
+                }),
                 series("folded over", &|f| f.fold_overs as f64),
             ],
         ),
@@ -530,6 +596,9 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
             vec![
                 series("bytes fetched so far", &|f| {
                     100.0 * f.bytes_fetched as f64 / report.stream_bytes as f64
+                }),
+                series("two-sided", &|f| {
+                    100.0 * f.bytes_fetched_two_sided as f64 / report.stream_bytes as f64
                 }),
                 series("surface in view", &|f| 100.0 * f.surface_in_view),
             ],

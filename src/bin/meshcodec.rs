@@ -117,6 +117,11 @@ enum Command {
         /// Write a render from the camera.
         #[arg(long)]
         png: Option<PathBuf>,
+        /// Refine the parts that face away from the eye too (for a surface drawn two-sided or
+        /// seen from inside); by default, a node whose normal cone turns every face away stays
+        /// coarse.
+        #[arg(long)]
+        two_sided: bool,
     },
     /// Convert a mesh file to another format (.ply, .obj, .glb or .gltf), keeping its normals,
     /// texture coordinates, colours and materials where the output format holds them.
@@ -199,6 +204,7 @@ fn main() -> ExitCode {
             tolerance,
             faces,
             png,
+            two_sided,
         } => {
             let camera = meshcodec::codecs::came::refine::Camera {
                 eye,
@@ -208,7 +214,8 @@ fn main() -> ExitCode {
                 width: size.0,
                 height: size.1,
             };
-            view(&input, &output, &camera, tolerance, faces, png.as_deref())
+            let look = (tolerance, two_sided);
+            view(&input, &output, &camera, look, faces, png.as_deref())
         }
         Command::Convert { input, output } => convert(&input, &output),
         Command::Distance {
@@ -404,7 +411,7 @@ fn view(
     input: &Path,
     output: &Path,
     camera: &meshcodec::codecs::came::refine::Camera,
-    tolerance: f64,
+    (tolerance, two_sided): (f64, bool),
     faces: Option<usize>,
     png: Option<&Path>,
 ) -> Result<()> {
@@ -412,7 +419,7 @@ fn view(
     let context = || input.display().to_string();
     // Only the header, the index and the meta-nodes this view needs are read.
     let mut front = ViewMesh::open_file(input).with_context(context)?;
-    let view = View::new(camera, tolerance)?;
+    let view = View::new(camera, tolerance)?.two_sided(two_sided);
     let budget = Budget {
         operations: usize::MAX,
         faces,

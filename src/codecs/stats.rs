@@ -100,6 +100,8 @@ pub enum CameField {
     Coordinates,
     /// Multiresolution data: error-sphere radii.
     MrData,
+    /// Normal cones (`came`; not in the paper).
+    Cones,
 }
 
 impl CameField {
@@ -110,15 +112,17 @@ impl CameField {
             CameField::Dependencies => "dependencies",
             CameField::Coordinates => "coordinates",
             CameField::MrData => "spheres",
+            CameField::Cones => "cones",
         }
     }
 
     /// Every field.
-    pub const ALL: [CameField; 4] = [
+    pub const ALL: [CameField; 5] = [
         CameField::Connectivity,
         CameField::Dependencies,
         CameField::Coordinates,
         CameField::MrData,
+        CameField::Cones,
     ];
 }
 

@@ -106,12 +106,20 @@ impl OurRow {
             .map_err(|e| Error::Unsupported(format!("{}: {e}", self.label)))
     }
 
+    /// The paper's four fields.
     fn fields(&self) -> Result<[f64; 4]> {
         let mut bits = [0.0; 4];
         for (b, field) in bits.iter_mut().zip(CameField::ALL) {
             *b = self.stat(Stat::CameBits(field))?;
         }
         Ok(bits)
+    }
+
+    /// Bits of the normal cones (none in the paper's coding).
+    fn cone_bits(&self) -> f64 {
+        self.stats
+            .get(Stat::CameBits(CameField::Cones))
+            .unwrap_or(0.0)
     }
 }
 
@@ -242,16 +250,16 @@ pub fn tables(results: &Path, out: &Path) -> Result<PathBuf> {
     }
 
     let _ = writeln!(md, "\n## Table 3: bits per field\n");
-    let _ = writeln!(md, "Connectivity: tree shape (leaf flags), triangle counts and the corner paths n1, n2, n3 with their lengths, ups and orientation; dependencies: their counts and paths; coordinates: the root, the difference vectors and (`came-paper`) the meta-nodes' frames; MR data: the error spheres' radii. Total = the four fields (as the paper's); the stream adds its header and unit index (\"stream bits\"). Bits/triangle is the total over the triangles, as the paper's.\n");
-    let _ = writeln!(md, "| model | depth | connect. | depend. | coord. | MR data | total | bits/triangle | stream bits | deps/node (raw) | meta-nodes | full level |");
+    let _ = writeln!(md, "Connectivity: tree shape (leaf flags), triangle counts and the corner paths n1, n2, n3 with their lengths, ups and orientation; dependencies: their counts and paths; coordinates: the root, the difference vectors and (`came-paper`) the meta-nodes' frames; MR data: the error spheres' radii; normal cones (`came` only, not in the paper): each inner node's cone of face normals for back-face culling (docs/FORMAT.md §8.2). Total = the fields (the paper's four, and the cones); the stream adds its header and unit index (\"stream bits\"). Bits/triangle is the total over the triangles, as the paper's.\n");
+    let _ = writeln!(md, "| model | depth | connect. | depend. | coord. | MR data | normal cones | total | bits/triangle | stream bits | deps/node (raw) | meta-nodes | full level |");
     let _ = writeln!(
         md,
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"
     );
     for p in &PAPER {
         let _ = writeln!(
             md,
-            "| paper: {} | {} | {} | {} | {} | {} | {} | {:.1} | | 1.5–2 | | lossy |",
+            "| paper: {} | {} | {} | {} | {} | {} | — | {} | {:.1} | | 1.5–2 | | lossy |",
             p.name,
             p.depth,
             p.bits[0],
@@ -265,16 +273,18 @@ pub fn tables(results: &Path, out: &Path) -> Result<PathBuf> {
     for rows in [&paper_rows, &came_rows] {
         for r in rows.iter() {
             let bits = r.fields()?;
-            let total: f64 = bits.iter().sum();
+            let cones = r.cone_bits();
+            let total: f64 = bits.iter().sum::<f64>() + cones;
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {} | {} | **{:.1}** | {} | {:.2} ({:.2}) | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | **{:.1}** | {} | {:.2} ({:.2}) | {} | {} |",
                 r.label,
                 r.stat(Stat::HierarchyDepth)?,
                 short(bits[0]),
                 short(bits[1]),
                 short(bits[2]),
                 short(bits[3]),
+                if cones > 0.0 { short(cones) } else { "—".into() },
                 short(total),
                 total / r.triangles as f64,
                 short(r.bytes as f64 * 8.0),

@@ -7,6 +7,7 @@ use super::Params;
 use crate::codecs::{LevelDecoder, LevelMesh};
 use crate::container::{Header, Index, StreamReader};
 use crate::error::{Error, Result};
+use crate::hierarchy::came::cones::CodedCone;
 use crate::hierarchy::came::NodeId;
 use crate::mesh::TriMesh;
 use glam::DVec3;
@@ -27,6 +28,8 @@ pub struct Node {
     pub position: [f64; 3],
     /// Its error sphere's radius (grid units).
     pub radius: f64,
+    /// Its normal cone as coded ([`CodedCone::NONE`] where the stream has none).
+    pub cone: CodedCone,
     /// Root of the unit that decoded the split creating it.
     pub created_unit: NodeId,
     /// Root of the unit that decoded its split.
@@ -123,7 +126,7 @@ impl DecodedTree {
     }
 
     /// Adds the root (an inner node: the meshes CAME codes have triangles).
-    pub fn add_root(&mut self, position: [f64; 3], radius: f64) {
+    pub fn add_root(&mut self, position: [f64; 3], radius: f64, cone: CodedCone) {
         self.nodes.push(Node {
             id: NodeId::ROOT,
             leaf: false,
@@ -131,6 +134,7 @@ impl DecodedTree {
             parent: u32::MAX,
             position,
             radius,
+            cone,
             created_unit: NodeId::ROOT,
             split_unit: None,
         });
@@ -148,14 +152,16 @@ impl DecodedTree {
         status(n.leaf, n.split_unit, n.created_unit, unit)
     }
 
-    /// Splits node `s` into children with the given leaf flags, positions and radii, decoded by
-    /// the unit rooted at `unit`.
+    /// Splits node `s` into children with the given leaf flags, positions, radii and cones,
+    /// decoded by the unit rooted at `unit`.
+    #[allow(clippy::too_many_arguments)]
     pub fn split(
         &mut self,
         s: u32,
         leaf: [bool; 2],
         positions: [[f64; 3]; 2],
         radii: [f64; 2],
+        cones: [CodedCone; 2],
         unit: NodeId,
         at: usize,
     ) -> Result<[u32; 2]> {
@@ -186,6 +192,7 @@ impl DecodedTree {
                 parent: s,
                 position: positions[side],
                 radius: radii[side],
+                cone: cones[side],
                 created_unit: unit,
                 split_unit: None,
             });

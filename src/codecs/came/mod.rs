@@ -122,25 +122,35 @@ pub struct Params {
     pub component_bits: u8,
     /// Bits per radius ratio.
     pub radius_bits: u8,
+    /// Bits a coordinate of a normal cone's axis (0: the stream codes no cones).
+    pub cone_bits: u8,
 }
 
 impl Params {
-    /// The header bytes.
+    /// The header bytes: four, and a fifth with the cones' bits when there are cones.
     pub fn to_bytes(self) -> Vec<u8> {
-        vec![
+        let mut bytes = vec![
             self.meta_levels,
             self.depth,
             self.component_bits,
             self.radius_bits,
-        ]
+        ];
+        if self.cone_bits > 0 {
+            bytes.push(self.cone_bits);
+        }
+        bytes
     }
 
     /// Parameters from header bytes; `components`: the range bits per component may take.
     pub fn from_bytes(bytes: &[u8], components: std::ops::RangeInclusive<u8>) -> Result<Params> {
         let bad = |what: &str| Error::malformed(0, 0, format!("CAME parameters: {what}"));
-        let &[meta_levels, depth, component_bits, radius_bits] = bytes else {
-            return Err(bad("4 bytes expected"));
+        let cone_bits = match bytes.len() {
+            4 => 0,
+            5 if bytes[4] > 0 => bytes[4],
+            _ => return Err(bad("4 bytes, or 5 with normal cones, expected")),
         };
+        let [meta_levels, depth, component_bits, radius_bits] =
+            [bytes[0], bytes[1], bytes[2], bytes[3]];
         if !(1..=16).contains(&meta_levels) {
             return Err(bad("levels per meta-node outside 1..16"));
         }
@@ -158,6 +168,7 @@ impl Params {
             depth,
             component_bits,
             radius_bits,
+            cone_bits,
         })
     }
 }
@@ -267,6 +278,8 @@ pub struct Layout {
     pub component_bits: u8,
     /// Bits per radius ratio.
     pub radius_bits: u8,
+    /// Bits a coordinate of a normal cone's axis (0: no cones).
+    pub cone_bits: u8,
 }
 
 /// Encodes `mesh` as a CAME stream: builds the hierarchy, partitions it into meta-nodes, has
@@ -286,6 +299,7 @@ pub fn encode_stream(
         depth: tree.depth(),
         component_bits: layout.component_bits,
         radius_bits: layout.radius_bits,
+        cone_bits: layout.cone_bits,
     };
     let mut fields = std::collections::BTreeMap::<&'static str, f64>::new();
     let units: Vec<(Vec<u8>, LevelCost)> = code_units(&tree, &part)

@@ -17,7 +17,9 @@ use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext, IntContext, U
 use crate::coding::SyntaxClass;
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
+use crate::hierarchy::came::cones::{self, coded_cones, CodedCone, ANGLE_BITS, NO_CONE};
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
+use crate::mesh::attribute_quantization::octahedral_max;
 use crate::hierarchy::came::{NodeId, VertexTree};
 use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
@@ -60,6 +62,10 @@ struct Contexts {
     dependency_rise: UintContext,
     dependency_up: UintContext,
     stop: [BitContext; 16],
+    /// Per class of the parent's cone ([`cone_class`]): the half-angle code's tree; the two
+    /// coordinates of an axis of its own (differences from the square's centre).
+    cone_angle: Vec<Vec<BitContext>>,
+    cone_axis: [IntContext; 2],
 }
 
 impl Contexts {
@@ -83,6 +89,8 @@ impl Contexts {
             dependency_rise: UintContext::default(),
             dependency_up: UintContext::default(),
             stop: [BitContext::default(); 16],
+            cone_angle: vec![vec![BitContext::default(); 1 << ANGLE_BITS]; CONE_CLASSES],
+            cone_axis: Default::default(),
         }
     }
 }
@@ -110,6 +118,33 @@ fn nearer(children: [[f64; 3]; 2], target: [f64; 3]) -> bool {
 
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// Context classes of a cone: its parent has none, or the parent's half-angle code + 1 (a
+/// child's faces are some of its parent's, so its cone is mostly as narrow or narrower).
+const CONE_CLASSES: usize = 1 + NO_CONE as usize;
+
+fn cone_class(parent: CodedCone) -> usize {
+    if parent.angle < NO_CONE {
+        1 + parent.angle as usize
+    } else {
+        0
+    }
+}
+
+/// Codes a node's cone: its half-angle code, then, unless its parent has a cone (whose axis
+/// it takes), its axis.
+fn put_cone(enc: &mut ArithEncoder, ctx: &mut Contexts, parent: CodedCone, cone: CodedCone) {
+    let class = cone_class(parent);
+    let g = SyntaxClass::Geometry;
+    put_symbol(enc, &mut ctx.cone_angle[class], cone.angle, ANGLE_BITS, g, "cones");
+    if cone.angle < NO_CONE && class == 0 {
+        let centre = octahedral_max(cones::AXIS_BITS) / 2;
+        for k in 0..2 {
+            let d = cone.axis[k] as i64 - centre as i64;
+            enc.int(&mut ctx.cone_axis[k], d, g, "cones");
+        }
+    }
 }
 
 impl Codec for Came {
@@ -146,6 +181,7 @@ impl Codec for Came {
             tails: Tails::Whole,
             component_bits: 0,
             radius_bits: RADIUS_BITS,
+            cone_bits: cones::AXIS_BITS,
         };
         encode_stream(mesh, layout, |tree, part| {
             let encoder = Encoder::new(tree, mesh, part);
@@ -173,6 +209,16 @@ pub fn params(header: &Header) -> Result<Params> {
             "came streams use 4-bit radius ratios",
         ));
     }
+    if ![0, cones::AXIS_BITS].contains(&params.cone_bits) {
+        return Err(Error::malformed(
+            0,
+            0,
+            format!(
+                "came streams code normal cones on {} bits a coordinate",
+                cones::AXIS_BITS
+            ),
+        ));
+    }
     Ok(params)
 }
 
@@ -186,6 +232,8 @@ struct Encoder<'a> {
     /// The decoder's (rounded-up) sphere radii, and each inner non-root node's ratio code.
     radii: Vec<f64>,
     ratio_codes: Vec<u32>,
+    /// Each node's normal cone as coded.
+    cones: Vec<CodedCone>,
     born: Vec<Vec<BornTriangle>>,
 }
 
@@ -215,6 +263,7 @@ impl<'a> Encoder<'a> {
                 }
             }
         }
+        let cones = coded_cones(tree, &mesh.cells, &mesh.faces, mesh.grid.cell);
         Encoder {
             tree,
             part,
@@ -222,6 +271,7 @@ impl<'a> Encoder<'a> {
             positions,
             radii,
             ratio_codes,
+            cones,
             born: born_triangles(tree, mesh),
         }
     }
@@ -253,6 +303,8 @@ impl<'a> Encoder<'a> {
             }
             let r = self.radii[tree.root as usize] as u64;
             enc.uint(&mut UintContext::default(), r, G, "spheres");
+            let cone = self.cones[tree.root as usize];
+            put_cone(&mut enc, &mut ctx, CodedCone::NONE, cone);
         }
         // Pass 1: shape, positions, spheres.
         for &s in &meta.nodes {
@@ -284,6 +336,8 @@ impl<'a> Encoder<'a> {
                     G,
                     "spheres",
                 );
+                let (parent, cone) = (self.cones[s as usize], self.cones[c as usize]);
+                put_cone(&mut enc, &mut ctx, parent, cone);
             }
         }
         // Pass 2: triangles and dependencies.
@@ -519,6 +573,37 @@ impl UnitReader<'_> {
         self.dec.bit(c).ok_or_else(|| cut_at(self.at))
     }
 
+    /// A node's normal cone ([`put_cone`]).
+    fn cone(&mut self, parent: CodedCone) -> Result<CodedCone> {
+        let class = cone_class(parent);
+        let angle = get_symbol(&mut self.dec, &mut self.ctx.cone_angle[class], ANGLE_BITS)
+            .ok_or_else(|| cut_at(self.at))?;
+        if angle >= NO_CONE {
+            return Ok(CodedCone::NONE);
+        }
+        if class > 0 {
+            return Ok(CodedCone {
+                axis: parent.axis,
+                angle,
+            });
+        }
+        let centre = octahedral_max(cones::AXIS_BITS) / 2;
+        let mut axis = [0; 2];
+        for (k, a) in axis.iter_mut().enumerate() {
+            let d = self
+                .dec
+                .int(&mut self.ctx.cone_axis[k])
+                .ok_or_else(|| cut_at(self.at))?;
+            *a = u32::try_from(centre as i64 + d)
+                .ok()
+                .filter(|&a| a <= octahedral_max(cones::AXIS_BITS))
+                .ok_or_else(|| {
+                    Error::malformed(0, self.at, "a normal cone's axis leaves its square")
+                })?;
+        }
+        Ok(CodedCone { axis, angle })
+    }
+
     fn uint(
         &mut self,
         pick: impl FnOnce(&mut Contexts) -> &mut UintContext,
@@ -697,6 +782,7 @@ impl UnitDecoder for ModelledUnits {
             at,
         };
         let whole = r.bit(|c| &mut c.whole)?;
+        let with_cones = params.cone_bits > 0;
         if first {
             let mut p = [0.0; 3];
             for x in &mut p {
@@ -708,7 +794,12 @@ impl UnitDecoder for ModelledUnits {
                 .filter(|&v| v <= 1 << 40)
                 .ok_or_else(|| Error::malformed(0, at, "the root's radius is cut or too large"))?
                 as f64;
-            r.tree.add_root(p, radius);
+            let cone = if with_cones {
+                r.cone(CodedCone::NONE)?
+            } else {
+                CodedCone::NONE
+            };
+            r.tree.add_root(p, radius, cone);
         }
         let top = r.tree.nodes[root as usize].id.len();
         let mut queue = vec![root];
@@ -719,7 +810,7 @@ impl UnitDecoder for ModelledUnits {
             let s = queue[at_node];
             at_node += 1;
             let node = &r.tree.nodes[s as usize];
-            let (sid, ps, rs) = (node.id, node.position, node.radius);
+            let (sid, ps, rs, parent_cone) = (node.id, node.position, node.radius, node.cone);
             let depth = sid.len() as usize + 1;
             let mut leaf = [false; 2];
             for (side, l) in leaf.iter_mut().enumerate() {
@@ -743,6 +834,7 @@ impl UnitDecoder for ModelledUnits {
             }
             let positions = [ps, pu];
             let mut radii = [0.0; 2];
+            let mut cones = [CodedCone::NONE; 2];
             for side in 0..2 {
                 if leaf[side] {
                     continue;
@@ -751,8 +843,11 @@ impl UnitDecoder for ModelledUnits {
                 let code = get_symbol(&mut r.dec, &mut r.ctx.ratio[side], RADIUS_BITS)
                     .ok_or_else(|| r.cut())?;
                 radii[side] = decoded_radius(code, base, RADIUS_BITS);
+                if with_cones {
+                    cones[side] = r.cone(parent_cone)?;
+                }
             }
-            let children = r.tree.split(s, leaf, positions, radii, unit, at)?;
+            let children = r.tree.split(s, leaf, positions, radii, cones, unit, at)?;
             for side in 0..2 {
                 if leaf[side] {
                     continue;
@@ -847,6 +942,45 @@ mod tests {
         let reader = StreamReader::open(bytes).unwrap();
         let params = params(reader.header()).unwrap();
         CameDecoder::new(reader, params, ModelledUnits).unwrap()
+    }
+
+    #[test]
+    fn every_decoded_cone_holds_the_normal_of_every_face_at_its_subtree() {
+        let mut mesh = generate::icosphere(3);
+        let far = generate::torus(1.0, 0.3, 30, 12);
+        mesh.append(&far, glam::DVec3::new(3.0, 0.5, 0.0), 1.0);
+        let (canonical, bytes) = stream(&mesh);
+        let mut d = decoder(&bytes);
+        while d.advance().unwrap() {}
+        let tree = d.tree();
+        let leaf_at: std::collections::HashMap<[u32; 3], NodeId> = tree
+            .nodes
+            .iter()
+            .filter(|n| n.leaf)
+            .map(|n| (n.position.map(|x| x as u32), n.id))
+            .collect();
+        let cell = glam::DVec3::from_array(canonical.grid.cell);
+        let (mut checked, mut with_cone) = (0, 0);
+        for face in &canonical.faces {
+            let p = face.map(|v| glam::DVec3::from_array(canonical.cells[v as usize].map(f64::from)) * cell);
+            let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+            for &v in face {
+                let leaf = leaf_at[&canonical.cells[v as usize]];
+                for len in 0..leaf.len() {
+                    let a = &tree.nodes[tree.get(leaf.ancestor(len)).unwrap() as usize];
+                    let cone = a.cone.decoded();
+                    checked += 1;
+                    if !cone.is_some() {
+                        continue;
+                    }
+                    with_cone += 1;
+                    let axis = glam::DVec3::from_array(cone.axis.map(f64::from));
+                    let off = normal.cross(axis).length().atan2(normal.dot(axis));
+                    assert!(off <= cone.half_angle as f64 + 1e-5, "{:?}", a.id);
+                }
+            }
+        }
+        assert!(with_cone > checked / 4, "{with_cone} of {checked} with a cone");
     }
 
     #[test]

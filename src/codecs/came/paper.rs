@@ -22,6 +22,7 @@ use crate::coding::huffman::{get_gamma, Huffman, LENGTH_FIELD_BITS};
 use crate::coding::{BitSink, BitSource, SyntaxClass};
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
+use crate::hierarchy::came::cones::CodedCone;
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
 use crate::hierarchy::came::{NodeId, VertexTree, MAX_DEPTH};
 use crate::mesh::quantize::GridShape;
@@ -197,6 +198,7 @@ impl Codec for CamePaper {
             tails: Tails::Split,
             component_bits: self.component_bits,
             radius_bits: RADIUS_BITS,
+            cone_bits: 0,
         };
         let bits = self.component_bits;
         encode_stream(mesh, layout, |tree, part| {
@@ -250,7 +252,15 @@ impl Codec for CamePaper {
 
 /// A `came-paper` stream's parameters, checked.
 pub fn params(header: &Header) -> Result<Params> {
-    Params::from_bytes(&header.params, 1..=16)
+    let params = Params::from_bytes(&header.params, 1..=16)?;
+    if params.cone_bits != 0 {
+        return Err(Error::malformed(
+            0,
+            0,
+            "came-paper streams code no normal cones",
+        ));
+    }
+    Ok(params)
 }
 
 /// The field each table's symbols are booked in.
@@ -551,7 +561,11 @@ impl UnitDecoder for PaperUnits {
                 *x = r.bits(header.grid.bits as u32)? as f64;
             }
             let radius = get_gamma(&mut r.source).ok_or_else(|| cut_at(at))? - 1;
-            tree.add_root(clamp_to_grid(DVec3::from_array(p), cells), radius as f64);
+            tree.add_root(
+                clamp_to_grid(DVec3::from_array(p), cells),
+                radius as f64,
+                CodedCone::NONE,
+            );
         }
         let bits = params.component_bits;
         let frame = Frame::read(&mut r.source, bits)
@@ -588,7 +602,7 @@ impl UnitDecoder for PaperUnits {
                     radii[side] = decoded_radius(code, base, params.radius_bits);
                 }
             }
-            let children = tree.split(s, leaf, positions, radii, unit, at)?;
+            let children = tree.split(s, leaf, positions, radii, [CodedCone::NONE; 2], unit, at)?;
             for side in 0..2 {
                 if leaf[side] {
                     continue;

@@ -24,6 +24,7 @@ mod build;
 mod grid;
 pub mod node_id;
 mod regions;
+pub mod cones;
 pub mod spheres;
 
 pub use build::{build, BuildOptions};

@@ -32,6 +32,7 @@
 use super::loader::{ByteSource, Dependency, Fetch, Loaded, Loader, SeekSource, UnitDelta, NONE};
 use super::view::View;
 use crate::error::{Error, Result};
+use crate::hierarchy::came::cones::NormalCone;
 use crate::hierarchy::came::NodeId;
 use crate::mesh::TriMesh;
 use glam::DVec3;
@@ -163,6 +164,8 @@ pub struct ViewMesh {
     /// Position and error-sphere radius, in world units.
     /// (One array: the view test of every active node, every pass, reads both.)
     spheres: Vec<(DVec3, f64)>,
+    /// Normal cone, for back-face culling.
+    cones: Vec<NormalCone>,
     state: Vec<State>,
     /// Triangles born at the node's split.
     born: Vec<SmallVec<[u32; 2]>>,
@@ -221,6 +224,7 @@ impl ViewMesh {
             children: Vec::new(),
             opens: Vec::new(),
             spheres: Vec::new(),
+            cones: Vec::new(),
             state: Vec::new(),
             born: Vec::new(),
             depends_on: Vec::new(),
@@ -337,6 +341,7 @@ impl ViewMesh {
             self.children.push([NONE; 2]);
             self.opens.push(NONE);
             self.spheres.push((n.center, n.radius));
+            self.cones.push(n.cone);
             self.state.push(State::Below);
             self.born.push(SmallVec::new());
             self.depends_on.push(SmallVec::new());
@@ -688,7 +693,7 @@ impl ViewMesh {
 
     fn wants(&self, view: &View, v: u32) -> bool {
         let (center, radius) = self.spheres[v as usize];
-        view.wants_split(center, radius, self.scale)
+        view.wants_split(center, radius, &self.cones[v as usize], self.scale)
     }
 
     fn adapt_passes(
@@ -1123,6 +1128,38 @@ mod tests {
             "{} vs {near}",
             vm.face_count()
         );
+    }
+
+    #[test]
+    fn back_faces_stay_coarse_unless_the_view_is_two_sided() {
+        let view = View::new(&camera(DVec3::new(0.5, 0.8, 4.0)), 0.5).unwrap();
+        let mut one = ViewMesh::from_stream(stream()).unwrap();
+        one.settle(&view, Budget::UNLIMITED, 64);
+        one.check_invariants().unwrap();
+        let mut two = ViewMesh::from_stream(stream()).unwrap();
+        two.settle(&view.clone().two_sided(true), Budget::UNLIMITED, 64);
+        two.check_invariants().unwrap();
+        assert!(
+            (one.face_count() as f64) < 0.9 * two.face_count() as f64,
+            "{} faces one-sided, {} two-sided",
+            one.face_count(),
+            two.face_count()
+        );
+        // Nodes the two-sided front splits stay on the one-sided front because they face away.
+        let faces_away = |v: u32| {
+            let (c, r) = one.spheres[v as usize];
+            view.faces_away(c, r, &one.cones[v as usize])
+        };
+        let split_in_two: std::collections::HashSet<NodeId> = (0..two.ids.len())
+            .filter(|&v| two.state[v] == State::Split)
+            .map(|v| two.ids[v])
+            .collect();
+        let culled = one
+            .active
+            .iter()
+            .filter(|&&v| split_in_two.contains(&one.ids[v as usize]) && faces_away(v))
+            .count();
+        assert!(culled > 0);
     }
 
     #[test]

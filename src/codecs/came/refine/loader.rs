@@ -10,6 +10,7 @@ use crate::codecs::came::decoded::{to_world, CameDecoder, DecodedTree, DecodedUn
 use crate::codecs::came::{modelled, paper};
 use crate::container::{read_header_and_index, Header, Index};
 use crate::error::{Error, Result};
+use crate::hierarchy::came::cones::NormalCone;
 use crate::hierarchy::came::NodeId;
 use glam::DVec3;
 use smallvec::SmallVec;
@@ -76,6 +77,8 @@ pub(super) struct NewNode {
     /// Position and error-sphere radius in world units.
     pub center: DVec3,
     pub radius: f64,
+    /// Normal cone ([`NormalCone::NONE`] where the stream has none).
+    pub cone: NormalCone,
 }
 
 /// A split's dependency: the node, once it is decoded (`NONE` before).
@@ -139,6 +142,7 @@ fn delta(decoded: &DecodedUnit, header: &Header) -> Result<UnitDelta> {
             parent,
             center: to_world(&header.grid, n.position),
             radius: n.radius * cell,
+            cone: n.cone.decoded(),
         });
     }
     for t in &tree.triangles[since.triangles..] {

@@ -18,8 +18,13 @@
 //!   r_v·√(1 + t²) ≥ κ·z, z the sphere's least depth and t its largest tangent off the axis
 //!   ([`View::wants_split`]) — Hoppe's r_v ≥ κ·|v − e|, made an upper bound.
 //!
-//! No normal cones are stored (the streams carry none), so there is no back-face culling: a
-//! node facing away is refined like one facing the eye.
+//! - n̂_v, α_v: the node's normal cone (axis, half-angle), holding the normal of every face with
+//!   a corner under v; `came` streams code one per inner node (docs/FORMAT.md §8.2, about 2
+//!   bits a triangle). Back-face culling: a node is not refined while every point of its sphere
+//!   sees every normal of its cone from behind ([`View::faces_away`]), Hoppe's test made to
+//!   hold over the sphere. The surface is then drawn one-sided; [`View::two_sided`] turns it
+//!   off. `came-paper` streams and `came` streams written before cones have none: every node
+//!   is refined as if it faced the eye.
 
 mod front;
 mod loader;

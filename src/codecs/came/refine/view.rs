@@ -1,7 +1,12 @@
 //! The view a front is adapted to: the eye, the frustum's side and near planes, and κ.
 
 use crate::error::{Error, Result};
+use crate::hierarchy::came::cones::NormalCone;
 use glam::DVec3;
+
+/// Radians added to a cone before it is judged to face away: more than its 32-bit axis and
+/// angle can be off.
+const CONE_MARGIN: f64 = 1e-4;
 
 /// A pinhole camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -26,6 +31,11 @@ pub struct View {
     planes: Vec<DVec3>,
     /// κ = 2·τ·tan(φ/2) / H: a sphere of radius r at distance d spans about τ·r / (κ·d) pixels.
     kappa: f64,
+    /// τ, in pixels.
+    tolerance: f64,
+    /// Whether nodes all of whose faces turn away from the eye are left unrefined (the
+    /// surface is drawn one-sided).
+    cull_back_faces: bool,
 }
 
 impl View {
@@ -61,7 +71,40 @@ impl View {
             forward,
             planes,
             kappa: 2.0 * tolerance * tan_y / camera.height as f64,
+            tolerance,
+            cull_back_faces: true,
         })
+    }
+
+    /// The same view with back faces refined like front faces (`true`: for a surface drawn
+    /// two-sided, or seen from inside) or not (`false`, the default).
+    pub fn two_sided(self, two_sided: bool) -> View {
+        View {
+            cull_back_faces: !two_sided,
+            ..self
+        }
+    }
+
+    /// Whether every face a node with this sphere and normal cone stands for turns away from
+    /// the eye (Hoppe 1997 §4.2, made to hold over the whole sphere): with w the direction
+    /// from the eye to the centre, θ its angle to the cone's axis, α the cone's half-angle and
+    /// β = asin(r / |w|) the sphere's angular radius, every point p of the sphere and normal n
+    /// of the cone have ∠(p − e, n) ≤ β + θ + α, so the node faces away when that is under 90°.
+    /// A sphere holding the eye never does.
+    pub fn faces_away(&self, center: DVec3, radius: f64, cone: &NormalCone) -> bool {
+        if !self.cull_back_faces || !cone.is_some() {
+            return false;
+        }
+        let w = center - self.eye;
+        let distance = w.length();
+        if !(distance > radius) {
+            return false;
+        }
+        let axis = DVec3::new(cone.axis[0] as f64, cone.axis[1] as f64, cone.axis[2] as f64);
+        let theta = w.cross(axis).length().atan2(w.dot(axis));
+        let beta = (radius / distance).asin();
+        // The margin covers the cone's axis and angle rounded to 32-bit floats.
+        theta + beta + cone.half_angle as f64 + CONE_MARGIN < std::f64::consts::FRAC_PI_2
     }
 
     /// A view that wants every node refined (no frustum, no tolerance): the full mesh.
@@ -71,6 +114,8 @@ impl View {
             forward: DVec3::ZERO,
             planes: Vec::new(),
             kappa: 0.0,
+            tolerance: 0.0,
+            cull_back_faces: false,
         }
     }
 
@@ -81,6 +126,8 @@ impl View {
             forward: DVec3::ZERO,
             planes: Vec::new(),
             kappa: f64::INFINITY,
+            tolerance: f64::INFINITY,
+            cull_back_faces: false,
         }
     }
 
@@ -94,14 +141,25 @@ impl View {
         self.kappa
     }
 
+    /// τ, in pixels.
+    pub fn tolerance(&self) -> f64 {
+        self.tolerance
+    }
+
+    /// Whether back faces are refined like front faces ([`View::two_sided`]).
+    pub fn is_two_sided(&self) -> bool {
+        !self.cull_back_faces
+    }
+
     /// Whether a sphere at `center` of `radius` meets the frustum.
     pub fn sees(&self, center: DVec3, radius: f64) -> bool {
         let d = center - self.eye;
         self.planes.iter().all(|n| d.dot(*n) >= -radius)
     }
 
-    /// Whether a node with this error sphere is to be refined, κ scaled by `scale` (the face
-    /// budget's regulation): visible and spanning the tolerance or more.
+    /// Whether a node with this error sphere and normal cone is to be refined, κ scaled by
+    /// `scale` (the face budget's regulation): in the frustum, not facing away
+    /// ([`View::faces_away`]) and spanning the tolerance or more.
     ///
     /// "Spanning" is bounded from above, so that no vertex of the node's subtree lands τ
     /// pixels or more from the node on the screen while the node stands for it: over the
@@ -109,7 +167,11 @@ impl View {
     /// the least depth and t the largest tangent off the axis, so the node is refined while
     /// r·√(1 + t²) ≥ κ·z_min (z_min = depth of the centre − r; t = (lateral distance + r) /
     /// z_min). A sphere reaching the eye's plane is always refined.
-    pub fn wants_split(&self, center: DVec3, radius: f64, scale: f64) -> bool {
+    pub fn wants_split(&self, center: DVec3, radius: f64, cone: &NormalCone, scale: f64) -> bool {
+        self.spans_tolerance(center, radius, scale) && !self.faces_away(center, radius, cone)
+    }
+
+    fn spans_tolerance(&self, center: DVec3, radius: f64, scale: f64) -> bool {
         let k = self.kappa * scale;
         if radius <= 0.0 || !k.is_finite() || !self.sees(center, radius) {
             return false;
@@ -132,6 +194,8 @@ impl View {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    const NONE: NormalCone = NormalCone::NONE;
 
     fn camera() -> Camera {
         Camera {
@@ -162,17 +226,46 @@ mod tests {
         let v = View::new(&camera(), 2.0).unwrap();
         // At distance 10 a pixel is 2·tan 30°·10 / 600 ≈ 0.0192 units.
         let pixel = 2.0 * (30f64).to_radians().tan() * 10.0 / 600.0;
-        assert!(v.wants_split(DVec3::ZERO, 2.1 * pixel, 1.0));
-        assert!(!v.wants_split(DVec3::ZERO, 1.9 * pixel, 1.0));
-        assert!(!v.wants_split(DVec3::ZERO, 2.1 * pixel, 1.2));
-        assert!(!v.wants_split(DVec3::new(0.0, 0.0, 30.0), 10.0, 1.0));
+        assert!(v.wants_split(DVec3::ZERO, 2.1 * pixel, &NONE, 1.0));
+        assert!(!v.wants_split(DVec3::ZERO, 1.9 * pixel, &NONE, 1.0));
+        assert!(!v.wants_split(DVec3::ZERO, 2.1 * pixel, &NONE, 1.2));
+        assert!(!v.wants_split(DVec3::new(0.0, 0.0, 30.0), 10.0, &NONE, 1.0));
         // Off the axis a sphere's subtree can spread further on the screen: at the edge of
         // the view (tangent ≈ 0.5 here) 1.9 pixels' radius is refined.
-        assert!(v.wants_split(DVec3::new(5.0, 0.0, 0.0), 1.9 * pixel, 1.0));
+        assert!(v.wants_split(DVec3::new(5.0, 0.0, 0.0), 1.9 * pixel, &NONE, 1.0));
         // A sphere reaching the eye's plane is.
-        assert!(v.wants_split(DVec3::new(0.0, 0.5, 9.5), 0.6, 1.0));
-        assert!(View::everything().wants_split(DVec3::ZERO, 1e-9, 1.0));
-        assert!(!View::nothing().wants_split(DVec3::ZERO, 1e9, 1.0));
+        assert!(v.wants_split(DVec3::new(0.0, 0.5, 9.5), 0.6, &NONE, 1.0));
+        assert!(View::everything().wants_split(DVec3::ZERO, 1e-9, &NONE, 1.0));
+        assert!(!View::nothing().wants_split(DVec3::ZERO, 1e9, &NONE, 1.0));
+    }
+
+    #[test]
+    fn a_node_facing_away_is_not_refined_unless_two_sided() {
+        // The eye at +z 10 looks down -z; a sphere at the origin.
+        let v = View::new(&camera(), 1.0).unwrap();
+        let cone = |axis: [f32; 3], degrees: f32| NormalCone {
+            axis,
+            half_angle: degrees.to_radians(),
+        };
+        let big = 0.5;
+        // Normals along -z face away (the eye sees their backs); along +z they face the eye.
+        assert!(v.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0)));
+        assert!(!v.wants_split(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0), 1.0));
+        assert!(!v.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, 1.0], 30.0)));
+        assert!(v.wants_split(DVec3::ZERO, big, &cone([0.0, 0.0, 1.0], 30.0), 1.0));
+        // Sideways: a face seen edge-on is not culled; nor is a cone reaching past 90°.
+        assert!(!v.faces_away(DVec3::ZERO, big, &cone([1.0, 0.0, 0.0], 5.0)));
+        assert!(!v.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 88.0)));
+        // The sphere's width counts: a cone of 60° facing away is culled when the sphere is
+        // small, not when it spans 30° seen from the eye (sin 30° · 10 = 5).
+        assert!(v.faces_away(DVec3::ZERO, 0.1, &cone([0.0, 0.0, -1.0], 60.0)));
+        assert!(!v.faces_away(DVec3::ZERO, 5.0, &cone([0.0, 0.0, -1.0], 60.0)));
+        // A sphere holding the eye, no cone, or a two-sided view: never.
+        assert!(!v.faces_away(DVec3::ZERO, 11.0, &cone([0.0, 0.0, -1.0], 1.0)));
+        assert!(!v.faces_away(DVec3::ZERO, big, &NONE));
+        let two = v.clone().two_sided(true);
+        assert!(!two.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0)));
+        assert!(two.wants_split(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0), 1.0));
     }
 
     #[test]
