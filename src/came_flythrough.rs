@@ -53,8 +53,10 @@ pub struct Frame {
     /// Faces and vertices of the adapted mesh.
     pub faces: usize,
     pub vertices: usize,
-    /// Faces of the two-sided front (no back-face culling) in the same view.
+    /// Faces of the two-sided front (no back-face culling) in the same view, and its
+    /// adaptation time (meta-node waits included).
     pub faces_two_sided: usize,
+    pub settle_ms_two_sided: f64,
     pub splits: usize,
     pub collapses: usize,
     /// Passes over the active nodes, and adaptations (one more after each wait for meta-nodes).
@@ -401,7 +403,9 @@ fn fly(
         }
         operations += splits + collapses;
         adapting += adapt_s;
+        let started = Instant::now();
         two_sided.settle(&view.clone().two_sided(true), Budget::UNLIMITED, 256);
+        let settle_ms_two_sided = started.elapsed().as_secs_f64() * 1e3;
         facing_the_eye(full, camera.eye, view.is_two_sided(), &mut facing);
         let (max_error_px, mean_error_px, visible_vertices) =
             measured_error(&front, leaves, &facing, &camera, &view)?;
@@ -413,6 +417,7 @@ fn fly(
             faces: front.face_count(),
             vertices: front.vertex_count(),
             faces_two_sided: two_sided.face_count(),
+            settle_ms_two_sided,
             splits,
             collapses,
             passes,

@@ -19,8 +19,8 @@ use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self, coded_cones, CodedCone, ANGLE_BITS, NO_CONE};
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
-use crate::mesh::attribute_quantization::octahedral_max;
 use crate::hierarchy::came::{NodeId, VertexTree};
+use crate::mesh::attribute_quantization::octahedral_max;
 use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
 
@@ -125,7 +125,7 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 const CONE_CLASSES: usize = 1 + NO_CONE as usize;
 
 fn cone_class(parent: CodedCone) -> usize {
-    if parent.angle < NO_CONE {
+    if (parent.angle as u32) < NO_CONE {
         1 + parent.angle as usize
     } else {
         0
@@ -137,8 +137,15 @@ fn cone_class(parent: CodedCone) -> usize {
 fn put_cone(enc: &mut ArithEncoder, ctx: &mut Contexts, parent: CodedCone, cone: CodedCone) {
     let class = cone_class(parent);
     let g = SyntaxClass::Geometry;
-    put_symbol(enc, &mut ctx.cone_angle[class], cone.angle, ANGLE_BITS, g, "cones");
-    if cone.angle < NO_CONE && class == 0 {
+    put_symbol(
+        enc,
+        &mut ctx.cone_angle[class],
+        cone.angle.into(),
+        ANGLE_BITS,
+        g,
+        "cones",
+    );
+    if (cone.angle as u32) < NO_CONE && class == 0 {
         let centre = octahedral_max(cones::AXIS_BITS) / 2;
         for k in 0..2 {
             let d = cone.axis[k] as i64 - centre as i64;
@@ -581,6 +588,7 @@ impl UnitReader<'_> {
         if angle >= NO_CONE {
             return Ok(CodedCone::NONE);
         }
+        let angle = angle as u8;
         if class > 0 {
             return Ok(CodedCone {
                 axis: parent.axis,
@@ -594,9 +602,9 @@ impl UnitReader<'_> {
                 .dec
                 .int(&mut self.ctx.cone_axis[k])
                 .ok_or_else(|| cut_at(self.at))?;
-            *a = u32::try_from(centre as i64 + d)
+            *a = u8::try_from(centre as i64 + d)
                 .ok()
-                .filter(|&a| a <= octahedral_max(cones::AXIS_BITS))
+                .filter(|&a| u32::from(a) <= octahedral_max(cones::AXIS_BITS))
                 .ok_or_else(|| {
                     Error::malformed(0, self.at, "a normal cone's axis leaves its square")
                 })?;
@@ -962,7 +970,9 @@ mod tests {
         let cell = glam::DVec3::from_array(canonical.grid.cell);
         let (mut checked, mut with_cone) = (0, 0);
         for face in &canonical.faces {
-            let p = face.map(|v| glam::DVec3::from_array(canonical.cells[v as usize].map(f64::from)) * cell);
+            let p = face.map(|v| {
+                glam::DVec3::from_array(canonical.cells[v as usize].map(f64::from)) * cell
+            });
             let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
             for &v in face {
                 let leaf = leaf_at[&canonical.cells[v as usize]];
@@ -980,7 +990,10 @@ mod tests {
                 }
             }
         }
-        assert!(with_cone > checked / 4, "{with_cone} of {checked} with a cone");
+        assert!(
+            with_cone > checked / 4,
+            "{with_cone} of {checked} with a cone"
+        );
     }
 
     #[test]

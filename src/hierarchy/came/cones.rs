@@ -20,6 +20,7 @@ use std::f64::consts::FRAC_PI_2;
 pub const AXIS_BITS: u8 = 6;
 /// Half-angle codes 0 … NO_CONE − 1 stand for (code + 1) · [`ANGLE_STEP`]; `NO_CONE` for none.
 pub const NO_CONE: u32 = 31;
+const _: () = assert!(AXIS_BITS <= 8);
 /// Bits of a half-angle code.
 pub const ANGLE_BITS: u8 = 5;
 /// The half-angle's step: 90° / 32.
@@ -27,30 +28,31 @@ pub const ANGLE_STEP: f64 = FRAC_PI_2 / 32.0;
 
 /// Nodes whose (decoded) error sphere is smaller, in grid cells, have no cone and code none.
 
-/// A cone as a stream codes it: its octahedral axis and its half-angle code.
+/// A cone as a stream codes it: its octahedral axis and its half-angle code (three bytes, so
+/// that the decoder's node records hardly grow).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CodedCone {
-    pub axis: [u32; 2],
+    pub axis: [u8; 2],
     /// Half-angle code; [`NO_CONE`]: no cone (the axis is then not coded).
-    pub angle: u32,
+    pub angle: u8,
 }
 
 impl CodedCone {
     pub const NONE: CodedCone = CodedCone {
         axis: [0, 0],
-        angle: NO_CONE,
+        angle: NO_CONE as u8,
     };
 
     /// The cone it stands for.
     pub fn decoded(self) -> NormalCone {
-        if self.angle >= NO_CONE {
+        if self.angle as u32 >= NO_CONE {
             return NormalCone::NONE;
         }
-        let a = octahedral_normal(self.axis, AXIS_BITS);
-        NormalCone {
-            axis: [a.x as f32, a.y as f32, a.z as f32],
-            half_angle: ((self.angle + 1) as f64 * ANGLE_STEP) as f32,
-        }
+        let a = octahedral_normal(self.axis.map(u32::from), AXIS_BITS);
+        NormalCone::new(
+            [a.x as f32, a.y as f32, a.z as f32],
+            (self.angle as f64 + 1.0) * ANGLE_STEP,
+        )
     }
 }
 
@@ -60,14 +62,35 @@ pub struct NormalCone {
     pub axis: [f32; 3],
     /// Radians; [`NormalCone::NONE`]'s is π (any direction).
     pub half_angle: f32,
+    /// Sine and cosine of the half-angle widened by [`CONE_MARGIN`], for tests without
+    /// inverse trigonometry.
+    pub sin: f32,
+    pub cos: f32,
 }
+
+/// Radians a cone is widened by in [`NormalCone::sin`] and `cos`: more than its 32-bit axis
+/// and angle can be off.
+pub const CONE_MARGIN: f64 = 1e-4;
 
 impl NormalCone {
     /// No cone: any direction.
     pub const NONE: NormalCone = NormalCone {
         axis: [0.0, 0.0, 1.0],
         half_angle: std::f32::consts::PI,
+        sin: 0.0,
+        cos: -1.0,
     };
+
+    /// The cone of half-angle `half_angle` (radians) about the unit vector `axis`.
+    pub fn new(axis: [f32; 3], half_angle: f64) -> NormalCone {
+        let widened = (half_angle + CONE_MARGIN).min(std::f64::consts::PI);
+        NormalCone {
+            axis,
+            half_angle: half_angle as f32,
+            sin: widened.sin() as f32,
+            cos: widened.cos() as f32,
+        }
+    }
 
     /// Whether it can cull anything (its half-angle is below 90°).
     pub fn is_some(&self) -> bool {
@@ -166,12 +189,12 @@ pub fn coded_cones(
     }
     let mut coded = vec![CodedCone::NONE; tree.node_count()];
     // The cone about `axis` holding `cone`, rounded up.
-    let code = |cone: &Cone, axis: [u32; 2]| -> CodedCone {
+    let code = |cone: &Cone, axis: [u8; 2]| -> CodedCone {
         if cone.is_empty() {
             // No face with an area: anything culls it; the narrowest cone says so.
             return CodedCone { axis, angle: 0 };
         }
-        let about = octahedral_normal(axis, AXIS_BITS);
+        let about = octahedral_normal(axis.map(u32::from), AXIS_BITS);
         let needed = angle(cone.axis, about) + cone.half_angle;
         let steps = (needed / ANGLE_STEP).ceil().max(1.0);
         if steps >= NO_CONE as f64 + 1.0 {
@@ -185,15 +208,15 @@ pub fn coded_cones(
         if angle >= NO_CONE {
             return CodedCone::NONE;
         }
-        CodedCone { axis, angle }
+        CodedCone {
+            axis,
+            angle: angle as u8,
+        }
     };
     let own = |cone: &Cone| {
-        let axis = if cone.is_empty() {
-            DVec3::Z
-        } else {
-            cone.axis
-        };
-        code(cone, octahedral_code(axis, AXIS_BITS))
+        let axis = if cone.is_empty() { DVec3::Z } else { cone.axis };
+        // Codes of 6 bits fit a byte.
+        code(cone, octahedral_code(axis, AXIS_BITS).map(|c| c as u8))
     };
     if tree.node_count() == 0 {
         return coded;
@@ -206,7 +229,7 @@ pub fn coded_cones(
                 continue;
             }
             let cone = &exact[c as usize];
-            coded[c as usize] = if parent.angle < NO_CONE {
+            coded[c as usize] = if (parent.angle as u32) < NO_CONE {
                 code(cone, parent.axis)
             } else {
                 own(cone)
@@ -257,7 +280,12 @@ mod tests {
         )
         .unwrap();
         let tree = build(&canonical.cells, &canonical.faces, &BuildOptions::default()).unwrap();
-        let cones = coded_cones(&tree, &canonical.cells, &canonical.faces, canonical.grid.cell);
+        let cones = coded_cones(
+            &tree,
+            &canonical.cells,
+            &canonical.faces,
+            canonical.grid.cell,
+        );
         let scale = DVec3::from_array(canonical.grid.cell);
         let mut some = 0;
         for (x, coded) in cones.iter().enumerate() {
@@ -269,10 +297,14 @@ mod tests {
             let axis = DVec3::from_array(cone.axis.map(|a| a as f64));
             let id = tree.ids[x];
             for face in &canonical.faces {
-                if !face.iter().any(|&v| id.is_ancestor_of(tree.ids[v as usize])) {
+                if !face
+                    .iter()
+                    .any(|&v| id.is_ancestor_of(tree.ids[v as usize]))
+                {
                     continue;
                 }
-                let p = face.map(|v| DVec3::from_array(canonical.cells[v as usize].map(f64::from)) * scale);
+                let p = face
+                    .map(|v| DVec3::from_array(canonical.cells[v as usize].map(f64::from)) * scale);
                 let n = (p[1] - p[0]).cross(p[2] - p[0]);
                 if n.length() == 0.0 {
                     continue;

@@ -21,10 +21,10 @@
 //! there; `came-paper` at the quadric optimum).
 
 mod build;
+pub mod cones;
 mod grid;
 pub mod node_id;
 mod regions;
-pub mod cones;
 pub mod spheres;
 
 pub use build::{build, BuildOptions};

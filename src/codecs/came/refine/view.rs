@@ -4,10 +4,6 @@ use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::NormalCone;
 use glam::DVec3;
 
-/// Radians added to a cone before it is judged to face away: more than its 32-bit axis and
-/// angle can be off.
-const CONE_MARGIN: f64 = 1e-4;
-
 /// A pinhole camera.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -95,16 +91,24 @@ impl View {
         if !self.cull_back_faces || !cone.is_some() {
             return false;
         }
+        // In cosines: θ < 90° − (α + β) ⇔ cos θ > sin(α + β) while α + β < 90°; with
+        // d = |w|, d·sin β = r and d·cos β = √(d² − r²) (α widened by the cone's margin).
         let w = center - self.eye;
-        let distance = w.length();
-        if !(distance > radius) {
+        let tangent_sq = w.length_squared() - radius * radius;
+        if !(tangent_sq > 0.0) {
             return false;
         }
-        let axis = DVec3::new(cone.axis[0] as f64, cone.axis[1] as f64, cone.axis[2] as f64);
-        let theta = w.cross(axis).length().atan2(w.dot(axis));
-        let beta = (radius / distance).asin();
-        // The margin covers the cone's axis and angle rounded to 32-bit floats.
-        theta + beta + cone.half_angle as f64 + CONE_MARGIN < std::f64::consts::FRAC_PI_2
+        let tangent = tangent_sq.sqrt();
+        let (sin, cos) = (cone.sin as f64, cone.cos as f64);
+        if cos * tangent <= sin * radius {
+            return false;
+        }
+        let axis = DVec3::new(
+            cone.axis[0] as f64,
+            cone.axis[1] as f64,
+            cone.axis[2] as f64,
+        );
+        w.dot(axis) > sin * tangent + cos * radius
     }
 
     /// A view that wants every node refined (no frustum, no tolerance): the full mesh.
@@ -243,10 +247,7 @@ mod tests {
     fn a_node_facing_away_is_not_refined_unless_two_sided() {
         // The eye at +z 10 looks down -z; a sphere at the origin.
         let v = View::new(&camera(), 1.0).unwrap();
-        let cone = |axis: [f32; 3], degrees: f32| NormalCone {
-            axis,
-            half_angle: degrees.to_radians(),
-        };
+        let cone = |axis: [f32; 3], degrees: f64| NormalCone::new(axis, degrees.to_radians());
         let big = 0.5;
         // Normals along -z face away (the eye sees their backs); along +z they face the eye.
         assert!(v.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0)));
@@ -266,6 +267,65 @@ mod tests {
         let two = v.clone().two_sided(true);
         assert!(!two.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0)));
         assert!(two.wants_split(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0), 1.0));
+    }
+
+    #[test]
+    fn facing_away_holds_for_every_point_of_the_sphere_and_normal_of_the_cone() {
+        let v = View::new(&camera(), 1.0).unwrap();
+        let state = std::cell::Cell::new(0x9e37_79b9_7f4a_7c15u64);
+        let next = || {
+            let mut x = state.get();
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            state.set(x);
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let unit = || {
+            let z: f64 = 2.0 * next() - 1.0;
+            let t = std::f64::consts::TAU * next();
+            let s = (1.0 - z * z).sqrt();
+            DVec3::new(s * t.cos(), s * t.sin(), z)
+        };
+        let (mut culled, mut agreed) = (0, 0);
+        for _ in 0..4000 {
+            let center = unit() * 8.0 * next();
+            let radius = 3.0 * next();
+            let axis = unit();
+            let alpha = 1.6 * next();
+            let cone = NormalCone::new(axis.as_vec3().to_array(), alpha);
+            let away = v.faces_away(center, radius, &cone);
+            // The angle form of the test, away from its boundary.
+            let w = center - v.eye();
+            let d = w.length();
+            if d > radius {
+                let theta = w.cross(axis).length().atan2(w.dot(axis));
+                let sum = theta + alpha + (radius / d).asin();
+                if sum < std::f64::consts::FRAC_PI_2 - 1e-3 {
+                    assert!(away, "θ + α + β = {sum}");
+                    agreed += 1;
+                } else if sum > std::f64::consts::FRAC_PI_2 + 1e-3 {
+                    assert!(!away, "θ + α + β = {sum}");
+                }
+            }
+            if !away {
+                continue;
+            }
+            culled += 1;
+            // Points of the sphere and normals at the cone's rim see each other from behind.
+            let side = axis.any_orthonormal_vector();
+            for k in 0..16 {
+                let turn = std::f64::consts::TAU * k as f64 / 16.0;
+                let rim = (side * turn.cos() + axis.cross(side) * turn.sin()) * alpha.sin();
+                let normal = axis * alpha.cos() + rim;
+                let p = center + unit() * radius;
+                assert!((p - v.eye()).dot(normal) > 0.0);
+            }
+        }
+        assert!(
+            culled > 100 && agreed > 100,
+            "{culled} culled, {agreed} agreed"
+        );
     }
 
     #[test]
