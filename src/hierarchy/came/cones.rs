@@ -26,8 +26,6 @@ pub const ANGLE_BITS: u8 = 5;
 /// The half-angle's step: 90° / 32.
 pub const ANGLE_STEP: f64 = FRAC_PI_2 / 32.0;
 
-/// Nodes whose (decoded) error sphere is smaller, in grid cells, have no cone and code none.
-
 /// A cone as a stream codes it: its octahedral axis and its half-angle code (three bytes, so
 /// that the decoder's node records hardly grow).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

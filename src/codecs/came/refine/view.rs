@@ -95,7 +95,8 @@ impl View {
         // d = |w|, d·sin β = r and d·cos β = √(d² − r²) (α widened by the cone's margin).
         let w = center - self.eye;
         let tangent_sq = w.length_squared() - radius * radius;
-        if !(tangent_sq > 0.0) {
+        // Not positive, or NaN: the sphere holds the eye.
+        if tangent_sq.is_nan() || tangent_sq <= 0.0 {
             return false;
         }
         let tangent = tangent_sq.sqrt();
