@@ -442,6 +442,16 @@ fn view(
         done.collapses,
         seconds * 1e3
     );
+    meshcodec::outln!(
+        "back faces: {}",
+        if two_sided {
+            "refined like front faces (--two-sided)"
+        } else if front.has_normal_cones() {
+            "left coarse where a node's normal cone turns every face away"
+        } else {
+            "refined like front faces (the stream codes no normal cones)"
+        }
+    );
     let fetched = front.fetched();
     meshcodec::outln!(
         "read {} of {} bytes ({:.1}%), {} of {} meta-nodes",

@@ -306,6 +306,12 @@ impl ViewMesh {
         }
     }
 
+    /// Whether a node loaded so far has a normal cone (a `came` stream with cones), so that
+    /// back faces can be culled.
+    pub fn has_normal_cones(&self) -> bool {
+        self.cones.iter().any(|c| c.is_some())
+    }
+
     /// The meta-nodes refused, and why.
     pub fn refusals(&self) -> &[(usize, String)] {
         &self.refusals
