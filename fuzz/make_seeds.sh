@@ -187,4 +187,11 @@ for codec in came came_paper; do
   mkdir -p $seeds/decode_${codec}_unit
   cp $seeds/decode_$codec/*.body $seeds/decode_${codec}_unit/
 done
+# View-dependent refinement over came streams with normal cones: 16 bytes of views (eyes on
+# three sides of the torus, tolerances, budgets), then the stream's body.
+mkdir -p $seeds/adapt_came
+for body in $seeds/decode_came/*.body; do
+  { printf '\xa0\x80\x80\x41\x80\xa0\x90\x22\x60\x80\x70\x83\x80\x80\x40\x10'; cat "$body"; } \
+    > "$seeds/adapt_came/$(basename "$body")"
+done
 rm -f "$stream"
