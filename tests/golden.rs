@@ -133,6 +133,43 @@ fn encoders_reproduce_the_golden_streams_and_these_decode_exactly() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// `came` streams written before normal cones (4 bytes of parameters) still decode exactly, and
+/// refine view-dependently without culling: `came-eight-before-cones.mc` is the golden stream of
+/// that build, kept.
+#[test]
+fn came_streams_without_normal_cones_still_decode_and_refine() {
+    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    let old = std::fs::read(golden_dir().join("came-eight-before-cones.mc")).unwrap();
+    let codec = codecs::by_name("came").unwrap();
+    let [(_, eight)] = read_all(["eight"]);
+    let canonical = canonical(codec, &eight);
+    let (decoded, _) = codecs::decode(&old, Stop::All).unwrap();
+    canonical.check_lossless(&decoded.mesh).unwrap();
+    let new = codec.encode(&canonical).unwrap().bytes;
+    let camera = Camera {
+        eye: glam::DVec3::new(0.0, 0.0, 3.0),
+        target: glam::DVec3::ZERO,
+        up: glam::DVec3::Y,
+        fov_degrees: 40.0,
+        width: 640,
+        height: 480,
+    };
+    let view = View::new(&camera, 0.5).unwrap();
+    let faces = |bytes: &[u8], view: &View| {
+        let mut front = ViewMesh::from_stream(bytes).unwrap();
+        front.settle(view, Budget::UNLIMITED, 64);
+        front.check_invariants().unwrap();
+        (front.face_count(), front.has_normal_cones())
+    };
+    let (old_faces, old_cones) = faces(&old, &view);
+    let (new_faces, new_cones) = faces(&new, &view);
+    let (two_sided, _) = faces(&new, &view.clone().two_sided(true));
+    assert!(!old_cones && new_cones);
+    // Without cones every node is refined as if it faced the eye: as two-sided.
+    assert_eq!(old_faces, two_sided);
+    assert!(new_faces < two_sided, "{new_faces} of {two_sided}");
+}
+
 #[test]
 fn streams_of_another_format_version_are_refused_in_one_line() {
     let codec = codecs::by_name("raw").unwrap();
