@@ -50,6 +50,7 @@ __all__ = [
     "levels",
     "load",
     "save",
+    "view",
 ]
 
 Bytes = Union[bytes, bytearray, memoryview]
@@ -300,6 +301,62 @@ def decode(stream: Bytes, level: Optional[int] = None, nbytes: Optional[int] = N
         raise MeshcodecError(f"nbytes must be a count of bytes, not {nbytes!r}")
     arrays, appearance, decoded, total = _core.decode(_stream(stream), level, nbytes)
     return _mesh(arrays, decoded, total, appearance)
+
+
+def view(
+    stream: Bytes,
+    eye: Any,
+    target: Any,
+    up: Any = (0.0, 1.0, 0.0),
+    fov: float = 50.0,
+    size: Any = (1280, 720),
+    tolerance: float = 1.0,
+    faces: Optional[int] = None,
+    two_sided: bool = False,
+) -> "tuple[Mesh, Dict[str, Any]]":
+    """The mesh a camera needs from a CAME stream (``came`` or ``came-paper``): its vertex
+    hierarchy refined where a vertex could land ``tolerance`` pixels or more from where the mesh
+    shows it, coarse elsewhere, reading only the meta-nodes that view needs.
+
+    Args:
+        stream: the stream's bytes.
+        eye, target, up: the camera, three numbers each, in the mesh's units.
+        fov: the vertical field of view in degrees.
+        size: the viewport, (width, height) in pixels.
+        tolerance: the screen-space tolerance in pixels.
+        faces: a face budget (the tolerance is raised until the mesh holds at most this many).
+        two_sided: refine the parts facing away from the eye too; by default a node whose
+            normal cone turns every face away stays coarse (streams with normal cones).
+
+    Returns:
+        The adapted :class:`Mesh` and a dict: ``splits``, ``collapses``, ``settled``, the
+        ``tolerance`` reached, ``back_faces_culled``, ``bytes_read`` of ``stream_bytes``,
+        ``units_loaded``, ``units_refused`` of ``units`` (meta-nodes).
+    """
+
+    def point(p: Any, name: str) -> "tuple[float, float, float]":
+        a = np.asarray(p, dtype=np.float64)
+        if a.shape != (3,):
+            raise MeshcodecError(f"{name} must be three numbers, not {p!r}")
+        return (float(a[0]), float(a[1]), float(a[2]))
+
+    if len(size) != 2 or any(isinstance(x, bool) or int(x) != x or x <= 0 for x in size):
+        raise MeshcodecError(f"size must be (width, height) in pixels, not {size!r}")
+    if faces is not None and (isinstance(faces, bool) or faces < 0):
+        raise MeshcodecError(f"faces must be a count of faces, not {faces!r}")
+    arrays, stats = _core.view(
+        _stream(stream),
+        point(eye, "eye"),
+        point(target, "target"),
+        point(up, "up"),
+        float(fov),
+        int(size[0]),
+        int(size[1]),
+        float(tolerance),
+        faces,
+        bool(two_sided),
+    )
+    return _mesh(arrays), stats
 
 
 def levels(stream: Union[Bytes, IO[bytes]], chunk_size: int = 1 << 16) -> Iterator[Mesh]:

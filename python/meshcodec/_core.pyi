@@ -36,6 +36,19 @@ def decode(
     stream: bytes, level: Optional[int] = None, nbytes: Optional[int] = None
 ) -> Tuple[_Arrays, Optional[_Appearance], int, int]: ...
 
+def view(
+    stream: bytes,
+    eye: Tuple[float, float, float],
+    target: Tuple[float, float, float],
+    up: Tuple[float, float, float],
+    fov: float,
+    width: int,
+    height: int,
+    tolerance: float,
+    faces: Optional[int] = None,
+    two_sided: bool = False,
+) -> Tuple[_Arrays, Dict[str, Any]]: ...
+
 class LevelIterator(Iterator[Tuple[_Arrays, Optional[_Appearance], int]]):
     def __init__(self, stream: bytes) -> None: ...
     @property

@@ -423,6 +423,72 @@ fn decode<'py>(
     Ok((arrays(py, mesh), appearance, decoded, total))
 }
 
+/// Adapts the vertex hierarchy of a `came` or `came-paper` stream to a camera
+/// (view-dependent refinement, reading only the meta-nodes the view needs): the adapted mesh's
+/// arrays and a dict of what it took.
+#[pyfunction]
+#[pyo3(signature = (stream, eye, target, up, fov, width, height, tolerance, faces=None, two_sided=false))]
+#[allow(clippy::too_many_arguments)]
+fn view<'py>(
+    py: Python<'py>,
+    stream: &[u8],
+    eye: [f64; 3],
+    target: [f64; 3],
+    up: [f64; 3],
+    fov: f64,
+    width: u32,
+    height: u32,
+    tolerance: f64,
+    faces: Option<usize>,
+    two_sided: bool,
+) -> PyResult<(MeshArrays<'py>, Bound<'py, PyDict>)> {
+    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    let camera = Camera {
+        eye: glam::DVec3::from_array(eye),
+        target: glam::DVec3::from_array(target),
+        up: glam::DVec3::from_array(up),
+        fov_degrees: fov,
+        width,
+        height,
+    };
+    let (mesh, done, fetched, scale, culled) = py
+        .detach(|| {
+            let view = View::new(&camera, tolerance)?.two_sided(two_sided);
+            let mut front = ViewMesh::from_stream(stream)?;
+            let budget = Budget {
+                operations: usize::MAX,
+                faces,
+            };
+            let done = front.settle(&view, budget, 64);
+            let culled = !two_sided && front.has_normal_cones();
+            Ok::<_, meshcodec::Error>((
+                front.mesh(),
+                done,
+                front.fetched(),
+                front.tolerance_scale(),
+                culled,
+            ))
+        })
+        .map_err(to_py)?;
+    let d = PyDict::new(py);
+    d.set_item("splits", done.splits)?;
+    d.set_item("collapses", done.collapses)?;
+    d.set_item("settled", done.settled)?;
+    d.set_item("tolerance", tolerance * scale)?;
+    d.set_item("back_faces_culled", culled)?;
+    d.set_item("bytes_read", fetched.bytes_read)?;
+    d.set_item("stream_bytes", fetched.stream_bytes)?;
+    d.set_item("units_loaded", fetched.units_loaded)?;
+    d.set_item("units_refused", fetched.units_refused)?;
+    d.set_item("units", fetched.units)?;
+    let level = LevelMesh {
+        mesh,
+        loose_edges: Vec::new(),
+        attributes: None,
+    };
+    Ok((arrays(py, level), d))
+}
+
 /// A decoded level: its arrays, its appearance (at the full level of a stream with an
 /// appearance unit), the levels decoded and the levels the stream holds.
 type DecodedLevel<'py> = (MeshArrays<'py>, Option<Bound<'py, PyDict>>, usize, usize);
@@ -708,6 +774,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<LevelIterator>()?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(decode, m)?)?;
+    m.add_function(wrap_pyfunction!(view, m)?)?;
     m.add_function(wrap_pyfunction!(canonical, m)?)?;
     m.add_function(wrap_pyfunction!(level_ends, m)?)?;
     m.add_function(wrap_pyfunction!(info, m)?)?;

@@ -181,6 +181,41 @@ def test_info_reads_the_header_and_index():
     assert meshcodec.info(stream[: units[1]["end_byte"]])["truncated"]
 
 
+def test_view_refines_a_came_stream_where_the_camera_looks():
+    bunny = shared("bunny.ply")
+    stream = meshcodec.encode(bunny.vertices, bunny.faces, codec="came")
+    centre = (bunny.vertices.min(axis=0) + bunny.vertices.max(axis=0)) / 2
+    eye = centre + np.array([0.0, 0.0, 0.25])
+    near, stats = meshcodec.view(stream, eye, centre, size=(640, 480))
+    assert stats["back_faces_culled"] and stats["settled"]
+    assert 0 < near.face_count < bunny.face_count
+    assert stats["bytes_read"] <= stats["stream_bytes"]
+    both, _ = meshcodec.view(stream, eye, centre, size=(640, 480), two_sided=True)
+    assert near.face_count < both.face_count
+    far, _ = meshcodec.view(stream, centre + np.array([0.0, 0.0, 5.0]), centre, size=(640, 480))
+    assert far.face_count < near.face_count
+    capped, capped_stats = meshcodec.view(stream, eye, centre, size=(640, 480), faces=2000)
+    assert capped.face_count <= 2000 and capped_stats["tolerance"] > 1.0
+    # Every vertex of the adapted mesh is a vertex of the full decode.
+    full = meshcodec.decode(stream)
+    cells = {tuple(v) for v in np.round(full.vertices, 9)}
+    assert all(tuple(v) in cells for v in np.round(near.vertices, 9))
+
+
+def test_view_refuses_streams_without_a_hierarchy_and_bad_cameras():
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    f = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    with pytest.raises(meshcodec.MeshcodecError, match="came"):
+        meshcodec.view(meshcodec.encode(v, f, codec="emc"), (0, 0, 3), (0, 0, 0))
+    stream = meshcodec.encode(v, f, codec="came")
+    with pytest.raises(meshcodec.MeshcodecError, match="camera"):
+        meshcodec.view(stream, (0, 0, 0), (0, 0, 0))
+    with pytest.raises(meshcodec.MeshcodecError, match="size"):
+        meshcodec.view(stream, (0, 0, 3), (0, 0, 0), size=(0, 480))
+    with pytest.raises(meshcodec.MeshcodecError, match="eye"):
+        meshcodec.view(stream, (0, 0), (0, 0, 0))
+
+
 def test_load_and_save_round_trip(tmp_path):
     mesh = shared("bunny-3k-libigl.off")
     for ext in ("ply", "obj"):
