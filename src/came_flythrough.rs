@@ -76,6 +76,8 @@ pub struct Frame {
     /// Present faces turned over against the same triangle of the full mesh (their normals
     /// more than 90° apart): fold-overs, which nothing in the build prevents.
     pub fold_overs: usize,
+    /// Of those, the ones whose full-mesh triangle faces the eye.
+    pub fold_overs_facing: usize,
     /// Full-mesh vertices inside the frustum with a face towards the eye, and the measured
     /// screen-space error over them.
     pub visible_vertices: usize,
@@ -261,16 +263,26 @@ fn facing_the_eye(mesh: &TriMesh, eye: DVec3, two_sided: bool, out: &mut Vec<boo
 }
 
 /// Present faces of `front` whose normal points against their full-resolution counterpart's
-/// (`at`: each vertex's position by leaf path).
-fn fold_overs(front: &ViewMesh, at: &std::collections::HashMap<u64, DVec3>) -> usize {
+/// (`at`: each vertex's position by leaf path): all of them, and those whose counterpart faces
+/// `eye` (fold-overs on the side a one-sided surface shows).
+fn fold_overs(
+    front: &ViewMesh,
+    at: &std::collections::HashMap<u64, DVec3>,
+    eye: DVec3,
+) -> (usize, usize) {
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
-    front
-        .present_triangles()
-        .filter(|(leaves, adapted)| {
-            let full = leaves.map(|l| at.get(&l.packed()).copied().unwrap_or(DVec3::ZERO));
-            normal(*adapted).dot(normal(full)) < 0.0
-        })
-        .count()
+    let (mut all, mut facing) = (0, 0);
+    for (leaves, adapted) in front.present_triangles() {
+        let full = leaves.map(|l| at.get(&l.packed()).copied().unwrap_or(DVec3::ZERO));
+        let n = normal(full);
+        if normal(adapted).dot(n) < 0.0 {
+            all += 1;
+            if (full[0] - eye).dot(n) < 0.0 {
+                facing += 1;
+            }
+        }
+    }
+    (all, facing)
 }
 
 /// The stream's path under the system's temporary folder (the stream is rebuilt each run and
@@ -407,6 +419,7 @@ fn fly(
         two_sided.settle(&view.clone().two_sided(true), Budget::UNLIMITED, 256);
         let settle_ms_two_sided = started.elapsed().as_secs_f64() * 1e3;
         facing_the_eye(full, camera.eye, view.is_two_sided(), &mut facing);
+        let (fold_overs, fold_overs_facing) = fold_overs(&front, &at, camera.eye);
         let (max_error_px, mean_error_px, visible_vertices) =
             measured_error(&front, leaves, &facing, &camera, &view)?;
         let fetched = front.fetched();
@@ -428,17 +441,19 @@ fn fly(
             units_loaded: fetched.units_loaded,
             bytes_fetched_two_sided: two_sided.fetched().bytes_read,
             surface_in_view: surface_in_view(&triangles, &view),
-            fold_overs: fold_overs(&front, &at),
+            fold_overs,
+            fold_overs_facing,
             visible_vertices,
             max_error_px,
             mean_error_px,
         };
         if i % 10 == 0 || i + 1 == FRAMES {
             log(format!(
-                "frame {i}: {} faces ({} two-sided, {} folded over), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
+                "frame {i}: {} faces ({} two-sided, {} folded over, {} of them facing the eye), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
                 frame.faces,
                 frame.faces_two_sided,
                 frame.fold_overs,
+                frame.fold_overs_facing,
                 splits,
                 collapses,
                 frame.adapt_ms,
@@ -522,11 +537,11 @@ fn fly(
 
 fn csv(report: &Flythrough) -> String {
     let mut out = String::from(
-        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,visible_vertices,max_error_px,mean_error_px\n",
+        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,fold_overs_facing,visible_vertices,max_error_px,mean_error_px\n",
     );
     for f in &report.frames {
         out += &format!(
-            "{},{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{:.5},{},{},{:.4},{:.4}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{:.5},{},{},{},{:.4},{:.4}\n",
             f.frame,
             f.faces,
             f.vertices,
@@ -542,6 +557,7 @@ fn csv(report: &Flythrough) -> String {
             f.bytes_fetched_two_sided,
             f.surface_in_view,
             f.fold_overs,
+            f.fold_overs_facing,
             f.visible_vertices,
             f.max_error_px,
             f.mean_error_px
@@ -582,6 +598,9 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
                     f.faces_two_sided as f64
                 }),
                 series("folded over", &|f| f.fold_overs as f64),
+                series("folded over, facing the eye", &|f| {
+                    f.fold_overs_facing as f64
+                }),
             ],
         ),
         panel(
