@@ -554,6 +554,14 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "pm" | "pm-reordered" => codecs::pm::vertex_copies(&header),
         _ => None,
     };
+    // A came stream with normal cones serves back-face culling (`meshcodec view`).
+    let normal_cones = match codec.name() {
+        "came" => codecs::came::modelled::params(&header)
+            .ok()
+            .map(|p| p.cone_bits > 0),
+        "came-paper" => Some(false),
+        _ => None,
+    };
     let report = serde_json::json!({
         "file": input.display().to_string(),
         "bytes": stream.len(),
@@ -574,6 +582,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         "meta_nodes": meta_nodes,
         "appearance": appearance,
         "vertex_copies": copies,
+        "normal_cones": normal_cones,
     });
     if json {
         meshcodec::outln!("{}", serde_json::to_string_pretty(&report)?);
@@ -611,6 +620,17 @@ fn info(input: &Path, json: bool) -> Result<()> {
             ""
         }
     );
+    if let Some(cones) = normal_cones {
+        let _ = writeln!(
+            text,
+            "{}",
+            if cones {
+                "normal cones: one per inner node (back faces culled by `meshcodec view`)"
+            } else {
+                "normal cones: none (every node refined as if it faced the eye)"
+            }
+        );
+    }
     if let Some(copies) = copies {
         let _ = writeln!(
             text,
