@@ -214,8 +214,15 @@ fn main() -> ExitCode {
                 width: size.0,
                 height: size.1,
             };
-            let look = (tolerance, two_sided);
-            view(&input, &output, &camera, look, faces, png.as_deref())
+            view(
+                &input,
+                &output,
+                &camera,
+                tolerance,
+                two_sided,
+                faces,
+                png.as_deref(),
+            )
         }
         Command::Convert { input, output } => convert(&input, &output),
         Command::Distance {
@@ -411,7 +418,8 @@ fn view(
     input: &Path,
     output: &Path,
     camera: &meshcodec::codecs::came::refine::Camera,
-    (tolerance, two_sided): (f64, bool),
+    tolerance: f64,
+    two_sided: bool,
     faces: Option<usize>,
     png: Option<&Path>,
 ) -> Result<()> {

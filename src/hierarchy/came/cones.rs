@@ -194,11 +194,11 @@ pub fn coded_cones(
         }
         let about = octahedral_normal(axis.map(u32::from), AXIS_BITS);
         let needed = angle(cone.axis, about) + cone.half_angle;
-        let steps = (needed / ANGLE_STEP).ceil().max(1.0);
-        if steps >= NO_CONE as f64 + 1.0 {
-            return CodedCone::NONE;
-        }
-        // Rounding may leave the bound a hair short of `needed`: one step more then.
+        // (code + 1) steps hold `needed`; rounding may leave the bound a hair short: one
+        // step more then.
+        let steps = (needed / ANGLE_STEP)
+            .ceil()
+            .clamp(1.0, NO_CONE as f64 + 1.0);
         let mut angle = steps as u32 - 1;
         if (angle + 1) as f64 * ANGLE_STEP < needed {
             angle += 1;

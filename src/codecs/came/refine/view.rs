@@ -27,8 +27,6 @@ pub struct View {
     planes: Vec<DVec3>,
     /// κ = 2·τ·tan(φ/2) / H: a sphere of radius r at distance d spans about τ·r / (κ·d) pixels.
     kappa: f64,
-    /// τ, in pixels.
-    tolerance: f64,
     /// Whether nodes all of whose faces turn away from the eye are left unrefined (the
     /// surface is drawn one-sided).
     cull_back_faces: bool,
@@ -67,7 +65,6 @@ impl View {
             forward,
             planes,
             kappa: 2.0 * tolerance * tan_y / camera.height as f64,
-            tolerance,
             cull_back_faces: true,
         })
     }
@@ -119,7 +116,6 @@ impl View {
             forward: DVec3::ZERO,
             planes: Vec::new(),
             kappa: 0.0,
-            tolerance: 0.0,
             cull_back_faces: false,
         }
     }
@@ -131,7 +127,6 @@ impl View {
             forward: DVec3::ZERO,
             planes: Vec::new(),
             kappa: f64::INFINITY,
-            tolerance: f64::INFINITY,
             cull_back_faces: false,
         }
     }
@@ -144,11 +139,6 @@ impl View {
     /// κ.
     pub fn kappa(&self) -> f64 {
         self.kappa
-    }
-
-    /// τ, in pixels.
-    pub fn tolerance(&self) -> f64 {
-        self.tolerance
     }
 
     /// Whether back faces are refined like front faces ([`View::two_sided`]).
