@@ -86,6 +86,9 @@ pub struct AppearanceSpec {
     /// Whether the values are coded inside the codec's own levels, so that every level carries
     /// them (`pm`), rather than in an appearance unit after the last.
     pub in_levels: bool,
+    /// Whether the levels carry only which corners share a normal, each level's normals being
+    /// derived from its positions (docs/FORMAT.md §5.2; with normals and `in_levels` only).
+    pub derived_normals: bool,
 }
 
 /// Material names and the library they come from.
@@ -102,6 +105,7 @@ const FLAG_UVS: u8 = 2;
 const FLAG_COLOURS: u8 = 4;
 const FLAG_MATERIALS: u8 = 8;
 const FLAG_IN_LEVELS: u8 = 16;
+const FLAG_DERIVED_NORMALS: u8 = 32;
 
 impl AppearanceSpec {
     fn write(&self, out: &mut Vec<u8>) {
@@ -109,7 +113,12 @@ impl AppearanceSpec {
             | self.uv_grid.map_or(0, |_| FLAG_UVS)
             | if self.colours { FLAG_COLOURS } else { 0 }
             | self.materials.as_ref().map_or(0, |_| FLAG_MATERIALS)
-            | if self.in_levels { FLAG_IN_LEVELS } else { 0 };
+            | if self.in_levels { FLAG_IN_LEVELS } else { 0 }
+            | if self.derived_normals {
+                FLAG_DERIVED_NORMALS
+            } else {
+                0
+            };
         out.push(flags);
         if let Some(bits) = self.normal_bits {
             out.push(bits);
@@ -142,7 +151,12 @@ impl AppearanceSpec {
         let at = *pos;
         let flags = byte(pos)?;
         let attributes = FLAG_NORMALS | FLAG_UVS | FLAG_COLOURS | FLAG_MATERIALS;
-        if flags & attributes == 0 || flags & !(attributes | FLAG_IN_LEVELS) != 0 {
+        let derived_alone = flags & FLAG_DERIVED_NORMALS != 0
+            && flags & (FLAG_NORMALS | FLAG_IN_LEVELS) != FLAG_NORMALS | FLAG_IN_LEVELS;
+        if flags & attributes == 0
+            || flags & !(attributes | FLAG_IN_LEVELS | FLAG_DERIVED_NORMALS) != 0
+            || derived_alone
+        {
             return Err(Error::malformed(
                 0,
                 at,
@@ -152,6 +166,7 @@ impl AppearanceSpec {
         let mut spec = AppearanceSpec {
             colours: flags & FLAG_COLOURS != 0,
             in_levels: flags & FLAG_IN_LEVELS != 0,
+            derived_normals: flags & FLAG_DERIVED_NORMALS != 0,
             ..AppearanceSpec::default()
         };
         if flags & FLAG_NORMALS != 0 {
@@ -962,6 +977,26 @@ mod tests {
         let mut bytes = Vec::new();
         big.write(&mut bytes);
         assert!(matches!(Header::read(&bytes), Err(Error::Limit(_))));
+    }
+
+    #[test]
+    fn derived_normals_are_declared_only_with_normals_inside_the_levels() {
+        let spec = AppearanceSpec {
+            normal_bits: Some(10),
+            in_levels: true,
+            derived_normals: true,
+            ..AppearanceSpec::default()
+        };
+        let mut bytes = Vec::new();
+        spec.write(&mut bytes);
+        assert_eq!(AppearanceSpec::read(&bytes, &mut 0).unwrap(), spec);
+        // The flag without normals, or without the levels carrying them: refused.
+        for flags in [FLAG_UVS | FLAG_IN_LEVELS, FLAG_NORMALS] {
+            let mut bad = bytes.clone();
+            bad[0] = flags | FLAG_DERIVED_NORMALS;
+            let err = AppearanceSpec::read(&bad, &mut 0).unwrap_err();
+            assert!(err.to_string().contains("appearance flags"), "{err}");
+        }
     }
 
     #[test]

@@ -235,6 +235,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
                 .or_else(|| codec_stats.get_named("appearance_bits"))
                 .map_or(0, |b| b.round() as u64),
             in_levels: options.appearance_in_levels.map(|f| f.name().to_string()),
+            derived_normals: a.bits.derive_normals && a.normals.is_some(),
         }),
         codec_stats,
         levels,

@@ -98,6 +98,10 @@ pub struct AppearanceRun {
     /// (`pm --attributes`); absent when an appearance unit follows the last level.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub in_levels: Option<String>,
+    /// Whether normals were derived from the positions over the input's normal wedges
+    /// (`--derive-normals`) rather than carried as the input's.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub derived_normals: bool,
 }
 
 impl RunResult {
@@ -141,12 +145,18 @@ pub fn result_stem(defaults: &EncodeOptions, result: &RunResult) -> String {
             stem.push('-');
             stem.push_str(rule);
         }
+        if appearance.derived_normals {
+            stem.push_str(DERIVED_NORMALS_SUFFIX);
+        }
     }
     stem
 }
 
 /// What [`result_stem`] appends for a run that coded appearance.
 pub const APPEARANCE_SUFFIX: &str = "-appearance";
+
+/// What [`result_stem`] appends for a run whose normals were derived from the positions.
+pub const DERIVED_NORMALS_SUFFIX: &str = "-derived-normals";
 
 /// `<results>/<codec>/<stem><suffix>`: where every file of a run lives (`.json`, `.csv`, `.mc`,
 /// `-rate-resolution.png`, …).

@@ -303,3 +303,196 @@ fn a_pm_geomorph_carries_appearance_from_the_coarse_corners_to_the_fine_ones() {
         assert!((*uv - (a + b) * 0.5).length() < 1e-12);
     }
 }
+
+/// spot with its uvs and normals that are smooth on most of it and flat (a crease at every edge)
+/// on a sixth: normal groups of every shape, crossing the uv seams.
+fn spot_with_creased_normals() -> meshcodec::mesh::attributes::AttributedMesh {
+    use glam::DVec3;
+    use meshcodec::mesh::attributes::{Attributes, Corner};
+    let mut spot = read_attributed(&resolve("spot").unwrap()).unwrap();
+    let (positions, faces) = (&spot.mesh.positions, &spot.mesh.faces);
+    let face_normal = |f: &[u32; 3]| {
+        let p = f.map(|v| positions[v as usize]);
+        (p[1] - p[0]).cross(p[2] - p[0])
+    };
+    let mut smooth = vec![DVec3::ZERO; positions.len()];
+    for f in faces {
+        for &v in f {
+            smooth[v as usize] += face_normal(f);
+        }
+    }
+    // Flat on the sixth of the faces furthest along +x (a crease at every edge pins vertices).
+    let centroid_x = |f: &[u32; 3]| f.iter().map(|&v| positions[v as usize].x).sum::<f64>();
+    let mut xs: Vec<f64> = faces.iter().map(centroid_x).collect();
+    xs.sort_by(f64::total_cmp);
+    let threshold = xs[xs.len() * 5 / 6];
+    let old = &spot.attributes;
+    let corners: Vec<[Corner; 3]> = faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let flat = centroid_x(f) > threshold;
+            std::array::from_fn(|k| Corner {
+                normal: Some(if flat {
+                    face_normal(f)
+                } else {
+                    smooth[f[k] as usize]
+                }),
+                uv: old.uvs.as_ref().map(|t| t[old.corners[i][k] as usize]),
+                colour: None,
+            })
+        })
+        .collect();
+    spot.attributes = Attributes::weld(faces, &corners).unwrap();
+    spot
+}
+
+/// Normals derived from geometry (`--derive-normals`, Hoppe 1998's Table 4 mode): pm codes no
+/// normal value, only which corners share one; every level's normals are those its own
+/// geometry gives its groups, and the full level is the canonical mesh whose normals are derived.
+#[test]
+fn pm_derives_normals_from_geometry_and_codes_only_the_creases() {
+    use meshcodec::codecs::pm::iter::{Geomorph, PMeshIter};
+    use meshcodec::codecs::AttributeFit;
+    use meshcodec::mesh::attribute_quantization::octahedral_code;
+    let mesh = spot_with_creased_normals();
+    let codec = codecs::by_name("pm-reordered").unwrap();
+    let mut options = codec.default_options();
+    options.quant_bits = 12;
+    let derived = AttributeBits {
+        derive_normals: true,
+        ..AttributeBits::default()
+    };
+    let (canonical, appearance) =
+        codecs::canonical_attributed_for(&mesh, &options, derived).unwrap();
+    let (_, carried) =
+        codecs::canonical_attributed_for(&mesh, &options, AttributeBits::default()).unwrap();
+    // The flat part keeps a crease at every edge: about as many normal groups either way
+    // (fewer where neighbouring faces' derived normals code alike and their groups merge).
+    let groups = |a: &meshcodec::mesh::canonical_attributes::CanonicalAttributes| {
+        let mut set = std::collections::HashSet::new();
+        for (face, wedges) in canonical.faces.iter().zip(&a.corners) {
+            for (&v, &w) in face.iter().zip(wedges) {
+                set.insert((v, a.normals.as_ref().unwrap()[w as usize]));
+            }
+        }
+        set.len()
+    };
+    let (ours, theirs) = (groups(&appearance), groups(&carried));
+    assert!(
+        ours <= theirs && ours * 50 > theirs * 49,
+        "{ours} vs {theirs}"
+    );
+    assert_ne!(appearance.normals, carried.normals);
+    for fit in [AttributeFit::Keep, AttributeFit::Fit] {
+        let what = fit.name();
+        let encoded =
+            codecs::encode_attributed_with(codec, &canonical, Some(&appearance), Some(fit))
+                .unwrap();
+        assert!(encoded.stats.get_named("bits_normal").unwrap_or(0.0) == 0.0);
+        let with_values =
+            codecs::encode_attributed_with(codec, &canonical, Some(&carried), Some(fit)).unwrap();
+        assert!(
+            encoded.bytes.len() < with_values.bytes.len(),
+            "{what}: {} vs {}",
+            encoded.bytes.len(),
+            with_values.bytes.len()
+        );
+        let mut decoder = codecs::open(&encoded.bytes).unwrap();
+        let mut levels = 0;
+        while decoder.advance().unwrap() {
+            let level = decoder.mesh().unwrap();
+            let a = level.attributes.as_ref().expect("every level");
+            // Each wedge's normal is its group's: the area-weighted normal of the faces whose
+            // corners at its vertex carry that normal.
+            let bits = appearance.bits.normal;
+            let normals = a.normals.as_ref().unwrap();
+            let mut sums = std::collections::HashMap::new();
+            for (f, face) in level.mesh.faces.iter().enumerate() {
+                let p = face.map(|v| level.mesh.positions[v as usize]);
+                let n = (p[1] - p[0]).cross(p[2] - p[0]);
+                for k in 0..3 {
+                    let code = octahedral_code(normals[a.corners[f][k] as usize], bits);
+                    *sums.entry((face[k], code)).or_insert(glam::DVec3::ZERO) += n;
+                }
+            }
+            for ((_, code), sum) in sums {
+                let again = octahedral_code(sum, bits);
+                let off = (code[0].abs_diff(again[0])).max(code[1].abs_diff(again[1]));
+                // Cell centres against exact cells: a code may move by one step.
+                assert!(off <= 1, "{what} level {levels}: {code:?} vs {again:?}");
+            }
+            levels += 1;
+        }
+        assert!(levels > 3, "{what}");
+        let full = decoder.mesh().unwrap();
+
+        assert_eq!(
+            appearance.check_lossless(&canonical, &full.mesh, full.attributes.as_ref().unwrap()),
+            Ok(()),
+            "{what}"
+        );
+        // Back to the base mesh and forward again; a geomorph between two levels.
+        let mut iter = PMeshIter::from_stream(&encoded.bytes).unwrap();
+        while iter.next().unwrap() {}
+        let end = iter.attributes().unwrap();
+        iter.goto_nvertices(0).unwrap();
+        let base_vertices = iter.nvertices();
+        let morph = Geomorph::new(&mut iter, base_vertices * 2).unwrap();
+        let at = |alpha| morph.evaluate_appearance(alpha).unwrap();
+        assert!(at(0.0).normals.unwrap().iter().all(|n| n.is_normalized()));
+        // At alpha 1 every corner has Mᶠ's normal (the geomorph's wedges split Mᶠ's further).
+        let corner_normals = |a: &meshcodec::mesh::attributes::Attributes| -> Vec<glam::DVec3> {
+            let normals = a.normals.as_ref().unwrap();
+            a.corners
+                .iter()
+                .flatten()
+                .map(|&w| normals[w as usize])
+                .collect()
+        };
+        let (ends, ours) = (
+            corner_normals(&at(1.0)),
+            corner_normals(&iter.attributes().unwrap()),
+        );
+        // (Renormalized after the blend: equal up to rounding.)
+        let differ = (0..ends.len())
+            .filter(|&i| (ends[i] - ours[i]).length() > 1e-12)
+            .count();
+        assert_eq!(differ, 0, "{what}: of {} corners", ends.len());
+        while iter.next().unwrap() {}
+        assert_eq!(iter.attributes().unwrap(), end, "{what}");
+    }
+}
+
+#[test]
+fn derived_normals_are_carried_as_values_by_the_other_codecs_and_pm_refuses_them_on_a_cut_mesh() {
+    use meshcodec::codecs::AttributeFit;
+    let derived = AttributeBits {
+        derive_normals: true,
+        ..AttributeBits::default()
+    };
+    let mesh = spot_with_creased_normals();
+    let codec = codecs::by_name("emc").unwrap();
+    let (canonical, appearance) =
+        codecs::canonical_attributed_for(&mesh, &codec.default_options(), derived).unwrap();
+    let encoded = codecs::encode_attributed(codec, &canonical, Some(&appearance)).unwrap();
+    let (full, _) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
+    assert_eq!(
+        appearance.check_lossless(&canonical, &full.mesh, full.attributes.as_ref().unwrap()),
+        Ok(())
+    );
+    // dragon-res3 is no manifold: its cut would split normal groups at the copied vertices.
+    let dragon = read_attributed(&resolve("dragon-res3").unwrap()).unwrap();
+    let pm = codecs::by_name("pm").unwrap();
+    let (canonical, appearance) =
+        codecs::canonical_attributed_for(&dragon, &pm.default_options(), derived).unwrap();
+    match codecs::encode_attributed_with(
+        pm,
+        &canonical,
+        Some(&appearance),
+        Some(AttributeFit::Keep),
+    ) {
+        Err(Error::Unsupported(why)) => assert!(why.contains("manifold"), "{why}"),
+        other => panic!("{:?}", other.map(|e| e.bytes.len())),
+    }
+}

@@ -57,7 +57,7 @@ Bytes = Union[bytes, bytearray, memoryview]
 PathLike = Union[str, "os.PathLike[str]"]
 
 # What `encode` accepts beyond the arrays, codec and quantization.
-_CODEC_OPTIONS = ("grid", "uv_bits", "normal_bits", "attributes")
+_CODEC_OPTIONS = ("grid", "uv_bits", "normal_bits", "attributes", "derive_normals")
 
 
 @dataclass
@@ -243,6 +243,9 @@ def encode(
             lossless codec carries it, ``came-paper`` refuses it.
         uv_bits: bits per uv axis over the uvs' bounding box (default 12).
         normal_bits: bits per octahedral normal coordinate (default 10).
+        derive_normals: True derives the normals from the positions over the appearance's
+            normal wedges (its normals then say only where the creases are); with ``pm`` and
+            ``attributes`` the stream codes no normal values at all.
         attributes: ``pm`` and ``pm-reordered`` only: "fit" or "keep" codes the appearance
             inside the vertex splits, so that every level carries it (a collapsed wedge takes
             the values interpolated to where its vertex went, or the survivor's); the stream
@@ -272,6 +275,7 @@ def encode(
         _bits(codec_options.get("uv_bits", 12)),
         _bits(codec_options.get("normal_bits", 10)),
         codec_options.get("attributes"),
+        bool(codec_options.get("derive_normals", False)),
     )
 
 

@@ -25,6 +25,7 @@ def encode(
     uv_bits: int = 12,
     normal_bits: int = 10,
     attributes: Optional[str] = None,
+    derive_normals: bool = False,
 ) -> bytes: ...
 def canonical(
     vertices: npt.NDArray[np.float64],

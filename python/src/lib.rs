@@ -315,10 +315,11 @@ fn grid_shape(grid: Option<&str>, default: GridShape) -> PyResult<GridShape> {
 }
 
 /// Encodes a mesh, with its appearance when given (uvs on `uv_bits`, normals octahedral on
-/// `normal_bits`; inside the levels by the rule `attributes`, "fit" or "keep", for pm);
+/// `normal_bits`, or derived from the positions with `derive_normals`; inside the levels by
+/// the rule `attributes`, "fit" or "keep", for pm);
 /// returns the stream.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, codec_name, quant_bits, grid=None, appearance=None, uv_bits=12, normal_bits=10, attributes=None))]
+#[pyo3(signature = (vertices, faces, codec_name, quant_bits, grid=None, appearance=None, uv_bits=12, normal_bits=10, attributes=None, derive_normals=false))]
 #[allow(clippy::too_many_arguments)]
 fn encode<'py>(
     py: Python<'py>,
@@ -331,6 +332,7 @@ fn encode<'py>(
     uv_bits: u8,
     normal_bits: u8,
     attributes: Option<&str>,
+    derive_normals: bool,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let codec = codec(codec_name)?;
     let in_levels = attributes
@@ -350,6 +352,7 @@ fn encode<'py>(
     let bits = AttributeBits {
         uv: uv_bits,
         normal: normal_bits,
+        derive_normals,
     };
     let bytes = py
         .detach(|| match attributes {

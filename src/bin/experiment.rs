@@ -56,6 +56,10 @@ struct Settings {
     /// Qn: bits per octahedral normal coordinate when coding appearance.
     #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS)]
     normal_bits: u8,
+    /// With --appearance, normals derived from the positions over the input's normal wedges
+    /// (results as STEM-appearance[-RULE]-derived-normals).
+    #[arg(long)]
+    derive_normals: bool,
     /// With --appearance, code it inside the levels (pm only: every level carries it), giving
     /// a collapsed wedge the values interpolated to where the vertex went (`fit`) or the
     /// survivor's (`keep`); results as STEM-appearance-RULE.
@@ -75,6 +79,7 @@ impl Settings {
             appearance: false,
             uv_bits: meshcodec::mesh::attribute_quantization::DEFAULT_UV_BITS,
             normal_bits: meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS,
+            derive_normals: false,
             attributes: None,
         }
     }
@@ -181,6 +186,9 @@ struct ExperimentSet {
     uv_bits: Option<u8>,
     /// Qn when coding appearance; absent: the default.
     normal_bits: Option<u8>,
+    /// Derive normals from the positions over the input's normal wedges.
+    #[serde(default)]
+    derive_normals: bool,
     /// Rules for appearance inside the levels ("fit", "keep"), each a run of its own; absent:
     /// the appearance unit.
     #[serde(default)]
@@ -222,6 +230,7 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
             meshcodec::mesh::attribute_quantization::AttributeBits {
                 uv: settings.uv_bits,
                 normal: settings.normal_bits,
+                derive_normals: settings.derive_normals,
             },
         ),
         appearance_in_levels: settings
@@ -369,6 +378,7 @@ impl Set {
             appearance: settings.appearance || set.appearance,
             uv_bits: set.uv_bits.unwrap_or(settings.uv_bits),
             normal_bits: set.normal_bits.unwrap_or(settings.normal_bits),
+            derive_normals: settings.derive_normals || set.derive_normals,
             ..settings.clone()
         };
         for rule in &set.attributes {

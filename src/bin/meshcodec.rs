@@ -51,6 +51,11 @@ enum Command {
         /// Bits per octahedral normal coordinate (Qn).
         #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS)]
         normal_bits: u8,
+        /// Normals derived from the positions over the input's normal wedges (its normals then
+        /// say only where the creases are): pm with --attributes codes no normal values at all
+        /// (Hoppe 1998's Table 4 mode); the other codecs carry the derived normals.
+        #[arg(long)]
+        derive_normals: bool,
         /// pm only: code the appearance inside the vertex splits, so that every level carries
         /// it, a collapsed wedge taking the values interpolated to where its vertex went (`fit`)
         /// or the survivor's (`keep`). Without it, an appearance unit follows the last level.
@@ -162,6 +167,7 @@ fn main() -> ExitCode {
             drop_attributes,
             uv_bits,
             normal_bits,
+            derive_normals,
             attributes,
             input,
             output,
@@ -176,6 +182,7 @@ fn main() -> ExitCode {
                     AttributeBits {
                         uv: uv_bits,
                         normal: normal_bits,
+                        derive_normals,
                     },
                     attributes
                         .as_deref()

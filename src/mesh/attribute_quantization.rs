@@ -27,6 +27,9 @@ pub struct AttributeBits {
     pub uv: u8,
     /// Qn: bits per octahedral normal coordinate.
     pub normal: u8,
+    /// Normals derived from the positions over each normal wedge (the input's normals say only
+    /// where creases are; [`super::derived_normals`]) instead of the input's own.
+    pub derive_normals: bool,
 }
 
 impl Default for AttributeBits {
@@ -34,6 +37,7 @@ impl Default for AttributeBits {
         AttributeBits {
             uv: DEFAULT_UV_BITS,
             normal: DEFAULT_NORMAL_BITS,
+            derive_normals: false,
         }
     }
 }

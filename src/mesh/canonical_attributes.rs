@@ -66,22 +66,32 @@ impl CanonicalAttributes {
             )?,
             None => None,
         };
+        let mut corner_codes: Vec<[CornerCode; 3]> = origins
+            .iter()
+            .map(|&origin| {
+                // A mesh with materials alone has no wedges: one a vertex, with no values.
+                let input = attributes.corners.get(origin as usize);
+                std::array::from_fn(|k| {
+                    input.map_or(CornerCode::default(), |c| {
+                        quantize_wedge(attributes, c[k], bits, uv_grid.as_ref())
+                    })
+                })
+            })
+            .collect();
+        if bits.derive_normals && attributes.normals.is_some() {
+            derive_corner_normals(canonical, &mut corner_codes, bits.normal);
+        }
         let mut wedge_of: HashMap<(VertexId, CornerCode), WedgeId> = HashMap::new();
         let mut codes = Vec::new();
         let mut wedge_vertex = Vec::new();
         let corners = canonical
             .faces
             .iter()
-            .zip(origins)
-            .map(|(face, &origin)| {
-                // A mesh with materials alone has no wedges: one a vertex, with no values.
-                let input = attributes.corners.get(origin as usize);
+            .zip(&corner_codes)
+            .map(|(face, values)| {
                 std::array::from_fn(|k| {
-                    let code = input.map_or(CornerCode::default(), |c| {
-                        quantize_wedge(attributes, c[k], bits, uv_grid.as_ref())
-                    });
-                    *wedge_of.entry((face[k], code)).or_insert_with(|| {
-                        codes.push(code);
+                    *wedge_of.entry((face[k], values[k])).or_insert_with(|| {
+                        codes.push(values[k]);
                         wedge_vertex.push(face[k]);
                         (codes.len() - 1) as WedgeId
                     })
@@ -243,6 +253,57 @@ fn quantize_wedge(
             _ => None,
         },
         colour: attributes.colours.as_ref().map(|c| colour_code(c[w])),
+    }
+}
+
+/// Replaces each corner's normal code by the one derived from the positions over its normal
+/// group ([`super::derived_normals`]): the corners of its vertex whose codes are equal. Groups of
+/// one vertex whose derived codes come out equal merge and are derived again, until none do, so
+/// that a decoder deriving over the groups the wedges show finds the same codes.
+fn derive_corner_normals(canonical: &CanonicalMesh, codes: &mut [[CornerCode; 3]], bits: u8) {
+    let cell = |v: u32| canonical.cells[v as usize].map(|x| x as i32);
+    let mut key: Vec<[[u32; 2]; 3]> = codes
+        .iter()
+        .map(|c| c.map(|c| c.normal.unwrap_or_default()))
+        .collect();
+    loop {
+        let mut label: HashMap<(VertexId, [u32; 2]), u32> = HashMap::new();
+        let group: Vec<[u32; 3]> = canonical
+            .faces
+            .iter()
+            .zip(&key)
+            .map(|(face, key)| {
+                std::array::from_fn(|k| {
+                    let next = label.len() as u32;
+                    *label.entry((face[k], key[k])).or_insert(next)
+                })
+            })
+            .collect();
+        let groups = label.len();
+        let derived = super::derived_normals::group_normal_codes(
+            &canonical.faces,
+            &group,
+            groups,
+            cell,
+            canonical.grid.cell,
+            bits,
+        );
+        let merged: std::collections::HashSet<(VertexId, [u32; 2])> = label
+            .iter()
+            .map(|(&(v, _), &g)| (v, derived[g as usize]))
+            .collect();
+        key = group
+            .iter()
+            .map(|g| g.map(|g| derived[g as usize]))
+            .collect();
+        if merged.len() == groups {
+            break;
+        }
+    }
+    for (codes, key) in codes.iter_mut().zip(key) {
+        for (c, n) in codes.iter_mut().zip(key) {
+            c.normal = Some(n);
+        }
     }
 }
 

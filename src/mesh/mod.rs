@@ -6,6 +6,7 @@ pub mod attribute_quantization;
 pub mod attributes;
 pub mod canonical;
 pub mod canonical_attributes;
+pub mod derived_normals;
 pub mod generate;
 pub mod io;
 pub mod manifold;

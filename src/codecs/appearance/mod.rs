@@ -58,6 +58,7 @@ pub fn spec_of(appearance: &CanonicalAttributes) -> AppearanceSpec {
             library: m.library.clone(),
         }),
         in_levels: false,
+        derived_normals: false,
     }
 }
 

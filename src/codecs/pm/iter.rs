@@ -123,6 +123,7 @@ impl<'a> PMeshIter<'a> {
             .ok_or_else(|| Error::Truncated("the stream ends before its base mesh".into()))?;
         let (mesh, values, restoration) = super::read_base(&header, &base.bytes)
             .ok_or_else(|| Error::malformed(1, base.start, "base mesh cannot be read"))?;
+        let wedge_contexts = WedgeContexts::after_base(values.as_ref(), None);
         Ok(PMeshIter {
             base: mesh.clone(),
             mesh,
@@ -148,7 +149,7 @@ impl<'a> PMeshIter<'a> {
                     flclw: params.flclw_coding(),
                     with_vad_s: params.with_vad_s(),
                 },
-                wedge_contexts: WedgeContexts::default(),
+                wedge_contexts,
             }),
         })
     }
@@ -423,12 +424,20 @@ impl<'a> PMeshIter<'a> {
             ),
             None => wedges::weld(&w.state, &self.mesh),
         };
+        let cells = match self.restoration() {
+            Some(r) => r.cells(),
+            None => &self.mesh.positions,
+        };
         Some(decoded_attributes(
-            corners,
-            wedge_vertex,
-            codes,
+            Welded {
+                corners,
+                wedge_vertex,
+                codes,
+            },
             &w.state,
             spec,
+            cells,
+            &self.header.grid,
         ))
     }
 
@@ -438,14 +447,30 @@ impl<'a> PMeshIter<'a> {
     }
 }
 
-/// The values of welded corner codes, with the state's face materials.
-fn decoded_attributes(
+/// Welded corner codes: each corner's wedge, each wedge's vertex and code.
+struct Welded {
     corners: Vec<[u32; 3]>,
     wedge_vertex: Vec<u32>,
     codes: Vec<CornerCode>,
+}
+
+/// The values of welded corner codes, with the state's face materials; when the stream's
+/// normals are derived, the normals of the wedges' groups over the vertices at `cells`.
+fn decoded_attributes(
+    wedges: Welded,
     state: &WedgeState,
     spec: &AppearanceSpec,
+    cells: &[[i32; 3]],
+    grid: &Grid,
 ) -> Attributes {
+    let Welded {
+        corners,
+        wedge_vertex,
+        mut codes,
+    } = wedges;
+    if let (true, Some(bits)) = (spec.derived_normals, spec.normal_bits) {
+        derive_normals(&corners, &wedge_vertex, &mut codes, cells, grid, bits);
+    }
     let appearance = crate::codecs::appearance::Appearance {
         corners,
         wedge_vertex,
@@ -453,6 +478,48 @@ fn decoded_attributes(
         materials: state.materials.clone(),
     };
     crate::codecs::appearance::to_attributes(&appearance, spec)
+}
+
+/// Replaces the normal labels of `codes` by the normals derived over their groups: the corners
+/// of one vertex with one label ([`crate::mesh::derived_normals`]).
+fn derive_normals(
+    corners: &[[u32; 3]],
+    wedge_vertex: &[u32],
+    codes: &mut [CornerCode],
+    cells: &[[i32; 3]],
+    grid: &Grid,
+    bits: u8,
+) {
+    let mut group_of: std::collections::HashMap<(u32, u32), u32> =
+        std::collections::HashMap::with_capacity(codes.len());
+    let wedge_group: Vec<u32> = wedge_vertex
+        .iter()
+        .zip(codes.iter())
+        .map(|(&v, &c)| {
+            let next = group_of.len() as u32;
+            *group_of.entry((v, wedges::label_of(c))).or_insert(next)
+        })
+        .collect();
+    let faces: Vec<[u32; 3]> = corners
+        .iter()
+        .map(|c| c.map(|w| wedge_vertex[w as usize]))
+        .collect();
+    let group: Vec<[u32; 3]> = corners
+        .iter()
+        .map(|c| c.map(|w| wedge_group[w as usize]))
+        .collect();
+    let cell = |v: u32| cells.get(v as usize).copied().unwrap_or_default();
+    let normals = crate::mesh::derived_normals::group_normal_codes(
+        &faces,
+        &group,
+        group_of.len(),
+        cell,
+        grid.cell,
+        bits,
+    );
+    for (code, g) in codes.iter_mut().zip(wedge_group) {
+        code.normal = Some(normals[g as usize]);
+    }
 }
 
 fn cell_centre(grid: &Grid, c: [i32; 3]) -> DVec3 {
@@ -534,13 +601,19 @@ impl Geomorph {
                     .map(|(f, c)| std::array::from_fn(|k| (f[k], c[k])))
                     .collect();
                 let (corners, wedge_vertex, codes) = wedges::weld_values(&iter.mesh, &pairs);
-                let end = |pick: fn(&(CornerCode, CornerCode)) -> CornerCode| {
-                    let codes = codes.iter().map(pick).collect();
-                    decoded_attributes(corners.clone(), wedge_vertex.clone(), codes, &w.state, spec)
+                let end = |pick: fn(&(CornerCode, CornerCode)) -> CornerCode,
+                           cells: &[[i32; 3]]| {
+                    let wedges = Welded {
+                        corners: corners.clone(),
+                        wedge_vertex: wedge_vertex.clone(),
+                        codes: codes.iter().map(pick).collect(),
+                    };
+                    decoded_attributes(wedges, &w.state, spec, cells, &grid)
                 };
+                // Derived normals at alpha 0 are those of Mᶠ's faces at the ancestors' places.
                 Some(AppearanceMorph {
-                    coarse: end(|p| p.1),
-                    fine: end(|p| p.0),
+                    coarse: end(|p| p.1, &ancestor),
+                    fine: end(|p| p.0, &iter.mesh.positions),
                 })
             }
             _ => None,

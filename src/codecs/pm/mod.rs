@@ -488,6 +488,13 @@ impl Pm {
         fit: AttributeFit,
     ) -> Result<Encoded> {
         let input = ManifoldInput::of(mesh)?;
+        let derived_normals = appearance.bits.derive_normals && appearance.normals.is_some();
+        if derived_normals && input.cut.is_some() {
+            // Copies of a vertex at the cut would each derive a normal of their own faces.
+            return Err(Error::Unsupported(
+                "pm derives normals inside its levels on oriented manifolds only; this mesh is cut to one (code its normals, or encode them in an appearance unit without --attributes)".into(),
+            ));
+        }
         let flipped = |f: usize| input.cut.as_ref().is_some_and(|c| c.flipped[f]);
         // Corner k of manifold face f is the canonical face's corner k, or for a flipped face
         // (its last two corners swapped) the other of the last two.
@@ -509,6 +516,10 @@ impl Pm {
         for split in &pm.vsplits {
             full.vsplit(split).expect("the encoder's own splits apply");
         }
+        // Derived normals travel as labels: one per normal group (a vertex's corners with one
+        // normal), numbered in order of first corner.
+        let mut labels: std::collections::HashMap<(u32, [u32; 2]), u32> =
+            std::collections::HashMap::new();
         // Each face of Mⁿ is a manifold face: its values, rotated to its first corner.
         let mut state = wedges::WedgeState {
             corners: Vec::with_capacity(full.faces.len()),
@@ -526,6 +537,15 @@ impl Pm {
             for i in 0..3 {
                 codes[(i + r) % 3] = code(f, i);
             }
+            if derived_normals {
+                for (c, &v) in codes.iter_mut().zip(&face.v) {
+                    let next = labels.len() as u32;
+                    let label = *labels
+                        .entry((v, c.normal.unwrap_or_default()))
+                        .or_insert(next);
+                    c.normal = Some(wedges::label_code(label));
+                }
+            }
             state.corners.push(codes);
             if let (Some(out), Some(m)) = (state.materials.as_mut(), &appearance.materials) {
                 out.push(m.face[f]);
@@ -533,6 +553,7 @@ impl Pm {
         }
         let mut spec = super::appearance::spec_of(appearance);
         spec.in_levels = true;
+        spec.derived_normals = derived_normals;
         let levels = wedge_levels::derive(&full, state, &pm.vsplits, fit, &spec);
         let plan = input.cut.as_ref().map(|cut| RepairPlan::of(cut, &pm));
         let params = self.params_with(plan.as_ref());
@@ -691,12 +712,13 @@ fn encode_pm(
         repair::put_flips(&mut enc, base, &plan.flips);
     }
     // The base level's contexts are its own, as the decoder reads it apart.
+    let mut base_contexts = wedges::WedgeContexts::default();
     let mut wedge_state = appearance.map(|(spec, levels)| {
-        let mut contexts = wedges::WedgeContexts::default();
-        wedges::code_base(&mut enc, &mut contexts, base, spec, Some(&levels.base))
+        wedges::code_base(&mut enc, &mut base_contexts, base, spec, Some(&levels.base))
             .expect("the encoder codes its own values")
     });
-    let mut wedge_contexts = wedges::WedgeContexts::default();
+    let mut wedge_contexts =
+        wedges::WedgeContexts::after_base(wedge_state.as_ref(), Some(base_contexts));
     // The base mesh's appearance is counted apart, so that the wedge fields are the splits'.
     let mut pushed = 0usize;
     let mut push = |enc: ArithEncoder, vertices: usize, triangles: usize, stats: &mut Stats| {

@@ -118,6 +118,11 @@ impl Restoration {
         self.cells.len()
     }
 
+    /// Cell of each vertex of the mesh.
+    pub fn cells(&self) -> &[[i32; 3]] {
+        &self.cells
+    }
+
     /// The mesh the manifold Mⁿ stands for, on `grid`.
     pub fn mesh(&self, mesh: &PmMesh, grid: &Grid) -> TriMesh {
         TriMesh::new(

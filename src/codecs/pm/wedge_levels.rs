@@ -10,7 +10,7 @@
 //! so that a texture stays where the surface went; it costs the bits of re-coding vs's
 //! values at the split.
 
-use super::wedges::{SplitTruth, WedgeState};
+use super::wedges::{label_code, label_of, SplitTruth, WedgeState};
 use crate::codecs::AttributeFit;
 use crate::container::AppearanceSpec;
 use crate::hierarchy::pmesh::{PmMesh, Vsplit, NIL};
@@ -36,11 +36,21 @@ fn mix(a: CornerCode, b: CornerCode, t: f64, spec: &AppearanceSpec) -> CornerCod
         return a;
     }
     if t >= 1.0 {
-        return b;
+        // A label of derived normals stays vs's (see `derive`).
+        return CornerCode {
+            normal: if spec.derived_normals {
+                a.normal
+            } else {
+                b.normal
+            },
+            ..b
+        };
     }
     let lerp = |x: u32, y: u32| (x as f64 * (1.0 - t) + y as f64 * t).round() as u32;
     CornerCode {
         normal: match (a.normal, b.normal, spec.normal_bits) {
+            // A label of derived normals names a group, which does not blend.
+            _ if spec.derived_normals => a.normal,
             (Some(x), Some(y), Some(bits)) => {
                 let n = octahedral_normal(x, bits) * (1.0 - t) + octahedral_normal(y, bits) * t;
                 Some(if n.length_squared() > 1e-12 {
@@ -92,6 +102,24 @@ pub fn derive(
         truths.push(truth);
         // The wedges that merge: (vt's, vs's) in fl, then in fr.
         let mut merging = vec![(state.corners[fl as usize][2], state.corners[fl as usize][0])];
+        // Normal labels that continue across the edge, each set named by vs's label in it.
+        let mut label_sets: Vec<Vec<u32>> = Vec::new();
+        if spec.derived_normals {
+            let mut across = vec![merging[0]];
+            if fr != NIL {
+                across.push((state.corners[fr as usize][1], state.corners[fr as usize][0]));
+            }
+            for (b, a) in across {
+                let (b, a) = (label_of(b), label_of(a));
+                match label_sets
+                    .iter_mut()
+                    .find(|s| s.contains(&a) || s.contains(&b))
+                {
+                    Some(set) => set.extend([a, b]),
+                    None => label_sets.push(vec![a, b]),
+                }
+            }
+        }
         if fr != NIL {
             let pair = (state.corners[fr as usize][1], state.corners[fr as usize][0]);
             if merging.iter().all(|m| m.0 != pair.0 && m.1 != pair.1) {
@@ -131,6 +159,16 @@ pub fn derive(
             let value = &mut state.corners[f as usize][k];
             if let Some(m) = merged.iter().find(|m| m.1 == *value) {
                 *value = m.2;
+            }
+        }
+        // The normal groups that continue across the edge merge whatever their other values,
+        // under vs's label: a label stays at one vertex, so that the decoder can tell a group
+        // it holds from a new one.
+        for &f in fan_s.iter().chain(&fan_t).filter(|&&f| f != fl && f != fr) {
+            let k = mesh.corner(f, vs).expect("a face of vs");
+            let value = &mut state.corners[f as usize][k];
+            if let Some(set) = label_sets.iter().find(|s| s.contains(&label_of(*value))) {
+                value.normal = Some(label_code(set[0]));
             }
         }
         for _ in 0..created {

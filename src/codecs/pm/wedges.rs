@@ -13,6 +13,12 @@
 //! at the corner's new position — and its residual is arithmetic-coded in contexts by how far
 //! the prediction moved it. Face materials of fl and fr are predicted from the faces across
 //! their edges at vl and vr.
+//!
+//! When the stream's normals are derived from geometry (Hoppe 1998's Table 4 mode), a corner's
+//! normal is not a value but a **label** naming its normal group among its vertex's: a new
+//! value takes its chart's label, another label of the vertex, or a fresh one, and no normal is
+//! coded; each level's normals are derived from its positions over the groups
+//! ([`crate::mesh::derived_normals`]).
 
 use crate::codecs::appearance::coder::Symbols;
 use crate::codecs::appearance::predict::{face_normal, uv_by_fit};
@@ -24,6 +30,7 @@ use crate::hierarchy::pmesh::{PmMesh, Vsplit, NIL};
 use crate::mesh::attribute_quantization::octahedral_max;
 use crate::mesh::canonical_attributes::CornerCode;
 use glam::{DVec2, DVec3};
+use std::collections::HashMap;
 
 /// Context sets for a new value's residual, by how far its prediction moved from the coarse
 /// value (log2 buckets of cells).
@@ -59,6 +66,138 @@ pub struct WedgeContexts {
     base_uv: [IntContext; 2],
     base_normal: [IntContext; 2],
     base_colour: [IntContext; 4],
+    labels: Labels,
+}
+
+impl WedgeContexts {
+    /// The splits' contexts after the base mesh whose values are `base` (the encoder passes
+    /// the base mesh's contexts too): fresh normal labels continue after the base mesh's, which
+    /// are numbered from 0 in order.
+    pub fn after_base(base: Option<&WedgeState>, coded_base: Option<WedgeContexts>) -> Self {
+        let mut contexts = WedgeContexts::default();
+        contexts.labels.next = base.map_or(0, |state| {
+            state
+                .corners
+                .iter()
+                .flatten()
+                .map(|&c| label_of(c).saturating_add(1))
+                .max()
+                .unwrap_or(0)
+        });
+        if let Some(coded) = coded_base {
+            contexts.labels.decoder_label = coded.labels.decoder_label;
+        }
+        contexts
+    }
+}
+
+/// The normal labels of a stream whose normals are derived: the state's `normal` of a corner
+/// holds [`label_code`] of its label.
+#[derive(Default)]
+struct Labels {
+    /// The label the next fresh group takes.
+    next: u32,
+    /// The encoder's: the decoder's label of each of its own labels met so far.
+    decoder_label: HashMap<u32, u32>,
+    /// Takes the predicted label: [class], the base mesh's last.
+    predicted: [BitContext; 4],
+    /// Takes another label of the vertex rather than a fresh one: [class].
+    other: [BitContext; 4],
+    other_index: UintContext,
+}
+
+/// The class index of the base mesh's corners in [`Labels`]' contexts.
+const BASE_CLASS: usize = 3;
+
+/// What no label is: an encoder's label not met yet.
+const UNMET: u32 = u32::MAX;
+
+/// The `normal` field that holds normal label `label`.
+pub fn label_code(label: u32) -> [u32; 2] {
+    [label, 0]
+}
+
+/// The normal label a corner's value holds.
+pub fn label_of(code: CornerCode) -> u32 {
+    code.normal.unwrap_or_default()[0]
+}
+
+/// How a new value's normal label is chosen: the vertex's labels, the one predicted, the class
+/// of corner, and (encoder) the encoder's own label.
+struct LabelChoice<'a> {
+    pool: &'a [u32],
+    predicted: Option<u32>,
+    class: usize,
+    own: Option<u32>,
+}
+
+impl Labels {
+    /// The encoder's value with its label turned into the decoder's ([`UNMET`] before it is
+    /// coded), and its own label.
+    fn translate(&self, value: CornerCode) -> (CornerCode, u32) {
+        let own = label_of(value);
+        let label = self.decoder_label.get(&own).copied().unwrap_or(UNMET);
+        let mut out = value;
+        out.normal = Some(label_code(label));
+        (out, own)
+    }
+
+    /// Codes a new value's label: the predicted one, another of the vertex's, or a fresh one.
+    fn code(
+        &mut self,
+        symbols: &mut impl Symbols,
+        choice: &LabelChoice,
+        target: u32,
+    ) -> Result<u32> {
+        let field = WedgeField::Corners.name();
+        let predicted = choice.predicted.filter(|p| choice.pool.contains(p));
+        if let Some(p) = predicted {
+            if symbols.bit(&mut self.predicted[choice.class], target == p, field)? {
+                return Ok(p);
+            }
+        }
+        let others: Vec<u32> = choice
+            .pool
+            .iter()
+            .copied()
+            .filter(|&l| Some(l) != predicted)
+            .collect();
+        if !others.is_empty() {
+            let index = others.iter().position(|&l| l == target);
+            if symbols.bit(&mut self.other[choice.class], index.is_some(), field)? {
+                let i = symbols.uint(&mut self.other_index, index.unwrap_or(0) as u64, field)?;
+                return others
+                    .get(i as usize)
+                    .copied()
+                    .ok_or_else(|| malformed("normal label beyond the vertex's"));
+            }
+        }
+        if let Some(own) = choice.own {
+            if self.decoder_label.contains_key(&own) {
+                return Err(malformed("a normal group met before is not at its vertex"));
+            }
+            self.decoder_label.insert(own, self.next);
+        }
+        let label = self.next;
+        self.next = self
+            .next
+            .checked_add(1)
+            .filter(|&n| n != UNMET)
+            .ok_or_else(|| malformed("more normal groups than labels"))?;
+        Ok(label)
+    }
+}
+
+/// The distinct normal labels of `values`, in order.
+fn labels_of(values: impl IntoIterator<Item = CornerCode>) -> Vec<u32> {
+    let mut out: Vec<u32> = Vec::new();
+    for v in values {
+        let l = label_of(v);
+        if !out.contains(&l) {
+            out.push(l);
+        }
+    }
+    out
 }
 
 /// The corner values and face materials of the current mesh.
@@ -164,6 +303,10 @@ struct Corner<'a> {
     chart: Option<CornerCode>,
     at: [i32; 3],
     coarse: &'a Coarse,
+    /// The normal labels of the corner's vertex, when normals are derived.
+    labels: Vec<u32>,
+    /// Whether the encoder runs (its values are true).
+    encoding: bool,
 }
 
 /// Codes the wedges of the split that just applied to `mesh` (whose state before it `coarse`
@@ -248,6 +391,26 @@ fn code_split_fields(
         }
         out
     };
+    let derived = spec.derived_normals;
+    let encoding = truth.is_some();
+    // With derived normals: the labels vs had, to which a split adds fresh ones only.
+    let coarse_labels = if derived {
+        labels_of(coarse.faces.iter().map(|c| c.codes[c.vs_corner]))
+    } else {
+        Vec::new()
+    };
+    let pool_with = |known: &[CornerCode]| -> Vec<u32> {
+        if !derived {
+            return Vec::new();
+        }
+        let mut pool = coarse_labels.clone();
+        for l in labels_of(known.iter().copied()) {
+            if !pool.contains(&l) {
+                pool.push(l);
+            }
+        }
+        pool
+    };
     // Faces vs keeps, then faces that moved to vt.
     let fan_s: Vec<u32> = mesh.fan(fl, vs);
     let fan_t: Vec<u32> = mesh.fan(fl, vt);
@@ -274,6 +437,8 @@ fn code_split_fields(
                 chart: Some(c),
                 at: mesh.positions[v as usize],
                 coarse,
+                labels: pool_with(known),
+                encoding,
             };
             let value = code_corner(symbols, contexts, spec, &corner, truth_of(g).0[k])?;
             if !map.iter().any(|x| x.0 == c) {
@@ -337,12 +502,27 @@ fn code_split_fields(
             } else {
                 [neighbour_s, neighbour_t, across]
             };
+            let labels = if !derived {
+                Vec::new()
+            } else if v == other {
+                // vl's (vr's) labels: those of its faces before the split.
+                labels_of(
+                    mesh.fan(f, v)
+                        .into_iter()
+                        .filter(|&g| g != fl && g != fr)
+                        .filter_map(|g| value_at(state, g, v)),
+                )
+            } else {
+                pool_with(rest)
+            };
             let corner = Corner {
                 class: Class::New,
                 candidates: candidates_of(&first, rest),
                 chart: class_chart,
                 at: mesh.positions[v as usize],
                 coarse,
+                labels,
+                encoding,
             };
             let value = code_corner(symbols, contexts, spec, &corner, truth_codes[k])?;
             state.corners[f as usize][k] = value;
@@ -412,6 +592,13 @@ fn code_corner(
 ) -> Result<CornerCode> {
     let class = corner.class as usize;
     let candidates = &corner.candidates;
+    // The encoder's labels become the decoder's before values are compared.
+    let (value, own) = if spec.derived_normals && corner.encoding {
+        let (value, own) = contexts.labels.translate(value);
+        (value, Some(own))
+    } else {
+        (value, None)
+    };
     for (i, &c) in candidates.iter().take(2).enumerate() {
         if symbols.bit(
             &mut contexts.same[class][i],
@@ -467,8 +654,15 @@ fn code_corner(
         normal: &mut contexts.normal[class],
         uv: &mut contexts.uv[class][scale],
         colour: &mut contexts.colour[class],
+        labels: &mut contexts.labels,
     };
-    code_value(symbols, residuals, spec, predicted, value)
+    let choice = LabelChoice {
+        pool: &corner.labels,
+        predicted: corner.chart.map(label_of),
+        class,
+        own,
+    };
+    code_value(symbols, residuals, spec, predicted, value, &choice)
 }
 
 /// The contexts of one value's residuals.
@@ -476,6 +670,7 @@ struct Residuals<'a> {
     normal: &'a mut [IntContext; 2],
     uv: &'a mut [IntContext; 2],
     colour: &'a mut [IntContext; 4],
+    labels: &'a mut Labels,
 }
 
 /// Codes `value` as its residuals from `predicted`, field by field as `spec` declares.
@@ -485,9 +680,13 @@ fn code_value(
     spec: &AppearanceSpec,
     predicted: CornerCode,
     value: CornerCode,
+    choice: &LabelChoice,
 ) -> Result<CornerCode> {
     let mut out = CornerCode::default();
-    if let Some(bits) = spec.normal_bits {
+    if spec.normal_bits.is_some() && spec.derived_normals {
+        let label = contexts.labels.code(symbols, choice, label_of(value))?;
+        out.normal = Some(label_code(label));
+    } else if let Some(bits) = spec.normal_bits {
         let (p, t) = (
             predicted.normal.unwrap_or_default(),
             value.normal.unwrap_or_default(),
@@ -606,6 +805,13 @@ pub fn code_base(
         for (k, slot) in codes.iter_mut().enumerate() {
             let v = face.v[k] as usize;
             let value = truth.map_or(CornerCode::default(), |t| t.corners[f][k]);
+            let (value, own) = match truth {
+                Some(_) if spec.derived_normals => {
+                    let (value, own) = contexts.labels.translate(value);
+                    (value, Some(own))
+                }
+                _ => (value, None),
+            };
             let index = known[v].iter().position(|&c| c == value);
             let code = if !known[v].is_empty()
                 && symbols.bit(
@@ -626,8 +832,20 @@ pub fn code_base(
                     normal: &mut contexts.base_normal,
                     uv: &mut contexts.base_uv,
                     colour: &mut contexts.base_colour,
+                    labels: &mut contexts.labels,
                 };
-                let code = code_value(symbols, residuals, spec, previous, value)?;
+                let pool = if spec.derived_normals {
+                    labels_of(known[v].iter().copied())
+                } else {
+                    Vec::new()
+                };
+                let choice = LabelChoice {
+                    pool: &pool,
+                    predicted: None,
+                    class: BASE_CLASS,
+                    own,
+                };
+                let code = code_value(symbols, residuals, spec, previous, value, &choice)?;
                 known[v].push(code);
                 previous = code;
                 code
