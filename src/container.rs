@@ -89,6 +89,9 @@ pub struct AppearanceSpec {
     /// Whether the levels carry only which corners share a normal, each level's normals being
     /// derived from its positions (docs/FORMAT.md §5.2; with normals and `in_levels` only).
     pub derived_normals: bool,
+    /// Whether the levels' new normals are predicted from the geometry of their vertex's faces
+    /// (docs/FORMAT.md §6.1; with normals coded in the levels only).
+    pub geometric_normals: bool,
 }
 
 /// Material names and the library they come from.
@@ -106,6 +109,7 @@ const FLAG_COLOURS: u8 = 4;
 const FLAG_MATERIALS: u8 = 8;
 const FLAG_IN_LEVELS: u8 = 16;
 const FLAG_DERIVED_NORMALS: u8 = 32;
+const FLAG_GEOMETRIC_NORMALS: u8 = 64;
 
 impl AppearanceSpec {
     fn write(&self, out: &mut Vec<u8>) {
@@ -116,6 +120,11 @@ impl AppearanceSpec {
             | if self.in_levels { FLAG_IN_LEVELS } else { 0 }
             | if self.derived_normals {
                 FLAG_DERIVED_NORMALS
+            } else {
+                0
+            }
+            | if self.geometric_normals {
+                FLAG_GEOMETRIC_NORMALS
             } else {
                 0
             };
@@ -151,12 +160,14 @@ impl AppearanceSpec {
         let at = *pos;
         let flags = byte(pos)?;
         let attributes = FLAG_NORMALS | FLAG_UVS | FLAG_COLOURS | FLAG_MATERIALS;
-        let derived_alone = flags & FLAG_DERIVED_NORMALS != 0
-            && flags & (FLAG_NORMALS | FLAG_IN_LEVELS) != FLAG_NORMALS | FLAG_IN_LEVELS;
-        if flags & attributes == 0
-            || flags & !(attributes | FLAG_IN_LEVELS | FLAG_DERIVED_NORMALS) != 0
-            || derived_alone
-        {
+        // Derived normals, or normals predicted from geometry (not both), need normals in the
+        // levels.
+        let normal_modes = flags & (FLAG_DERIVED_NORMALS | FLAG_GEOMETRIC_NORMALS);
+        let bad_mode = normal_modes != 0
+            && (normal_modes == FLAG_DERIVED_NORMALS | FLAG_GEOMETRIC_NORMALS
+                || flags & (FLAG_NORMALS | FLAG_IN_LEVELS) != FLAG_NORMALS | FLAG_IN_LEVELS);
+        let known = attributes | FLAG_IN_LEVELS | FLAG_DERIVED_NORMALS | FLAG_GEOMETRIC_NORMALS;
+        if flags & attributes == 0 || flags & !known != 0 || bad_mode {
             return Err(Error::malformed(
                 0,
                 at,
@@ -167,6 +178,7 @@ impl AppearanceSpec {
             colours: flags & FLAG_COLOURS != 0,
             in_levels: flags & FLAG_IN_LEVELS != 0,
             derived_normals: flags & FLAG_DERIVED_NORMALS != 0,
+            geometric_normals: flags & FLAG_GEOMETRIC_NORMALS != 0,
             ..AppearanceSpec::default()
         };
         if flags & FLAG_NORMALS != 0 {
@@ -980,7 +992,7 @@ mod tests {
     }
 
     #[test]
-    fn derived_normals_are_declared_only_with_normals_inside_the_levels() {
+    fn normal_modes_are_declared_only_with_normals_inside_the_levels() {
         let spec = AppearanceSpec {
             normal_bits: Some(10),
             in_levels: true,
@@ -990,8 +1002,10 @@ mod tests {
         let mut bytes = Vec::new();
         spec.write(&mut bytes);
         assert_eq!(AppearanceSpec::read(&bytes, &mut 0).unwrap(), spec);
-        // The flag without normals, or without the levels carrying them: refused.
-        for flags in [FLAG_UVS | FLAG_IN_LEVELS, FLAG_NORMALS] {
+        // Either normal mode without normals, or without the levels carrying them, or both
+        // modes at once: refused.
+        let both = FLAG_NORMALS | FLAG_IN_LEVELS | FLAG_GEOMETRIC_NORMALS;
+        for flags in [FLAG_UVS | FLAG_IN_LEVELS, FLAG_NORMALS, both] {
             let mut bad = bytes.clone();
             bad[0] = flags | FLAG_DERIVED_NORMALS;
             let err = AppearanceSpec::read(&bad, &mut 0).unwrap_err();

@@ -392,6 +392,14 @@ fn pm_derives_normals_from_geometry_and_codes_only_the_creases() {
         assert!(encoded.stats.get_named("bits_normal").unwrap_or(0.0) == 0.0);
         let with_values =
             codecs::encode_attributed_with(codec, &canonical, Some(&carried), Some(fit)).unwrap();
+        // Normal values are predicted from geometry; derived normals are labels alone.
+        let spec = |bytes: &[u8]| {
+            let reader = meshcodec::container::StreamReader::open(bytes).unwrap();
+            reader.header().appearance.clone().unwrap()
+        };
+        let (ours, theirs) = (spec(&encoded.bytes), spec(&with_values.bytes));
+        assert!(ours.derived_normals && !ours.geometric_normals);
+        assert!(!theirs.derived_normals && theirs.geometric_normals);
         assert!(
             encoded.bytes.len() < with_values.bytes.len(),
             "{what}: {} vs {}",

@@ -416,7 +416,12 @@ const HOPPE_WEDGE_ROWS: [(&str, [f64; 11]); 7] = [
 ];
 
 /// The shared meshes with appearance that pm takes, for the wedge table.
-const WEDGE_MESHES: [&str; 4] = ["bunny-10k-textured", "spot", "airplane-colored", "feline-26k"];
+const WEDGE_MESHES: [&str; 4] = [
+    "bunny-10k-textured",
+    "spot",
+    "airplane-colored",
+    "feline-26k",
+];
 
 /// The shared manifolds with normals, for the wedge table's rows with derived normals.
 const DERIVED_NORMAL_MESHES: [&str; 2] = ["feline-26k", "bunny-3k-closed"];
@@ -475,7 +480,8 @@ fn wedge_table(md: &mut String, results: &Path) -> Result<()> {
                 // A field the mesh does not have is no column of its.
                 let cell = |w: WedgeField| bits(w).map_or("—".to_string(), |b| format!("{b:.1}"));
                 let normal = if derived {
-                    if let Some(degrees) = r.levels.last().and_then(|l| l.appearance.normal_degrees) {
+                    if let Some(degrees) = r.levels.last().and_then(|l| l.appearance.normal_degrees)
+                    {
                         derived_errors.push(format!("{mesh} {degrees:.2}°"));
                     }
                     "0".to_string()

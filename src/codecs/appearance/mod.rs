@@ -59,6 +59,7 @@ pub fn spec_of(appearance: &CanonicalAttributes) -> AppearanceSpec {
         }),
         in_levels: false,
         derived_normals: false,
+        geometric_normals: false,
     }
 }
 

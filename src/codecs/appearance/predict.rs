@@ -43,6 +43,49 @@ pub fn face_normal(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     (b - a).cross(c - a)
 }
 
+/// The unit normal at a vertex from its faces' corners (each the vertex's position and its two
+/// neighbours in the face, counter-clockwise), each face's normal weighted by its angle at the
+/// vertex (Thürmer and Wüthrich); zero when the faces have no area. Such normals are what
+/// modelling tools write for smooth surfaces, so they predict a file's normals best.
+pub fn vertex_normal_by_angles(corners: impl IntoIterator<Item = [DVec3; 3]>) -> DVec3 {
+    corners
+        .into_iter()
+        .map(|[p, a, b]| {
+            let (u, v) = (a - p, b - p);
+            u.cross(v).normalize_or_zero() * angle_between(u, v)
+        })
+        .sum::<DVec3>()
+        .normalize_or_zero()
+}
+
+/// The angle between `u` and `v` in radians, within 0.002 of the true one, computed with + − × ÷
+/// and √ alone. Those are exactly rounded in IEEE arithmetic, so an encoder and a decoder on
+/// any platform predict alike; a maths library's `acos` or `atan2` may differ in its last bit,
+/// and a prediction that differs by one code would decode another value.
+pub fn angle_between(u: DVec3, v: DVec3) -> f64 {
+    let y = u.cross(v).length();
+    let x = u.dot(v);
+    let (small, large) = if y <= x.abs() {
+        (y, x.abs())
+    } else {
+        (x.abs(), y)
+    };
+    if large <= 0.0 {
+        return 0.0;
+    }
+    // atan(t) for t in [0, 1] (Rajan et al. 2006's approximation).
+    let t = small / large;
+    let quarter = std::f64::consts::FRAC_PI_4;
+    let mut angle = quarter * t - t * (t - 1.0) * (0.2447 + 0.0663 * t);
+    if y > x.abs() {
+        angle = 2.0 * quarter - angle;
+    }
+    if x < 0.0 {
+        angle = 4.0 * quarter - angle;
+    }
+    angle
+}
+
 /// The uv of corner `p` of a triangle (p, a, b) from the triangle (a, b, c) across its edge a–b,
 /// all of whose uvs are known and which shares a chart with it: the two triangles are unfolded
 /// into one plane about the edge, and the affine map that takes (a, b, c) to their uvs is applied
@@ -109,6 +152,28 @@ pub fn uv_by_fit(p: DVec3, normal: DVec3, pairs: &[(DVec3, DVec2)]) -> Option<DV
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn angles_are_close_to_the_true_ones_and_vertex_normals_weigh_by_them() {
+        let mut worst: f64 = 0.0;
+        for i in 0..=360 {
+            let a = (i as f64).to_radians();
+            let v = DVec3::new(a.cos(), a.sin(), 0.0) * 3.0;
+            let truth = DVec3::X.angle_between(v);
+            worst = worst.max((super::angle_between(DVec3::X * 2.0, v) - truth).abs());
+        }
+        assert!(worst < 0.002, "{worst}");
+        // A corner of 90° and one of 45°, with normals +z and +x: weights 2:1.
+        let n = super::vertex_normal_by_angles([
+            [DVec3::ZERO, DVec3::X, DVec3::Y],
+            [DVec3::ZERO, DVec3::Y, DVec3::new(0.0, 1.0, -1.0)],
+        ]);
+        let expected = (DVec3::Z * std::f64::consts::FRAC_PI_2
+            - DVec3::X * std::f64::consts::FRAC_PI_4)
+            .normalize();
+        assert!((n - expected).length() < 2e-3, "{n} {expected}");
+    }
+
     use super::*;
 
     #[test]

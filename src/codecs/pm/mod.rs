@@ -554,6 +554,7 @@ impl Pm {
         let mut spec = super::appearance::spec_of(appearance);
         spec.in_levels = true;
         spec.derived_normals = derived_normals;
+        spec.geometric_normals = spec.normal_bits.is_some() && !derived_normals;
         let levels = wedge_levels::derive(&full, state, &pm.vsplits, fit, &spec);
         let plan = input.cut.as_ref().map(|cut| RepairPlan::of(cut, &pm));
         let params = self.params_with(plan.as_ref());

@@ -21,13 +21,13 @@
 //! ([`crate::mesh::derived_normals`]).
 
 use crate::codecs::appearance::coder::Symbols;
-use crate::codecs::appearance::predict::{face_normal, uv_by_fit};
+use crate::codecs::appearance::predict::{face_normal, uv_by_fit, vertex_normal_by_angles};
 use crate::codecs::stats::WedgeField;
 use crate::coding::arith::{BitContext, IntContext, UintContext};
 use crate::container::AppearanceSpec;
 use crate::error::{Error, Result};
 use crate::hierarchy::pmesh::{PmMesh, Vsplit, NIL};
-use crate::mesh::attribute_quantization::octahedral_max;
+use crate::mesh::attribute_quantization::{octahedral_code, octahedral_max};
 use crate::mesh::canonical_attributes::CornerCode;
 use glam::{DVec2, DVec3};
 use std::collections::HashMap;
@@ -56,7 +56,7 @@ pub struct WedgeContexts {
     /// [class][scale][axis]
     uv: [[[IntContext; 2]; SCALES]; 3],
     /// [class][axis]
-    normal: [[IntContext; 2]; 3],
+    normal: [[IntContext; 5]; 3],
     /// [class][channel]
     colour: [[IntContext; 4]; 3],
     material_same: [BitContext; 2],
@@ -64,7 +64,7 @@ pub struct WedgeContexts {
     base_known: BitContext,
     base_index: UintContext,
     base_uv: [IntContext; 2],
-    base_normal: [IntContext; 2],
+    base_normal: [IntContext; 5],
     base_colour: [IntContext; 4],
     labels: Labels,
 }
@@ -307,6 +307,9 @@ struct Corner<'a> {
     labels: Vec<u32>,
     /// Whether the encoder runs (its values are true).
     encoding: bool,
+    /// The normal the corner's vertex has by its faces after the split, when normals are
+    /// predicted from geometry.
+    geometric: Option<DVec3>,
 }
 
 /// Codes the wedges of the split that just applied to `mesh` (whose state before it `coarse`
@@ -411,6 +414,16 @@ fn code_split_fields(
         }
         pool
     };
+    // With normals predicted from geometry: the normal of a vertex's faces after the split.
+    let geometric = |faces: &[u32], at: u32| -> Option<DVec3> {
+        spec.geometric_normals.then(|| {
+            vertex_normal_by_angles(faces.iter().filter_map(|&g| {
+                let face = mesh.faces[g as usize].v;
+                let k = face.iter().position(|&v| v == at)?;
+                Some([0, 1, 2].map(|i| point(mesh.positions[face[(k + i) % 3] as usize])))
+            }))
+        })
+    };
     // Faces vs keeps, then faces that moved to vt.
     let fan_s: Vec<u32> = mesh.fan(fl, vs);
     let fan_t: Vec<u32> = mesh.fan(fl, vt);
@@ -439,6 +452,7 @@ fn code_split_fields(
                 coarse,
                 labels: pool_with(known),
                 encoding,
+                geometric: geometric(fan, v),
             };
             let value = code_corner(symbols, contexts, spec, &corner, truth_of(g).0[k])?;
             if !map.iter().any(|x| x.0 == c) {
@@ -523,6 +537,13 @@ fn code_split_fields(
                 coarse,
                 labels,
                 encoding,
+                geometric: if v == vs {
+                    geometric(&fan_s, v)
+                } else if v == vt {
+                    geometric(&fan_t, v)
+                } else {
+                    geometric(&mesh.fan(f, v), v)
+                },
             };
             let value = code_corner(symbols, contexts, spec, &corner, truth_codes[k])?;
             state.corners[f as usize][k] = value;
@@ -650,6 +671,12 @@ fn code_corner(
         scale = ((32 - moved.leading_zeros()) as usize).min(SCALES - 1);
         predicted.uv = Some(fitted);
     }
+    // A normal is predicted by its vertex's faces, when the stream says so and they have area.
+    if let (Some(bits), Some(n)) = (spec.normal_bits, corner.geometric) {
+        if n != DVec3::ZERO {
+            predicted.normal = Some(octahedral_code(n, bits));
+        }
+    }
     let residuals = Residuals {
         normal: &mut contexts.normal[class],
         uv: &mut contexts.uv[class][scale],
@@ -667,7 +694,7 @@ fn code_corner(
 
 /// The contexts of one value's residuals.
 struct Residuals<'a> {
-    normal: &'a mut [IntContext; 2],
+    normal: &'a mut [IntContext; 5],
     uv: &'a mut [IntContext; 2],
     colour: &'a mut [IntContext; 4],
     labels: &'a mut Labels,
@@ -693,13 +720,64 @@ fn code_value(
         );
         let max = octahedral_max(bits) as i64;
         let mut n = [0u32; 2];
+        let mut first = 0i64;
+        // Predicted from geometry: the second residual's contexts by the first's size, and the
+        // value taken across an edge of the octahedral square when nearer the prediction there.
+        let geometric = spec.geometric_normals;
+        // The square continues across each edge into its mirror image: (u, v) beyond u = max
+        // is (2 max − u, max − v), and likewise at the other edges.
+        let (pu, pv) = (p[0] as i64, p[1] as i64);
+        let (tu, tv) = (t[0] as i64, t[1] as i64);
+        let mut target = [tu, tv];
+        if geometric {
+            let images = [
+                (tu < max).then_some([2 * max - tu, max - tv]),
+                (tu > 0).then_some([-tu, max - tv]),
+                (tv < max).then_some([max - tu, 2 * max - tv]),
+                (tv > 0).then_some([max - tu, -tv]),
+            ];
+            let cost = |q: [i64; 2]| (q[0] - pu).abs() + (q[1] - pv).abs();
+            for q in images.into_iter().flatten() {
+                if cost(q) < cost(target) {
+                    target = q;
+                }
+            }
+        }
+        let mut q = [0i64; 2];
         for axis in 0..2 {
+            let c = if axis == 1 && geometric {
+                1 + match first.unsigned_abs() {
+                    0 => 0,
+                    1 => 1,
+                    2..=3 => 2,
+                    _ => 3,
+                }
+            } else {
+                axis
+            };
             let d = symbols.int(
-                &mut contexts.normal[axis],
-                t[axis] as i64 - p[axis] as i64,
+                &mut contexts.normal[c],
+                target[axis] - p[axis] as i64,
                 WedgeField::Normal.name(),
             )?;
-            n[axis] = within(p[axis] as i64 + d, max + 1, "normal")?;
+            first = d;
+            q[axis] = p[axis] as i64 + d;
+        }
+        // Back from a mirror image (a value outside the square in one coordinate only; a
+        // corrupt one outside in both is caught below).
+        if geometric {
+            if q[0] > max {
+                q = [2 * max - q[0], max - q[1]];
+            } else if q[0] < 0 {
+                q = [-q[0], max - q[1]];
+            } else if q[1] > max {
+                q = [max - q[0], 2 * max - q[1]];
+            } else if q[1] < 0 {
+                q = [max - q[0], -q[1]];
+            }
+        }
+        for axis in 0..2 {
+            n[axis] = within(q[axis], max + 1, "normal")?;
         }
         out.normal = Some(n);
     }
