@@ -182,6 +182,13 @@ for codec in pm pm-reordered; do
     tail -c +6 "$stream" > "$seeds/decode_pm_wedges/$codec-torus-fin-$rule.body"
   done
 done
+# Normals in the splits on the torus (a manifold with uvs and normals): predicted from the
+# geometry of their vertex's faces (appearance flag 64), and derived from it (flag 32).
+for derive in "" --derive-normals; do
+  target/release/meshcodec encode --codec pm-reordered --quant 10 --uv-bits 8 --normal-bits 6 \
+    --attributes keep $derive $seeds/read_obj/torus.obj "$stream" >/dev/null 2>&1
+  tail -c +6 "$stream" > "$seeds/decode_pm_wedges/pm-reordered-torus-keep${derive:+-derived}.body"
+done
 # One meta-node alone takes the CAME codecs' streams too.
 for codec in came came_paper; do
   mkdir -p $seeds/decode_${codec}_unit

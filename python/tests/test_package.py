@@ -276,6 +276,32 @@ def test_appearance_is_loaded_coded_decoded_and_saved(tmp_path):
         meshcodec.encode(mesh.vertices, mesh.faces, appearance=bad)
 
 
+def test_pm_derives_normals_from_geometry_when_asked():
+    mesh = meshcodec.load(MESHES / "feline-26k.obj")
+    a = mesh.appearance
+    assert a is not None and a.normals is not None
+    coded = meshcodec.encode(mesh.vertices, mesh.faces, codec="pm-reordered", appearance=a,
+                             attributes="keep")
+    derived = meshcodec.encode(mesh.vertices, mesh.faces, codec="pm-reordered", appearance=a,
+                               attributes="keep", derive_normals=True)
+    # No normal value in the splits: a smaller stream, every level with normals.
+    assert len(derived) < 0.8 * len(coded)
+    levels = list(meshcodec.levels(derived))
+    assert len(levels) > 3 and all(l.appearance.normals is not None for l in levels)
+
+    # The derived normals are near the file's (a smooth surface), not equal to them.
+    def normal_at(m):
+        corners = m.appearance.normals[m.appearance.corners].reshape(-1, 3)
+        at = m.vertices[m.faces].reshape(-1, 3)
+        return {tuple(np.round(p, 9)): n for p, n in zip(at, corners)}
+
+    ours, theirs = normal_at(levels[-1]), normal_at(meshcodec.decode(coded))
+    assert ours.keys() == theirs.keys()
+    cosines = np.array([np.dot(ours[k], theirs[k]) for k in ours])
+    mean_degrees = np.degrees(np.arccos(np.clip(cosines, -1, 1))).mean()
+    assert 0.1 < mean_degrees < 5, mean_degrees
+
+
 def test_distance_is_zero_to_itself_and_grows_as_levels_coarsen():
     mesh = shared("bunny-3k-libigl.off")
     # The BVH measures in float32 about the mesh's centre.

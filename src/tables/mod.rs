@@ -470,6 +470,14 @@ fn wedge_table(md: &mut String, results: &Path) -> Result<()> {
                     );
                     continue;
                 };
+                if stat(&r, Stat::Vsplits).unwrap_or(0.0) < 1.0 {
+                    let _ = writeln!(
+                        md,
+                        "| {mesh} (ours) | `{codec}` {rule}{how}: no vertex split, the seams pin every vertex in the base mesh ({} bits a vertex) | | | | | | | | | | | | |",
+                        format_args!("{:.1}", r.bits_per_vertex())
+                    );
+                    continue;
+                }
                 let splits = stat(&r, Stat::Vsplits)?.max(1.0);
                 let bits = |w: WedgeField| {
                     r.codec_stats
