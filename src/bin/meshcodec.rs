@@ -550,6 +550,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         let entry = reader.index().appearance;
         serde_json::json!({
             "normal_bits": spec.normal_bits,
+            "normals": normal_mode(spec),
             "uv_bits": spec.uv_grid.map(|g| g.bits),
             "uv_origin": spec.uv_grid.map(|g| g.origin),
             "uv_cell": spec.uv_grid.map(|g| g.cell),
@@ -655,7 +656,14 @@ fn info(input: &Path, json: bool) -> Result<()> {
     if let Some(spec) = &header.appearance {
         let mut carried = Vec::new();
         if let Some(bits) = spec.normal_bits {
-            carried.push(format!("normals (octahedral, {bits} bits a coordinate)"));
+            let mode = match normal_mode(spec) {
+                Some("derived") => ", derived from the positions over their groups",
+                Some("predicted") => ", predicted from the geometry of their vertex's faces",
+                _ => "",
+            };
+            carried.push(format!(
+                "normals (octahedral, {bits} bits a coordinate{mode})"
+            ));
         }
         if let Some(g) = spec.uv_grid {
             carried.push(format!(
@@ -844,4 +852,18 @@ fn distance(
         );
     }
     Ok(())
+}
+
+/// How a stream's normals travel: "derived" (each level derives them from its positions over
+/// the normal groups), "predicted" (values predicted from the geometry of their vertex's faces),
+/// "coded" (values), or none.
+fn normal_mode(spec: &meshcodec::container::AppearanceSpec) -> Option<&'static str> {
+    spec.normal_bits?;
+    Some(if spec.derived_normals {
+        "derived"
+    } else if spec.geometric_normals {
+        "predicted"
+    } else {
+        "coded"
+    })
 }
