@@ -724,25 +724,12 @@ fn code_value(
         // Predicted from geometry: the second residual's contexts by the first's size, and the
         // value taken across an edge of the octahedral square when nearer the prediction there.
         let geometric = spec.geometric_normals;
-        // The square continues across each edge into its mirror image: (u, v) beyond u = max
-        // is (2 max − u, max − v), and likewise at the other edges.
-        let (pu, pv) = (p[0] as i64, p[1] as i64);
-        let (tu, tv) = (t[0] as i64, t[1] as i64);
-        let mut target = [tu, tv];
-        if geometric {
-            let images = [
-                (tu < max).then_some([2 * max - tu, max - tv]),
-                (tu > 0).then_some([-tu, max - tv]),
-                (tv < max).then_some([max - tu, 2 * max - tv]),
-                (tv > 0).then_some([max - tu, -tv]),
-            ];
-            let cost = |q: [i64; 2]| (q[0] - pu).abs() + (q[1] - pv).abs();
-            for q in images.into_iter().flatten() {
-                if cost(q) < cost(target) {
-                    target = q;
-                }
-            }
-        }
+        let truth = [t[0] as i64, t[1] as i64];
+        let target = if geometric {
+            nearest_image(truth, [p[0] as i64, p[1] as i64], max)
+        } else {
+            truth
+        };
         let mut q = [0i64; 2];
         for axis in 0..2 {
             let c = if axis == 1 && geometric {
@@ -761,20 +748,10 @@ fn code_value(
                 WedgeField::Normal.name(),
             )?;
             first = d;
-            q[axis] = p[axis] as i64 + d;
+            q[axis] = (p[axis] as i64).saturating_add(d);
         }
-        // Back from a mirror image (a value outside the square in one coordinate only; a
-        // corrupt one outside in both is caught below).
         if geometric {
-            if q[0] > max {
-                q = [2 * max - q[0], max - q[1]];
-            } else if q[0] < 0 {
-                q = [-q[0], max - q[1]];
-            } else if q[1] > max {
-                q = [max - q[0], 2 * max - q[1]];
-            } else if q[1] < 0 {
-                q = [max - q[0], -q[1]];
-            }
+            q = fold_into_square(q, max);
         }
         for axis in 0..2 {
             n[axis] = within(q[axis], max + 1, "normal")?;
@@ -817,6 +794,42 @@ fn code_value(
         out.colour = Some(rgba);
     }
     Ok(out)
+}
+
+/// Of octahedral code `t` (in 0..=`max` on both coordinates) and its mirror images across the
+/// square's four edges, the nearest to `p` (L1). The square continues across each edge into its
+/// mirror image: (u, v) beyond u = max is (2 max − u, max − v), and likewise at the other edges.
+/// Only images strictly outside the square count, so that [`fold_into_square`] undoes the choice.
+fn nearest_image(t: [i64; 2], p: [i64; 2], max: i64) -> [i64; 2] {
+    let [u, v] = t;
+    let images = [
+        (u < max).then_some([2 * max - u, max - v]),
+        (u > 0).then_some([-u, max - v]),
+        (v < max).then_some([max - u, 2 * max - v]),
+        (v > 0).then_some([max - u, -v]),
+    ];
+    let cost = |q: [i64; 2]| (q[0] - p[0]).abs() + (q[1] - p[1]).abs();
+    images
+        .into_iter()
+        .flatten()
+        .fold(t, |best, q| if cost(q) < cost(best) { q } else { best })
+}
+
+/// The code inside the square that a point outside it in one coordinate mirrors (a point inside
+/// is itself; one outside in both, which no encoder writes, is left for the range check).
+fn fold_into_square(q: [i64; 2], max: i64) -> [i64; 2] {
+    let mirror = |x: i64, to: i64| to.saturating_sub(x);
+    if q[0] > max {
+        [mirror(q[0], 2 * max), mirror(q[1], max)]
+    } else if q[0] < 0 {
+        [mirror(q[0], 0), mirror(q[1], max)]
+    } else if q[1] > max {
+        [mirror(q[0], max), mirror(q[1], 2 * max)]
+    } else if q[1] < 0 {
+        [mirror(q[0], max), mirror(q[1], 0)]
+    } else {
+        q
+    }
 }
 
 /// The uv at `at` by the affine map that fits the coarse chart of `chart` around vs: the
@@ -974,4 +987,25 @@ pub fn weld_face_values<T: Copy + Eq + std::hash::Hash>(
         })
         .collect();
     (corners, wedge_vertex, codes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{fold_into_square, nearest_image};
+
+    #[test]
+    fn a_code_taken_across_the_octahedral_square_s_edge_folds_back_to_itself() {
+        for max in [6i64, 254, 1022] {
+            for u in 0..=max {
+                for v in [0, 1, max / 2, max - 1, max] {
+                    for p in [[0, 0], [max, 3], [2, max], [max / 2, max / 2], [max, max]] {
+                        let image = nearest_image([u, v], p, max);
+                        assert_eq!(fold_into_square(image, max), [u, v], "{u} {v} {p:?}");
+                    }
+                }
+            }
+        }
+        // Near the right edge on the other side of the fold, the image is the nearer.
+        assert_eq!(nearest_image([1021, 900], [1022, 120], 1022), [1023, 122]);
+    }
 }
