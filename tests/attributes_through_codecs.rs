@@ -160,7 +160,6 @@ fn the_harness_codes_appearance_when_asked_and_measures_it_at_the_level_that_car
 /// forward again to the same appearance, and a cut or damaged stream is an error.
 #[test]
 fn pm_carries_appearance_at_every_level_with_either_rule() {
-    use meshcodec::codecs::pm::iter::PMeshIter;
     use meshcodec::codecs::AttributeFit;
     // dragon-res3 and the fuzz seed torus-fin.obj (a fin, and a quad turned over) are no
     // oriented manifolds: pm cuts them, and the last level welds and turns back the corners too.
@@ -198,19 +197,8 @@ fn pm_carries_appearance_at_every_level_with_either_rule() {
                     levels += 1;
                 }
                 assert!(levels > 1, "{what}");
-                let full = decoder.mesh().unwrap();
-                assert_eq!(
-                    appearance.check_lossless(
-                        &canonical,
-                        &full.mesh,
-                        full.attributes.as_ref().unwrap()
-                    ),
-                    Ok(()),
-                    "{what}"
-                );
-                let mut iter = PMeshIter::from_stream(&encoded.bytes).unwrap();
-                while iter.next().unwrap() {}
-                let end = iter.attributes().unwrap();
+                assert_full_level_lossless(&appearance, &canonical, decoder.as_ref(), &what);
+                let (mut iter, end) = at_the_full_level(&encoded.bytes);
                 iter.goto_nvertices(0).unwrap();
                 let base = iter.attributes().unwrap();
                 assert_eq!(base.corners.len(), iter.nfaces(), "{what}");
@@ -352,7 +340,7 @@ fn spot_with_creased_normals() -> meshcodec::mesh::attributes::AttributedMesh {
 /// geometry gives its groups, and the full level is the canonical mesh whose normals are derived.
 #[test]
 fn pm_derives_normals_from_geometry_and_codes_only_the_creases() {
-    use meshcodec::codecs::pm::iter::{Geomorph, PMeshIter};
+    use meshcodec::codecs::pm::iter::Geomorph;
     use meshcodec::codecs::AttributeFit;
     use meshcodec::mesh::attribute_quantization::octahedral_code;
     let mesh = spot_with_creased_normals();
@@ -433,17 +421,9 @@ fn pm_derives_normals_from_geometry_and_codes_only_the_creases() {
             levels += 1;
         }
         assert!(levels > 3, "{what}");
-        let full = decoder.mesh().unwrap();
-
-        assert_eq!(
-            appearance.check_lossless(&canonical, &full.mesh, full.attributes.as_ref().unwrap()),
-            Ok(()),
-            "{what}"
-        );
+        assert_full_level_lossless(&appearance, &canonical, decoder.as_ref(), what);
         // Back to the base mesh and forward again; a geomorph between two levels.
-        let mut iter = PMeshIter::from_stream(&encoded.bytes).unwrap();
-        while iter.next().unwrap() {}
-        let end = iter.attributes().unwrap();
+        let (mut iter, end) = at_the_full_level(&encoded.bytes);
         iter.goto_nvertices(0).unwrap();
         let base_vertices = iter.nvertices();
         let morph = Geomorph::new(&mut iter, base_vertices * 2).unwrap();
@@ -503,4 +483,33 @@ fn derived_normals_are_carried_as_values_by_the_other_codecs_and_pm_refuses_them
         Err(Error::Unsupported(why)) => assert!(why.contains("manifold"), "{why}"),
         other => panic!("{:?}", other.map(|e| e.bytes.len())),
     }
+}
+
+/// Checks that the level `decoder` stands at is the canonical mesh with its appearance.
+fn assert_full_level_lossless(
+    appearance: &meshcodec::mesh::canonical_attributes::CanonicalAttributes,
+    canonical: &meshcodec::mesh::CanonicalMesh,
+    decoder: &dyn codecs::LevelDecoder,
+    what: &str,
+) {
+    let full = decoder.mesh().unwrap();
+    let decoded = full.attributes.as_ref().expect("appearance decoded");
+    assert_eq!(
+        appearance.check_lossless(canonical, &full.mesh, decoded),
+        Ok(()),
+        "{what}"
+    );
+}
+
+/// A PMeshIter over `stream` moved to its full level, and that level's appearance.
+fn at_the_full_level(
+    stream: &[u8],
+) -> (
+    meshcodec::codecs::pm::iter::PMeshIter<'_>,
+    meshcodec::mesh::attributes::Attributes,
+) {
+    let mut iter = meshcodec::codecs::pm::iter::PMeshIter::from_stream(stream).unwrap();
+    while iter.next().unwrap() {}
+    let end = iter.attributes().unwrap();
+    (iter, end)
 }
