@@ -513,3 +513,60 @@ fn at_the_full_level(
     let end = iter.attributes().unwrap();
     (iter, end)
 }
+
+/// Derived normals on an open manifold: groups at boundary vertices, whose fans end at the hole.
+#[test]
+fn pm_derives_normals_on_a_mesh_with_a_hole() {
+    use meshcodec::codecs::AttributeFit;
+    use meshcodec::mesh::attributes::Attributes;
+    let mut mesh = spot_with_creased_normals();
+    // Cut a cap off the top: the faces whose corners all lie above the 95th percentile of y.
+    let positions = mesh.mesh.positions.clone();
+    let mut ys: Vec<f64> = positions.iter().map(|p| p.y).collect();
+    ys.sort_by(f64::total_cmp);
+    let cut = ys[ys.len() * 95 / 100];
+    let keep: Vec<usize> = (0..mesh.mesh.faces.len())
+        .filter(|&f| {
+            !mesh.mesh.faces[f]
+                .iter()
+                .all(|&v| positions[v as usize].y > cut)
+        })
+        .collect();
+    assert!(keep.len() < mesh.mesh.faces.len());
+    let old = mesh.attributes.clone();
+    let faces: Vec<[u32; 3]> = keep.iter().map(|&f| mesh.mesh.faces[f]).collect();
+    let corners: Vec<[meshcodec::mesh::attributes::Corner; 3]> = keep
+        .iter()
+        .map(|&f| {
+            std::array::from_fn(|k| meshcodec::mesh::attributes::Corner {
+                normal: old.normals.as_ref().map(|n| n[old.corners[f][k] as usize]),
+                uv: old.uvs.as_ref().map(|t| t[old.corners[f][k] as usize]),
+                colour: None,
+            })
+        })
+        .collect();
+    mesh.mesh.faces = faces;
+    mesh.attributes = Attributes::weld(&mesh.mesh.faces, &corners).unwrap();
+    let codec = codecs::by_name("pm-reordered").unwrap();
+    let derived = AttributeBits {
+        derive_normals: true,
+        ..AttributeBits::default()
+    };
+    let (canonical, appearance) =
+        codecs::canonical_attributed_for(&mesh, &codec.default_options(), derived).unwrap();
+    let encoded = codecs::encode_attributed_with(
+        codec,
+        &canonical,
+        Some(&appearance),
+        Some(AttributeFit::Keep),
+    )
+    .unwrap();
+    let mut decoder = codecs::open(&encoded.bytes).unwrap();
+    while decoder.advance().unwrap() {}
+    assert_full_level_lossless(
+        &appearance,
+        &canonical,
+        decoder.as_ref(),
+        "spot with a hole",
+    );
+}
