@@ -8,6 +8,9 @@ use meshcodec::mesh::attribute_quantization::AttributeBits;
 use meshcodec::mesh::io::{read_attributed, resolve};
 use meshcodec::Error;
 
+mod common;
+use common::spot_with_creased_normals;
+
 const MESHES: [&str; 4] = [
     "bunny-10k-textured",
     "spot",
@@ -290,49 +293,6 @@ fn a_pm_geomorph_carries_appearance_from_the_coarse_corners_to_the_fine_ones() {
         let (a, b) = (at0.uvs.as_ref().unwrap()[w], at1.uvs.as_ref().unwrap()[w]);
         assert!((*uv - (a + b) * 0.5).length() < 1e-12);
     }
-}
-
-/// spot with its uvs and normals that are smooth on most of it and flat (a crease at every edge)
-/// on a sixth: normal groups of every shape, crossing the uv seams.
-fn spot_with_creased_normals() -> meshcodec::mesh::attributes::AttributedMesh {
-    use glam::DVec3;
-    use meshcodec::mesh::attributes::{Attributes, Corner};
-    let mut spot = read_attributed(&resolve("spot").unwrap()).unwrap();
-    let (positions, faces) = (&spot.mesh.positions, &spot.mesh.faces);
-    let face_normal = |f: &[u32; 3]| {
-        let p = f.map(|v| positions[v as usize]);
-        (p[1] - p[0]).cross(p[2] - p[0])
-    };
-    let mut smooth = vec![DVec3::ZERO; positions.len()];
-    for f in faces {
-        for &v in f {
-            smooth[v as usize] += face_normal(f);
-        }
-    }
-    // Flat on the sixth of the faces furthest along +x (a crease at every edge pins vertices).
-    let centroid_x = |f: &[u32; 3]| f.iter().map(|&v| positions[v as usize].x).sum::<f64>();
-    let mut xs: Vec<f64> = faces.iter().map(centroid_x).collect();
-    xs.sort_by(f64::total_cmp);
-    let threshold = xs[xs.len() * 5 / 6];
-    let old = &spot.attributes;
-    let corners: Vec<[Corner; 3]> = faces
-        .iter()
-        .enumerate()
-        .map(|(i, f)| {
-            let flat = centroid_x(f) > threshold;
-            std::array::from_fn(|k| Corner {
-                normal: Some(if flat {
-                    face_normal(f)
-                } else {
-                    smooth[f[k] as usize]
-                }),
-                uv: old.uvs.as_ref().map(|t| t[old.corners[i][k] as usize]),
-                colour: None,
-            })
-        })
-        .collect();
-    spot.attributes = Attributes::weld(faces, &corners).unwrap();
-    spot
 }
 
 /// Normals derived from geometry (`--derive-normals`, Hoppe 1998's Table 4 mode): pm codes no

@@ -12,6 +12,9 @@
 //!   its uvs (12-bit positions and uvs): the appearance unit's bytes are pinned too, and the
 //!   stream must decode to the canonical mesh with its appearance exactly.
 //!
+//! - `tests/golden/v<FORMAT_VERSION>/` pins `pm-reordered` with the appearance in its splits:
+//!   spot's uvs, vw-beetle's normals predicted from geometry, and spot's creased normals derived.
+//!
 //! Both are regenerated on purpose with `UPDATE_GOLDEN=1 cargo test --release --test golden`,
 //! which a change of syntax must come with (and a new format version: docs/FORMAT.md, History).
 
@@ -22,6 +25,8 @@ use meshcodec::mesh::{CanonicalMesh, TriMesh};
 use meshcodec::Error;
 use std::fmt::Write as _;
 use std::path::PathBuf;
+
+mod common;
 
 /// Small shared meshes every codec takes: a closed genus-2 surface and a bust of three
 /// components.
@@ -198,15 +203,23 @@ fn appearance_golden(
     version: u8,
     file: &str,
 ) {
+    let original = meshcodec::mesh::io::read_attributed(&resolve(mesh).unwrap()).unwrap();
+    let bits = meshcodec::mesh::attribute_quantization::AttributeBits::default();
+    appearance_golden_of(codec, &original, bits, fit, version, file);
+}
+
+/// [`appearance_golden`] of a mesh in memory, its appearance quantized by `bits`.
+fn appearance_golden_of(
+    codec: &str,
+    original: &meshcodec::mesh::attributes::AttributedMesh,
+    bits: meshcodec::mesh::attribute_quantization::AttributeBits,
+    fit: Option<codecs::AttributeFit>,
+    version: u8,
+    file: &str,
+) {
     let codec = codecs::by_name(codec).unwrap();
-    let path = resolve(mesh).unwrap();
-    let original = meshcodec::mesh::io::read_attributed(&path).unwrap();
-    let (canonical, appearance) = codecs::canonical_attributed_for(
-        &original,
-        &codec.default_options(),
-        meshcodec::mesh::attribute_quantization::AttributeBits::default(),
-    )
-    .unwrap();
+    let (canonical, appearance) =
+        codecs::canonical_attributed_for(original, &codec.default_options(), bits).unwrap();
     let bytes = codecs::encode_attributed_with(codec, &canonical, Some(&appearance), fit)
         .unwrap()
         .bytes;
@@ -260,6 +273,35 @@ fn the_golden_stream_with_appearance_in_pm_splits_is_reproduced_and_decodes_exac
         Some(codecs::AttributeFit::Fit),
         FORMAT_VERSION,
         "pm-reordered-spot-appearance-fit.mc",
+    );
+}
+
+/// Normals in pm's splits, both ways (docs/FORMAT.md §6.1): predicted from the geometry of
+/// their vertex's faces (flag 64) on vw-beetle.obj, a mesh pm cuts to a manifold; and derived
+/// from the positions over their groups (flag 32) on spot with creased normals.
+#[test]
+fn the_golden_streams_with_normals_in_pm_splits_are_reproduced_and_decode_exactly() {
+    use meshcodec::mesh::attribute_quantization::AttributeBits;
+    let beetle = meshcodec::mesh::io::read_attributed(&resolve("vw-beetle").unwrap()).unwrap();
+    appearance_golden_of(
+        "pm-reordered",
+        &beetle,
+        AttributeBits::default(),
+        Some(codecs::AttributeFit::Keep),
+        FORMAT_VERSION,
+        "pm-reordered-vw-beetle-normals-keep.mc",
+    );
+    let derived = AttributeBits {
+        derive_normals: true,
+        ..AttributeBits::default()
+    };
+    appearance_golden_of(
+        "pm-reordered",
+        &common::spot_with_creased_normals(),
+        derived,
+        Some(codecs::AttributeFit::Keep),
+        FORMAT_VERSION,
+        "pm-reordered-spot-creased-derived-normals-keep.mc",
     );
 }
 

@@ -65,3 +65,49 @@ pub fn walk_without_cracks(bytes: &[u8], every_split: bool) -> usize {
     }
     groups.iter().map(Vec::len).sum()
 }
+
+/// spot with its uvs and normals that are smooth on most of it and flat (a crease at every edge)
+/// on a sixth: normal groups of every shape, crossing the uv seams.
+#[allow(dead_code)]
+pub fn spot_with_creased_normals() -> meshcodec::mesh::attributes::AttributedMesh {
+    use glam::DVec3;
+    use meshcodec::mesh::attributes::{Attributes, Corner};
+    let mut spot =
+        meshcodec::mesh::io::read_attributed(&meshcodec::mesh::io::resolve("spot").unwrap())
+            .unwrap();
+    let (positions, faces) = (&spot.mesh.positions, &spot.mesh.faces);
+    let face_normal = |f: &[u32; 3]| {
+        let p = f.map(|v| positions[v as usize]);
+        (p[1] - p[0]).cross(p[2] - p[0])
+    };
+    let mut smooth = vec![DVec3::ZERO; positions.len()];
+    for f in faces {
+        for &v in f {
+            smooth[v as usize] += face_normal(f);
+        }
+    }
+    // Flat on the sixth of the faces furthest along +x (a crease at every edge pins vertices).
+    let centroid_x = |f: &[u32; 3]| f.iter().map(|&v| positions[v as usize].x).sum::<f64>();
+    let mut xs: Vec<f64> = faces.iter().map(centroid_x).collect();
+    xs.sort_by(f64::total_cmp);
+    let threshold = xs[xs.len() * 5 / 6];
+    let old = &spot.attributes;
+    let corners: Vec<[Corner; 3]> = faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| {
+            let flat = centroid_x(f) > threshold;
+            std::array::from_fn(|k| Corner {
+                normal: Some(if flat {
+                    face_normal(f)
+                } else {
+                    smooth[f[k] as usize]
+                }),
+                uv: old.uvs.as_ref().map(|t| t[old.corners[i][k] as usize]),
+                colour: None,
+            })
+        })
+        .collect();
+    spot.attributes = Attributes::weld(faces, &corners).unwrap();
+    spot
+}
