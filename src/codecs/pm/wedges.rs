@@ -307,9 +307,28 @@ struct Corner<'a> {
     labels: Vec<u32>,
     /// Whether the encoder runs (its values are true).
     encoding: bool,
-    /// The normal the corner's vertex has by its faces after the split, when normals are
-    /// predicted from geometry.
-    geometric: Option<DVec3>,
+    /// The mesh after the split, the corner's vertex and one of its faces: what predicts a new
+    /// normal when normals are predicted from geometry ([`Corner::geometric_normal`]).
+    mesh: &'a PmMesh,
+    vertex: u32,
+    face: u32,
+}
+
+impl Corner<'_> {
+    /// The angle-weighted normal of the corner's vertex's faces after the split (zero when they
+    /// have no area); computed only for a new value, which is when it predicts.
+    fn geometric_normal(&self) -> DVec3 {
+        let mesh = self.mesh;
+        vertex_normal_by_angles(
+            mesh.fan(self.face, self.vertex)
+                .into_iter()
+                .filter_map(|g| {
+                    let face = mesh.faces[g as usize].v;
+                    let k = face.iter().position(|&v| v == self.vertex)?;
+                    Some([0, 1, 2].map(|i| point(mesh.positions[face[(k + i) % 3] as usize])))
+                }),
+        )
+    }
 }
 
 /// Codes the wedges of the split that just applied to `mesh` (whose state before it `coarse`
@@ -414,16 +433,6 @@ fn code_split_fields(
         }
         pool
     };
-    // With normals predicted from geometry: the normal of a vertex's faces after the split.
-    let geometric = |faces: &[u32], at: u32| -> Option<DVec3> {
-        spec.geometric_normals.then(|| {
-            vertex_normal_by_angles(faces.iter().filter_map(|&g| {
-                let face = mesh.faces[g as usize].v;
-                let k = face.iter().position(|&v| v == at)?;
-                Some([0, 1, 2].map(|i| point(mesh.positions[face[(k + i) % 3] as usize])))
-            }))
-        })
-    };
     // Faces vs keeps, then faces that moved to vt.
     let fan_s: Vec<u32> = mesh.fan(fl, vs);
     let fan_t: Vec<u32> = mesh.fan(fl, vt);
@@ -452,7 +461,9 @@ fn code_split_fields(
                 coarse,
                 labels: pool_with(known),
                 encoding,
-                geometric: geometric(fan, v),
+                mesh,
+                vertex: v,
+                face: fl,
             };
             let value = code_corner(symbols, contexts, spec, &corner, truth_of(g).0[k])?;
             if !map.iter().any(|x| x.0 == c) {
@@ -537,13 +548,9 @@ fn code_split_fields(
                 coarse,
                 labels,
                 encoding,
-                geometric: if v == vs {
-                    geometric(&fan_s, v)
-                } else if v == vt {
-                    geometric(&fan_t, v)
-                } else {
-                    geometric(&mesh.fan(f, v), v)
-                },
+                mesh,
+                vertex: v,
+                face: if v == other { f } else { fl },
             };
             let value = code_corner(symbols, contexts, spec, &corner, truth_codes[k])?;
             state.corners[f as usize][k] = value;
@@ -672,7 +679,8 @@ fn code_corner(
         predicted.uv = Some(fitted);
     }
     // A normal is predicted by its vertex's faces, when the stream says so and they have area.
-    if let (Some(bits), Some(n)) = (spec.normal_bits, corner.geometric) {
+    if let (Some(bits), true) = (spec.normal_bits, spec.geometric_normals) {
+        let n = corner.geometric_normal();
         if n != DVec3::ZERO {
             predicted.normal = Some(octahedral_code(n, bits));
         }
