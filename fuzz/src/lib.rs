@@ -269,6 +269,7 @@ pub fn read_as(format: &str, bytes: &[u8]) {
         .attributes
         .validate(&attributed.mesh)
         .expect("wedges the reader accepted");
+    derive_normals_of(&attributed);
     for out in ["ply", "obj", "glb"] {
         let Ok(written) = io::write_attributed_bytes(&attributed, out) else {
             continue;
@@ -281,6 +282,35 @@ pub fn read_as(format: &str, bytes: &[u8]) {
             assert!(back == attributed, "ply changed the attributed mesh");
         }
     }
+}
+
+/// The canonical mesh of a mesh with normals, its normals derived from the positions over its
+/// normal groups (docs/CONTRACT.md §2.1): built without a panic, its wedges valid and its own
+/// appearance lossless against it.
+fn derive_normals_of(attributed: &meshcodec::mesh::attributes::AttributedMesh) {
+    if attributed.attributes.normals.is_none() || attributed.mesh.faces.len() > 4096 {
+        return;
+    }
+    let options = EncodeOptions {
+        quant_bits: 10,
+        grid: GridShape::Cubic,
+    };
+    let bits = meshcodec::mesh::attribute_quantization::AttributeBits {
+        derive_normals: true,
+        ..Default::default()
+    };
+    let Ok((canonical, appearance)) = codecs::canonical_attributed_for(attributed, &options, bits)
+    else {
+        return;
+    };
+    let mesh = canonical.to_mesh();
+    let values = appearance.to_attributes();
+    values.validate(&mesh).expect("derived normals' wedges");
+    assert_eq!(
+        appearance.check_lossless(&canonical, &mesh, &values),
+        Ok(()),
+        "the canonical mesh with derived normals is not itself"
+    );
 }
 
 /// One edit of a valid stream.
