@@ -425,8 +425,10 @@ def level_ends(stream: Bytes) -> List[int]:
 
 def info(stream: Bytes) -> Dict[str, Any]:
     """What a stream's header and index say, without decoding it: codec, format version,
-    quantization grid, vertex and triangle counts, levels and the bytes each needs, and every
-    unit (for CAME: every meta-node) with its parent and byte range."""
+    quantization grid, vertex and triangle counts, levels and the bytes each needs, every unit
+    (for CAME: every meta-node) with its parent and byte range, and ``appearance``: None, or
+    what the stream carries (normal_bits, normals "coded", "predicted" from geometry or
+    "derived" from it, uv_bits, colours, materials, in_levels)."""
     return _core.info(_stream(stream))
 
 

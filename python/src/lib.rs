@@ -607,6 +607,33 @@ fn info<'py>(py: Python<'py>, stream: &[u8]) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("payload_start", start)?;
     d.set_item("layered", index.is_layered())?;
     d.set_item("units", units)?;
+    // What appearance the stream carries, and how its normals travel.
+    let appearance = match &header.appearance {
+        None => None,
+        Some(spec) => {
+            let a = PyDict::new(py);
+            a.set_item("normal_bits", spec.normal_bits)?;
+            let normals = spec.normal_bits.map(|_| {
+                if spec.derived_normals {
+                    "derived"
+                } else if spec.geometric_normals {
+                    "predicted"
+                } else {
+                    "coded"
+                }
+            });
+            a.set_item("normals", normals)?;
+            a.set_item("uv_bits", spec.uv_grid.map(|g| g.bits))?;
+            a.set_item("colours", spec.colours)?;
+            a.set_item(
+                "materials",
+                spec.materials.as_ref().map(|m| m.names.clone()),
+            )?;
+            a.set_item("in_levels", spec.in_levels)?;
+            Some(a)
+        }
+    };
+    d.set_item("appearance", appearance)?;
     Ok(d)
 }
 

@@ -171,6 +171,7 @@ def test_info_reads_the_header_and_index():
     about = meshcodec.info(stream)
     assert about["codec"] == "came" and about["quant_bits"] == 14
     assert about["format_version"] == 2  # geometry alone; a stream with an appearance unit is APPEARANCE_UNIT_VERSION
+    assert about["appearance"] is None
     assert about["bytes"] == about["stream_bytes"] == len(stream)
     assert not about["layered"] and not about["truncated"]
     units = about["units"]
@@ -286,6 +287,9 @@ def test_pm_derives_normals_from_geometry_when_asked():
                                attributes="keep", derive_normals=True)
     # No normal value in the splits: a smaller stream, every level with normals.
     assert len(derived) < 0.8 * len(coded)
+    assert meshcodec.info(derived)["appearance"]["normals"] == "derived"
+    assert meshcodec.info(coded)["appearance"]["normals"] == "predicted"
+    assert meshcodec.info(coded)["appearance"]["in_levels"]
     levels = list(meshcodec.levels(derived))
     assert len(levels) > 3 and all(l.appearance.normals is not None for l in levels)
 
