@@ -94,6 +94,22 @@ pub struct AppearanceSpec {
     pub geometric_normals: bool,
 }
 
+impl AppearanceSpec {
+    /// How the stream's normals travel: "derived" (each level derives them from its positions
+    /// over the normal groups), "predicted" (values predicted from the geometry of their
+    /// vertex's faces), "coded" (values), or `None` without normals.
+    pub fn normal_mode(&self) -> Option<&'static str> {
+        self.normal_bits?;
+        Some(if self.derived_normals {
+            "derived"
+        } else if self.geometric_normals {
+            "predicted"
+        } else {
+            "coded"
+        })
+    }
+}
+
 /// Material names and the library they come from.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct MaterialNames {

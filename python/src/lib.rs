@@ -613,16 +613,7 @@ fn info<'py>(py: Python<'py>, stream: &[u8]) -> PyResult<Bound<'py, PyDict>> {
         Some(spec) => {
             let a = PyDict::new(py);
             a.set_item("normal_bits", spec.normal_bits)?;
-            let normals = spec.normal_bits.map(|_| {
-                if spec.derived_normals {
-                    "derived"
-                } else if spec.geometric_normals {
-                    "predicted"
-                } else {
-                    "coded"
-                }
-            });
-            a.set_item("normals", normals)?;
+            a.set_item("normals", spec.normal_mode())?;
             a.set_item("uv_bits", spec.uv_grid.map(|g| g.bits))?;
             a.set_item("colours", spec.colours)?;
             a.set_item(

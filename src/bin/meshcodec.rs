@@ -550,7 +550,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
         let entry = reader.index().appearance;
         serde_json::json!({
             "normal_bits": spec.normal_bits,
-            "normals": normal_mode(spec),
+            "normals": spec.normal_mode(),
             "uv_bits": spec.uv_grid.map(|g| g.bits),
             "uv_origin": spec.uv_grid.map(|g| g.origin),
             "uv_cell": spec.uv_grid.map(|g| g.cell),
@@ -656,7 +656,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
     if let Some(spec) = &header.appearance {
         let mut carried = Vec::new();
         if let Some(bits) = spec.normal_bits {
-            let mode = match normal_mode(spec) {
+            let mode = match spec.normal_mode() {
                 Some("derived") => ", derived from the positions over their groups",
                 Some("predicted") => ", predicted from the geometry of their vertex's faces",
                 _ => "",
@@ -852,18 +852,4 @@ fn distance(
         );
     }
     Ok(())
-}
-
-/// How a stream's normals travel: "derived" (each level derives them from its positions over
-/// the normal groups), "predicted" (values predicted from the geometry of their vertex's faces),
-/// "coded" (values), or none.
-fn normal_mode(spec: &meshcodec::container::AppearanceSpec) -> Option<&'static str> {
-    spec.normal_bits?;
-    Some(if spec.derived_normals {
-        "derived"
-    } else if spec.geometric_normals {
-        "predicted"
-    } else {
-        "coded"
-    })
 }

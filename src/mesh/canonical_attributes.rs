@@ -267,19 +267,8 @@ fn derive_corner_normals(canonical: &CanonicalMesh, codes: &mut [[CornerCode; 3]
         .map(|c| c.map(|c| c.normal.unwrap_or_default()))
         .collect();
     loop {
-        let mut label: HashMap<(VertexId, [u32; 2]), u32> = HashMap::new();
-        let group: Vec<[u32; 3]> = canonical
-            .faces
-            .iter()
-            .zip(&key)
-            .map(|(face, key)| {
-                std::array::from_fn(|k| {
-                    let next = label.len() as u32;
-                    *label.entry((face[k], key[k])).or_insert(next)
-                })
-            })
-            .collect();
-        let groups = label.len();
+        let (group, groups) =
+            super::derived_normals::groups_by_key(&canonical.faces, key.iter().copied());
         let derived = super::derived_normals::group_normal_codes(
             &canonical.faces,
             &group,
@@ -288,15 +277,14 @@ fn derive_corner_normals(canonical: &CanonicalMesh, codes: &mut [[CornerCode; 3]
             canonical.grid.cell,
             bits,
         );
-        let merged: std::collections::HashSet<(VertexId, [u32; 2])> = label
-            .iter()
-            .map(|(&(v, _), &g)| (v, derived[g as usize]))
-            .collect();
         key = group
             .iter()
             .map(|g| g.map(|g| derived[g as usize]))
             .collect();
-        if merged.len() == groups {
+        // Groups of one vertex whose codes came out equal are one group now.
+        let (_, merged) =
+            super::derived_normals::groups_by_key(&canonical.faces, key.iter().copied());
+        if merged == groups {
             break;
         }
     }

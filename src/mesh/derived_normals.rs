@@ -53,6 +53,28 @@ pub fn group_normal_codes(
         .collect()
 }
 
+/// The normal groups of corners keyed by `keys` (one a corner, face by face): the corners of
+/// one vertex with one key are a group. Returns each corner's group, groups numbered in order of
+/// first corner, and their count.
+pub fn groups_by_key<K: Copy + Eq + std::hash::Hash>(
+    faces: &[[u32; 3]],
+    keys: impl IntoIterator<Item = [K; 3]>,
+) -> (Vec<[u32; 3]>, usize) {
+    let mut group_of: std::collections::HashMap<(u32, K), u32> =
+        std::collections::HashMap::with_capacity(faces.len() * 3 / 2);
+    let group = faces
+        .iter()
+        .zip(keys)
+        .map(|(face, key)| {
+            std::array::from_fn(|k| {
+                let next = group_of.len() as u32;
+                *group_of.entry((face[k], key[k])).or_insert(next)
+            })
+        })
+        .collect();
+    (group, group_of.len())
+}
+
 /// The cross product of a triangle's edges in cell units (exact: cells fit in 25 bits).
 fn cell_cross(p: [[i32; 3]; 3]) -> [i64; 3] {
     let d = |a: [i32; 3], b: [i32; 3]| [0, 1, 2].map(|i| b[i] as i64 - a[i] as i64);

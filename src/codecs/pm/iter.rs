@@ -490,35 +490,22 @@ fn derive_normals(
     grid: &Grid,
     bits: u8,
 ) {
-    let mut group_of: std::collections::HashMap<(u32, u32), u32> =
-        std::collections::HashMap::with_capacity(codes.len());
-    let wedge_group: Vec<u32> = wedge_vertex
-        .iter()
-        .zip(codes.iter())
-        .map(|(&v, &c)| {
-            let next = group_of.len() as u32;
-            *group_of.entry((v, wedges::label_of(c))).or_insert(next)
-        })
-        .collect();
+    use crate::mesh::derived_normals::{group_normal_codes, groups_by_key};
     let faces: Vec<[u32; 3]> = corners
         .iter()
         .map(|c| c.map(|w| wedge_vertex[w as usize]))
         .collect();
-    let group: Vec<[u32; 3]> = corners
+    let labels = corners
         .iter()
-        .map(|c| c.map(|w| wedge_group[w as usize]))
-        .collect();
+        .map(|c| c.map(|w| wedges::label_of(codes[w as usize])));
+    let (group, groups) = groups_by_key(&faces, labels);
     let cell = |v: u32| cells.get(v as usize).copied().unwrap_or_default();
-    let normals = crate::mesh::derived_normals::group_normal_codes(
-        &faces,
-        &group,
-        group_of.len(),
-        cell,
-        grid.cell,
-        bits,
-    );
-    for (code, g) in codes.iter_mut().zip(wedge_group) {
-        code.normal = Some(normals[g as usize]);
+    let normals = group_normal_codes(&faces, &group, groups, cell, grid.cell, bits);
+    // A wedge's corners share its vertex and label, so any of them names its group.
+    for (wedges, group) in corners.iter().zip(&group) {
+        for (&w, &g) in wedges.iter().zip(group) {
+            codes[w as usize].normal = Some(normals[g as usize]);
+        }
     }
 }
 
