@@ -177,3 +177,59 @@ fn decoding_stops_after_any_pass_of(codec: &str) {
         }
     }
 }
+
+/// `emc` shows every vertex of an intermediate level inside its own cell of that level (where
+/// its neighbours predict it), and from the level that decodes the last vertex on, the mesh's
+/// own faces (its face corrections follow that level).
+#[test]
+fn emc_levels_show_vertices_in_their_cells_and_the_mesh_faces_once_all_are_decoded() {
+    use meshcodec::mesh::canonical::rotate_to_smallest;
+    let faces = |level: &LevelMesh| {
+        let mut faces: Vec<_> = level
+            .mesh
+            .faces
+            .iter()
+            .map(|&f| rotate_to_smallest(f))
+            .collect();
+        faces.sort_unstable();
+        faces
+    };
+    let mut settled_before_the_last = 0;
+    for (seed, per_axis) in [(3, false), (8, true), (21, false), (34, false)] {
+        let (canonical, encoded) = encode("emc", seed, 12, per_axis).unwrap();
+        let (full, _) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
+        let grid = canonical.grid;
+        let cells: Vec<[u32; 3]> = full
+            .mesh
+            .positions
+            .iter()
+            .map(|&p| grid.quantize(p))
+            .collect();
+        let mut decoder = codecs::open(&encoded.bytes).unwrap();
+        let mut moved = 0;
+        for level in 1..=12u32 {
+            assert!(decoder.advance().unwrap());
+            let shown = decoder.mesh().unwrap();
+            let shift = 12 - level;
+            for (v, &p) in shown.mesh.positions.iter().enumerate() {
+                let cell = grid.quantize(p).map(|c| c >> shift);
+                assert_eq!(
+                    cell,
+                    cells[v].map(|c| c >> shift),
+                    "seed {seed} level {level} vertex {v}"
+                );
+                let centre = grid.coarse_centre(cell, [shift as u8; 3]);
+                moved += (p != centre) as usize;
+            }
+            if shown.mesh.vertex_count() == canonical.vertex_count() {
+                assert_eq!(faces(&shown), faces(&full), "seed {seed} level {level}");
+                settled_before_the_last += (level < 12) as usize;
+            }
+        }
+        assert!(
+            moved > 0,
+            "seed {seed}: no vertex shown off its cell's centre"
+        );
+    }
+    assert!(settled_before_the_last > 0);
+}

@@ -853,12 +853,89 @@ pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
         }
         let _ = writeln!(md);
     }
+    intermediate_levels(results, &mut md)?;
     let _ = writeln!(md, "Connectivity and geometry of our arithmetic-coded streams are split in proportion to the coder's own estimate of each class's bits; `emc` books the split and leaf questions (which cells are occupied) as geometry, the edge questions and the face corrections as connectivity, as the paper books split distances and edge codes.\n");
     let _ = writeln!(md, "Rate-distortion on bunny.ply (every level of the progressive coders, Draco at quantization 8 to 16): [emc-rate-distortion.png](emc-rate-distortion.png). The valence-driven coder's curve is MEPP2's Compression_Valence (commit d977d05, adaptive quantization on, 12 bits, base mesh of at most 100 vertices) measured on this bunny outside the project, read from `../shared/anchors/{VALENCE_ANCHOR}` (its provenance and how each level's bits and errors were measured are in that file).");
     std::fs::create_dir_all(out)?;
     let path = out.join("emc-vs-anchors.md");
     std::fs::write(&path, md)?;
     Ok(path)
+}
+
+/// The section of emc-vs-anchors.md that compares every level of `emc` with `pm`'s and the
+/// valence-driven coder's RMS error at the same cumulative bits (interpolated on log–log axes
+/// between their levels, where both have levels on either side).
+fn intermediate_levels(results: &Path, md: &mut String) -> Result<()> {
+    let _ = writeln!(md, "## Intermediate levels: RMS error at the same bits\n");
+    let _ = writeln!(md, "Each level of `emc` at 12 bits beside `pm`'s and the valence-driven coder's RMS error at the same cumulative bits, interpolated on log–log axes between their own levels (blank where they have no level on one side). RMS is relative to the bounding box's diagonal, both ways between the level and the original (docs/CONTRACT.md §5). `emc` shows each vertex where its neighbours predict it inside its cell (`codecs::emc::modelled::placement`; BENCHMARKS.md compares it with the cell centres). The target of the last column: `emc`'s RMS no higher than the lower of the others'.\n");
+    let valence = valence_anchor()?;
+    let rms_points = |r: &RunResult| -> Vec<(f64, f64)> {
+        r.levels
+            .iter()
+            .filter_map(|l| Some((l.bits as f64, l.rms?)))
+            .filter(|&(_, rms)| rms > 0.0)
+            .collect()
+    };
+    for mesh in ["bunny", "armadillo-43k"] {
+        let emc = load_at(results, "emc", mesh, 12)?;
+        let pm = rms_points(&load_at(results, "pm", mesh, 12)?);
+        let others: Vec<(&str, Vec<(f64, f64)>)> = if mesh == "bunny" {
+            vec![("pm", pm), ("valence coder", valence.rms.clone())]
+        } else {
+            vec![("pm", pm)]
+        };
+        let _ = writeln!(md, "### {mesh}\n");
+        let mut head = "| level | bits/vertex | `emc` RMS |".to_string();
+        let mut rule = "|---:|---:|---:|".to_string();
+        for (name, _) in &others {
+            head += &format!(" {name} |");
+            rule += "---:|";
+        }
+        let _ = writeln!(md, "{head} `emc` / lower | met |\n{rule}---:|---|");
+        let v = emc.vertices as f64;
+        for level in &emc.levels {
+            let (Some(rms), x) = (level.rms, level.bits as f64) else {
+                continue;
+            };
+            let theirs: Vec<Option<f64>> = others
+                .iter()
+                .map(|(_, points)| log_log_interpolate(points, x))
+                .collect();
+            let lower = theirs.iter().flatten().copied().reduce(f64::min);
+            let mut row = format!("| {} | {:.3} | {rms:.3e} |", level.level, x / v);
+            for t in &theirs {
+                row += &format!(" {} |", t.map_or(String::new(), |t| format!("{t:.3e}")));
+            }
+            let (ratio, met) = match lower {
+                Some(lower) if rms > 0.0 => (
+                    format!("{:.2}", rms / lower),
+                    if rms <= lower { "yes" } else { "**no**" },
+                ),
+                _ => (String::new(), ""),
+            };
+            let _ = writeln!(md, "{row} {ratio} | {met} |");
+        }
+        let _ = writeln!(md);
+    }
+    Ok(())
+}
+
+/// `points`' y at `x`, interpolated on log–log axes between the two points around it (sorted by
+/// x); `None` outside their range.
+fn log_log_interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
+    let mut sorted = points.to_vec();
+    sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    sorted.windows(2).find_map(|w| {
+        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
+        if !(x0 <= x && x <= x1 && x0 > 0.0 && y0 > 0.0 && y1 > 0.0) {
+            return None;
+        }
+        if x1 == x0 {
+            return Some(y0.min(y1));
+        }
+        let t = (x / x0).ln() / (x1 / x0).ln();
+        Some((y0.ln() + t * (y1 / y0).ln()).exp())
+    })
 }
 
 /// The anchor file of the valence-driven coder's levels on bunny.ply (measured outside the
@@ -873,6 +950,8 @@ struct ValenceAnchor {
     commit: String,
     /// (cumulative bits, Hausdorff) per level.
     levels: Vec<(f64, f64)>,
+    /// (cumulative bits, RMS) per level.
+    rms: Vec<(f64, f64)>,
 }
 
 /// Folders the anchor files are looked up in: `$MESHCODEC_ANCHORS`, then `anchors` beside each
@@ -911,13 +990,24 @@ fn valence_anchor() -> Result<ValenceAnchor> {
         .collect::<Option<Vec<_>>>()
         .filter(|l| !l.is_empty())
         .ok_or_else(|| bad("a level without bits or hausdorff_relative"))?;
+    let rms = json["levels"]
+        .as_array()
+        .ok_or_else(|| bad("no levels"))?
+        .iter()
+        .map(|l| Some((l["bits"].as_f64()?, l["rms_relative"].as_f64()?)))
+        .collect::<Option<Vec<_>>>()
+        .ok_or_else(|| bad("a level without bits or rms_relative"))?;
     let commit = json["commit"]
         .as_str()
         .unwrap_or("?")
         .chars()
         .take(7)
         .collect();
-    Ok(ValenceAnchor { commit, levels })
+    Ok(ValenceAnchor {
+        commit,
+        levels,
+        rms,
+    })
 }
 
 /// Writes paper-tables/emc-rate-distortion.{png,svg}: bits against Hausdorff error on bunny.ply

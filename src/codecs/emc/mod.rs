@@ -48,12 +48,23 @@ use crate::error::{Error, Result};
 use crate::hierarchy::octree::{axes_by_extent, StepOrder};
 use crate::mesh::CanonicalMesh;
 
-/// Parameters stored in the header: the syntax (which coder) and the axis order.
+/// Parameters stored in the header: the syntax (which coder), the axis order and, for `emc`,
+/// where the face corrections are coded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EmcParams {
     /// Levels and axis order.
     pub order: StepOrder,
+    /// The face corrections follow the first level after which every vertex is decoded (the
+    /// edge graph is final from then on), so that the levels after it show the mesh's own
+    /// faces; else they follow the last level, as the paper codes them. `emc` writes the
+    /// former (a fifth parameter byte, 1); `emc-paper`, and `emc` streams written before it,
+    /// the latter (four bytes).
+    pub faces_when_settled: bool,
 }
+
+/// The fifth parameter byte of an `emc` stream whose face corrections follow the level that
+/// decodes the last vertex.
+const FACES_WHEN_SETTLED: u8 = 1;
 
 /// Which of the two syntaxes a stream uses (first parameter byte).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -65,22 +76,28 @@ pub enum Syntax {
 }
 
 impl EmcParams {
-    /// The parameters for `mesh`: as many levels as quantization bits, axes by extent.
-    pub fn for_mesh(mesh: &CanonicalMesh) -> EmcParams {
+    /// The parameters for `mesh` in `syntax`: as many levels as quantization bits, axes by
+    /// extent.
+    pub fn for_mesh(mesh: &CanonicalMesh, syntax: Syntax) -> EmcParams {
         EmcParams {
             order: StepOrder {
                 levels: mesh.grid.bits,
                 axes: axes_by_extent(extent_of(mesh)),
             },
+            faces_when_settled: syntax == Syntax::Modelled,
         }
     }
 
     /// The header that a stream of `mesh` in `syntax` starts with.
     pub fn header(&self, syntax: Syntax, codec_id: u8, mesh: &CanonicalMesh) -> Header {
         let [a, b, c] = self.order.axes;
+        let mut params = vec![syntax as u8, a, b, c];
+        if self.faces_when_settled {
+            params.push(FACES_WHEN_SETTLED);
+        }
         Header {
             codec_id,
-            params: vec![syntax as u8, a, b, c],
+            params,
             grid: mesh.grid,
             vertices: mesh.vertex_count() as u64,
             triangles: mesh.face_count() as u64,
@@ -94,7 +111,12 @@ impl EmcParams {
         let header = stream.header();
         let bad = |what: &str| Error::malformed(0, 6, what);
         let p = &header.params;
-        if p.len() != 4 || p[0] != syntax as u8 {
+        let faces_when_settled = match p.get(4) {
+            None => false,
+            Some(&FACES_WHEN_SETTLED) if syntax == Syntax::Modelled => true,
+            Some(_) => return Err(bad("emc parameters of unknown syntax")),
+        };
+        if !(4..=5).contains(&p.len()) || p[0] != syntax as u8 {
             return Err(bad("emc parameters of unknown syntax"));
         }
         let axes = [p[1], p[2], p[3]];
@@ -113,6 +135,7 @@ impl EmcParams {
                 levels: header.grid.bits,
                 axes,
             },
+            faces_when_settled,
         })
     }
 }

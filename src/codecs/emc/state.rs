@@ -242,8 +242,16 @@ impl EmcState {
     /// oriented by propagation from outward-facing guesses (no bits are spent on it).
     /// `triangles`: the header's count, which bounds the cliques listed.
     pub fn level_mesh(&self, grid: &Grid, triangles: u64) -> Result<LevelMesh, String> {
+        self.level_mesh_at(self.positions(grid), triangles)
+    }
+
+    /// [`Self::level_mesh`] with the vertices shown at `positions` (one per vertex).
+    pub fn level_mesh_at(
+        &self,
+        positions: Vec<DVec3>,
+        triangles: u64,
+    ) -> Result<LevelMesh, String> {
         let cliques = self.cliques(triangles)?;
-        let positions = self.positions(grid);
         let skipped = vec![false; cliques.len()];
         let centre = centroid(&positions);
         let flipped = propagate_orientation(&cliques, &skipped, &positions, centre, |_, _, p| p);
@@ -389,9 +397,9 @@ pub fn face_corrections(
         "every face is a 3-clique of its own edges"
     );
     let skipped = corrections.skipped(cliques.len());
-    let positions: Vec<_> = (0..state.len())
-        .map(|v| mesh.grid.dequantize(state.cells[v]))
-        .collect();
+    // The decoder's positions when it reads the corrections: its cells' centres (at the last
+    // level, the vertices' own cells).
+    let positions = state.positions(&mesh.grid);
     // Let the propagation follow the true orientations and note where they were not predicted.
     let is_flipped = |t: usize| sides[t] == 2;
     let centre = centroid(&positions);

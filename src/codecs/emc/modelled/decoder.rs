@@ -3,11 +3,12 @@
 
 use super::walk::{Question, Side, Stop, Walker};
 use crate::codecs::emc::state::FaceCorrections;
+use crate::codecs::emc::EmcParams;
 use crate::codecs::{LevelDecoder, LevelMesh, PassStops};
 use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
-use crate::hierarchy::octree::StepOrder;
+use crate::mesh::TriMesh;
 
 struct DecoderSide {
     coder: ArithDecoder,
@@ -65,21 +66,24 @@ fn get_list(
 pub struct EmcDecoder<'a> {
     stream: StreamReader<'a>,
     header: Header,
+    params: EmcParams,
     walker: Walker,
     levels_done: usize,
-    /// The full mesh once the last level's corrections are read.
-    final_mesh: Option<LevelMesh>,
+    /// The mesh's faces (and loose edges) once the face corrections are read, with the
+    /// positions of the level they followed.
+    settled: Option<LevelMesh>,
 }
 
 impl<'a> EmcDecoder<'a> {
-    pub fn new(stream: StreamReader<'a>, order: StepOrder) -> Self {
+    pub fn new(stream: StreamReader<'a>, params: EmcParams) -> Self {
         let header = stream.header().clone();
         EmcDecoder {
-            walker: Walker::new(order, header.vertices),
+            walker: Walker::new(params.order, header.vertices),
             header,
+            params,
             stream,
             levels_done: 0,
-            final_mesh: None,
+            settled: None,
         }
     }
 
@@ -102,7 +106,12 @@ impl<'a> EmcDecoder<'a> {
                 self.header.vertices,
                 self.header.triangles,
             )?;
-            if level == order.levels as usize && passes >= 3 {
+            let last = level == order.levels as usize;
+            let all_decoded = self.walker.state.len() as u64 == self.header.vertices;
+            if passes >= 3
+                && self.settled.is_none()
+                && (last || self.params.faces_when_settled && all_decoded)
+            {
                 self.read_corrections(&mut side.coder)?;
             }
             Ok(())
@@ -137,7 +146,7 @@ impl<'a> EmcDecoder<'a> {
                 self.header.triangles,
             )
             .map_err(Stop::Fault)?;
-        self.final_mesh = Some(mesh);
+        self.settled = Some(mesh);
         Ok(())
     }
 }
@@ -162,9 +171,25 @@ impl LevelDecoder for EmcDecoder<'_> {
     }
 
     fn mesh(&self) -> Result<LevelMesh> {
-        self.walker
-            .state
-            .shown_mesh(self.final_mesh.as_ref(), &self.header)
+        let grid = &self.header.grid;
+        // The full level is exact: its cells' centres.
+        let positions = if self.levels_done == self.levels() {
+            self.walker.state.positions(grid)
+        } else {
+            self.walker.shown_positions(grid)
+        };
+        match &self.settled {
+            Some(settled) => Ok(LevelMesh {
+                mesh: TriMesh::new(positions, settled.mesh.faces.clone()),
+                loose_edges: settled.loose_edges.clone(),
+                attributes: settled.attributes.clone(),
+            }),
+            None => self
+                .walker
+                .state
+                .level_mesh_at(positions, self.header.triangles)
+                .map_err(Error::Limit),
+        }
     }
 
     fn pass_stops(&mut self) -> Option<&mut dyn PassStops> {

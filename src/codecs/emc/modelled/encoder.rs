@@ -97,14 +97,25 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
     };
     let mut writer = StreamWriter::new(&header);
     let mut stats = Stats::default();
+    // Whether the face corrections are coded (the edge graph is final from then on).
+    let mut settled = false;
     for level in 1..=order.levels as usize {
         walker
             .level(&mut side, level, 3, n, mesh.face_count() as u64)
             .expect("the encoder's answers agree with the header");
         let mut coder = std::mem::take(&mut side.coder);
-        if level == order.levels as usize {
+        let last = level == order.levels as usize;
+        if !settled && (last || params.faces_when_settled && walker.state.len() as u64 == n) {
+            settled = true;
+            debug_assert!(
+                walker.leaf.iter().all(|&leaf| leaf),
+                "every vertex decoded is a leaf: no split follows"
+            );
+            // What only splits read goes before the corrections, the encoder's peak of memory.
             side.clusters.release_edges();
-            walker.release_caches();
+            if last {
+                walker.release_caches();
+            }
             let corrections = face_corrections(
                 mesh,
                 &walker.state,
@@ -134,12 +145,8 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
                 connectivity_bits: level_ledger.connectivity,
                 geometry_bits: level_ledger.geometry,
                 vertices: walker.state.len(),
-                // Triangles are listed once, from the last level's edge graph.
-                triangles: if level == order.levels as usize {
-                    mesh.face_count()
-                } else {
-                    0
-                },
+                // Triangles are listed once the corrections make them the mesh's faces.
+                triangles: if settled { mesh.face_count() } else { 0 },
             },
         );
     }

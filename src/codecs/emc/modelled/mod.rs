@@ -27,8 +27,17 @@
 //! level instead of three. A stream cut after one or two passes of a level (`Stop::Passes`)
 //! shows the clusters refined by those passes and the leaves as the level before left them.
 //!
-//! The last level ends with the paper coder's three face-correction lists (false triangles,
-//! faces in both orientations, orientation exceptions), lengths and gaps in adaptive Exp-Golomb.
+//! The first level at whose end every vertex is decoded (often several levels before the last:
+//! bunny.ply at 12 bits has all its vertices after level 9) ends with the paper coder's three
+//! face-correction lists (false triangles, faces in both orientations, orientation
+//! exceptions), lengths and gaps in adaptive Exp-Golomb. No split follows, so the edge graph is
+//! final, and the levels after it show the mesh's own faces rather than every 3-clique: the
+//! paper sends the lists after the last level, where the false triangles of the levels before
+//! made bunny's Hausdorff error rise from level 10 to 11. Streams written before this
+//! (4 bytes of parameters) still decode, with the lists after the last level.
+//!
+//! An intermediate level shows each vertex where the walker's estimate expects it inside its
+//! cell, not at the cell's centre (`placement`; no bits).
 //!
 //! # Contexts
 //! - *Which half*: a smooth surface puts a vertex near its ring's plane and near the ring's
@@ -95,6 +104,7 @@
 mod contexts;
 mod decoder;
 mod encoder;
+mod placement;
 pub mod walk;
 
 use super::{EmcParams, Syntax};
@@ -136,13 +146,13 @@ impl Codec for Emc {
     }
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
-        let params = EmcParams::for_mesh(mesh);
+        let params = EmcParams::for_mesh(mesh, Syntax::Modelled);
         let header = params.header(Syntax::Modelled, self.id(), mesh);
         encoder::encode(mesh, &params, header)
     }
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
         let params = EmcParams::from_stream(&stream, Syntax::Modelled)?;
-        Ok(Box::new(decoder::EmcDecoder::new(stream, params.order)))
+        Ok(Box::new(decoder::EmcDecoder::new(stream, params)))
     }
 }

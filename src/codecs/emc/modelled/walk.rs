@@ -119,7 +119,7 @@ fn select(choose: bool, a: f64, b: f64) -> f64 {
 /// axes, else their mean; the error is the neighbours' residual spread plus what the vertex's
 /// own cell leaves open.
 #[inline(always)]
-fn estimate(m: &Moments, axis: usize, shifts: [u8; 3]) -> (f64, f64) {
+pub(super) fn estimate(m: &Moments, axis: usize, shifts: [u8; 3]) -> (f64, f64) {
     let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
     let var_a = m.cov[axis][axis].max(0.0);
     let (cbb, ccc, cbc) = (m.cov[b][b], m.cov[c][c], m.cov[b][c]);
@@ -210,10 +210,10 @@ fn leaf_contexts(m: &Moments, shifts: [u8; 3]) -> ([usize; 3], [bool; 3]) {
 }
 
 /// Count, mean and covariance of a vertex's neighbours (see [`Walker::moments`]).
-struct Moments {
+pub(super) struct Moments {
     k: usize,
-    mean: [f64; 3],
-    cov: [[f64; 3]; 3],
+    pub(super) mean: [f64; 3],
+    pub(super) cov: [[f64; 3]; 3],
 }
 
 /// The state both sides keep, with the modelled coder's extra knowledge of each vertex.
@@ -282,6 +282,12 @@ impl Walker {
         } else {
             self.centres[v] = centre;
         }
+    }
+
+    /// Twice `v`'s cell centre in units of the full grid, and the shifts of its half-widths:
+    /// half the width of its cell along axis `a` is 2^`shifts[a]` in those units.
+    pub(super) fn cell_of(&self, v: usize) -> ([i32; 3], [u8; 3]) {
+        (self.centres[v], self.shifts[self.state.depth[v] as usize])
     }
 
     /// Half the width of `v`'s cell along `axis` is 2^this, in the units of the centres.
@@ -399,7 +405,7 @@ impl Walker {
 
     /// Count, mean and covariance of `v`'s neighbours' cell centres, relative to `v`'s centre;
     /// `None` without neighbours.
-    fn moments(&self, v: usize) -> Option<Moments> {
+    pub(super) fn moments(&self, v: usize) -> Option<Moments> {
         let origin = self.centres[v];
         let neighbours = &self.state.adjacency[v];
         if neighbours.is_empty() {

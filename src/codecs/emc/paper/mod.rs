@@ -93,7 +93,7 @@ impl Codec for EmcPaper {
     }
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
-        let params = EmcParams::for_mesh(mesh);
+        let params = EmcParams::for_mesh(mesh, Syntax::Paper);
         let header = params.header(Syntax::Paper, self.id(), mesh);
         encoder::encode(mesh, &params, header)
     }
