@@ -14,9 +14,9 @@
 //! by [`TRUST`] × (how far the neighbours reach, in half-widths, at least 1) it fits the errors
 //! measured on bunny.ply and armadillo-43k.obj at 12 bits: where the neighbours lie within a
 //! cell or two (coarse levels, clusters) the prediction is better than σ² says; where they lie
-//! many cells away (the finest levels) it is worse. On bunny.ply this lowers every level's RMS
-//! error, by 1.13–1.46× at levels 5–9 and 1.01–1.05× at levels 10–11 (`cargo run --release
-//! --example emc_placement`; BENCHMARKS.md, "Intermediate levels").
+//! many cells away (the finest levels) it is worse. On bunny.ply this lowers the RMS error of
+//! levels 4–11, by 1.13–1.46× at levels 4–9 and 1.01–1.05× at levels 10–11 (`cargo run
+//! --release --example emc_placement`; BENCHMARKS.md, "Intermediate levels").
 
 use super::walk::{estimate, Walker};
 use crate::mesh::Grid;
@@ -29,10 +29,11 @@ const TRUST: f64 = 0.25;
 /// How far out towards its cell's faces a vertex may be shown, in half-widths.
 const INSIDE: f64 = 0.999;
 
-/// Along an axis on which a cell is still a quarter of the grid or more (the first two levels),
-/// the neighbours span the whole model and their plane says nothing of where the vertex lies:
-/// it stays at its cell's centre.
-const COARSE_LEVELS: u8 = 2;
+/// Along an axis on which a cell is still an eighth of the grid or more (the first three
+/// levels), the neighbours span a large part of the model and their plane says little of where
+/// the vertex lies: it stays at its cell's centre (placed there, levels 1–2 of bunny.ply had
+/// 1.2–1.5× the RMS error of the centres, level 3 of porsche and dragon-res3 1.09–1.15×).
+const COARSE_LEVELS: u8 = 3;
 
 impl Walker {
     /// Every vertex's shown position: its expected place inside its cell along each axis
