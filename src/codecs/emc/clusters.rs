@@ -21,14 +21,22 @@ pub struct SplitPlan {
 }
 
 /// Clusters of the hierarchy over the trie.
+///
+/// The mesh's vertices are kept by their trie position (key order): a cluster is a range of
+/// positions, its vertices' edges one contiguous run of [`Self::edges`], and their neighbours lie
+/// mostly nearby (keys interleave the axes' bits, so near cells have near keys). Indexed by
+/// mesh vertex id instead, a split's reads scatter over the whole mesh: on bunny-closed-35k ×16
+/// the split plans took 29% of the encode time that way.
 pub struct Clusters {
     /// The key trie of the mesh's cells.
     pub trie: KeyTrie,
     /// Trie range of each list vertex.
     pub ranges: Vec<Range<usize>>,
-    /// The mesh's edges, per mesh vertex.
-    neighbours: Vec<Vec<u32>>,
-    /// List vertex each mesh vertex belongs to now.
+    /// Where each trie position's edges start in [`Self::edges`] (one more entry at the end).
+    edge_starts: Vec<u32>,
+    /// The mesh's edges: for each trie position in order, the trie positions of its neighbours.
+    edges: Vec<u32>,
+    /// List vertex each trie position belongs to now.
     cluster_of: Vec<u32>,
     stamp_lower: Vec<u32>,
     stamp_upper: Vec<u32>,
@@ -39,10 +47,12 @@ impl Clusters {
     /// One cluster holding every vertex of `mesh`.
     pub fn new(mesh: &CanonicalMesh, trie: KeyTrie) -> Clusters {
         let n = mesh.vertex_count();
+        let (edge_starts, edges) = edges_by_position(&trie, &mesh.faces);
         Clusters {
             trie,
             ranges: std::iter::once(0..n).collect(),
-            neighbours: crate::hierarchy::cliques::adjacency(n, &mesh.faces),
+            edge_starts,
+            edges,
             cluster_of: vec![0; n],
             stamp_lower: vec![0],
             stamp_upper: vec![0],
@@ -70,9 +80,7 @@ impl Clusters {
         plan.lower = range.start..mid;
         plan.upper = mid..range.end;
         let r = state.len() as u32;
-        for &u in &self.trie.vertices[plan.upper.clone()] {
-            self.cluster_of[u as usize] = r;
-        }
+        self.cluster_of[plan.upper.clone()].fill(r);
         // Which clusters each half touches.
         self.stamp += 1;
         self.stamp_lower.resize(state.len() + 1, 0);
@@ -83,12 +91,11 @@ impl Clusters {
             (plan.upper.clone(), &mut self.stamp_upper),
         ] {
             let is_lower = half.start == range.start;
-            for &u in &self.trie.vertices[half] {
-                for &w in &self.neighbours[u as usize] {
-                    let c = self.cluster_of[w as usize];
-                    stamps[c as usize] = self.stamp;
-                    plan.connecting |= is_lower && c == r;
-                }
+            let run = self.edge_starts[half.start] as usize..self.edge_starts[half.end] as usize;
+            for &w in &self.edges[run] {
+                let c = self.cluster_of[w as usize];
+                stamps[c as usize] = self.stamp;
+                plan.connecting |= is_lower && c == r;
             }
         }
         plan.codes.clear();
@@ -108,7 +115,8 @@ impl Clusters {
     /// cluster is a single vertex: the face corrections that follow are the encoder's peak of
     /// memory, and these are a third of it on a large mesh.
     pub fn release_edges(&mut self) {
-        self.neighbours = Vec::new();
+        self.edge_starts = Vec::new();
+        self.edges = Vec::new();
         self.cluster_of = Vec::new();
         self.stamp_lower = Vec::new();
         self.stamp_upper = Vec::new();
@@ -119,4 +127,61 @@ impl Clusters {
         self.ranges[v] = plan.lower.clone();
         self.ranges.push(plan.upper.clone());
     }
+}
+
+/// The mesh's edges in trie positions, both ways, each position's neighbours ascending and
+/// once: the start of each position's run, and the runs one after another.
+fn edges_by_position(trie: &KeyTrie, faces: &[[u32; 3]]) -> (Vec<u32>, Vec<u32>) {
+    let n = trie.vertices.len();
+    let mut position = vec![0u32; n];
+    for (i, &u) in trie.vertices.iter().enumerate() {
+        position[u as usize] = i as u32;
+    }
+    // Every face's three edges both ways (repeats included), counted, then placed: at most
+    // 6 · 2^29 entries (limits::MAX_TRIANGLES), within u32.
+    let mut starts = vec![0u32; n + 1];
+    for f in faces {
+        for &u in f {
+            starts[position[u as usize] as usize + 1] += 2;
+        }
+    }
+    for i in 0..n {
+        starts[i + 1] += starts[i];
+    }
+    let mut next = starts.clone();
+    let mut edges = vec![0u32; starts[n] as usize];
+    for f in faces {
+        let p = f.map(|u| position[u as usize]);
+        for k in 0..3 {
+            let (a, b) = (p[k], p[(k + 1) % 3]);
+            for (from, to) in [(a, b), (b, a)] {
+                edges[next[from as usize] as usize] = to;
+                next[from as usize] += 1;
+            }
+        }
+    }
+    drop(next);
+    // Each run sorted and its repeats dropped, the runs moved down over the gaps.
+    let mut end = 0usize;
+    let mut start = 0usize;
+    for i in 0..n {
+        let run_end = starts[i + 1] as usize;
+        edges[start..run_end].sort_unstable();
+        let new_start = end;
+        let mut last = None;
+        for j in start..run_end {
+            let w = edges[j];
+            if last != Some(w) {
+                edges[end] = w;
+                end += 1;
+                last = Some(w);
+            }
+        }
+        starts[i] = new_start as u32;
+        start = run_end;
+    }
+    starts[n] = end as u32;
+    edges.truncate(end);
+    edges.shrink_to_fit();
+    (starts, edges)
 }
