@@ -982,21 +982,19 @@ fn valence_anchor() -> Result<ValenceAnchor> {
     let bad = |what: &str| Error::Unsupported(format!("{}: {what}", path.display()));
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&path)?).map_err(|e| bad(&e.to_string()))?;
-    let levels = json["levels"]
-        .as_array()
-        .ok_or_else(|| bad("no levels"))?
-        .iter()
-        .map(|l| Some((l["bits"].as_f64()?, l["hausdorff_relative"].as_f64()?)))
-        .collect::<Option<Vec<_>>>()
-        .filter(|l| !l.is_empty())
-        .ok_or_else(|| bad("a level without bits or hausdorff_relative"))?;
-    let rms = json["levels"]
-        .as_array()
-        .ok_or_else(|| bad("no levels"))?
-        .iter()
-        .map(|l| Some((l["bits"].as_f64()?, l["rms_relative"].as_f64()?)))
-        .collect::<Option<Vec<_>>>()
-        .ok_or_else(|| bad("a level without bits or rms_relative"))?;
+    // (cumulative bits, `field`) of every level.
+    let series = |field: &str| {
+        json["levels"]
+            .as_array()
+            .ok_or_else(|| bad("no levels"))?
+            .iter()
+            .map(|l| Some((l["bits"].as_f64()?, l[field].as_f64()?)))
+            .collect::<Option<Vec<_>>>()
+            .filter(|l| !l.is_empty())
+            .ok_or_else(|| bad(&format!("a level without bits or {field}")))
+    };
+    let levels = series("hausdorff_relative")?;
+    let rms = series("rms_relative")?;
     let commit = json["commit"]
         .as_str()
         .unwrap_or("?")
