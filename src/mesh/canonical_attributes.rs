@@ -266,9 +266,11 @@ fn derive_corner_normals(canonical: &CanonicalMesh, codes: &mut [[CornerCode; 3]
         .iter()
         .map(|c| c.map(|c| c.normal.unwrap_or_default()))
         .collect();
+    let groups_of = |key: &[[[u32; 2]; 3]]| {
+        super::derived_normals::groups_by_key(&canonical.faces, key.iter().copied())
+    };
+    let (mut group, mut groups) = groups_of(&key);
     loop {
-        let (group, groups) =
-            super::derived_normals::groups_by_key(&canonical.faces, key.iter().copied());
         let derived = super::derived_normals::group_normal_codes(
             &canonical.faces,
             &group,
@@ -282,11 +284,11 @@ fn derive_corner_normals(canonical: &CanonicalMesh, codes: &mut [[CornerCode; 3]
             .map(|g| g.map(|g| derived[g as usize]))
             .collect();
         // Groups of one vertex whose codes came out equal are one group now.
-        let (_, merged) =
-            super::derived_normals::groups_by_key(&canonical.faces, key.iter().copied());
-        if merged == groups {
+        let merged = groups_of(&key);
+        if merged.1 == groups {
             break;
         }
+        (group, groups) = merged;
     }
     for (codes, key) in codes.iter_mut().zip(key) {
         for (c, n) in codes.iter_mut().zip(key) {

@@ -152,6 +152,7 @@ pub fn uv_by_fit(p: DVec3, normal: DVec3, pairs: &[(DVec3, DVec2)]) -> Option<DV
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn angles_are_close_to_the_true_ones_and_vertex_normals_weigh_by_them() {
@@ -160,11 +161,11 @@ mod tests {
             let a = (i as f64).to_radians();
             let v = DVec3::new(a.cos(), a.sin(), 0.0) * 3.0;
             let truth = DVec3::X.angle_between(v);
-            worst = worst.max((super::angle_between(DVec3::X * 2.0, v) - truth).abs());
+            worst = worst.max((angle_between(DVec3::X * 2.0, v) - truth).abs());
         }
         assert!(worst < 0.002, "{worst}");
         // A corner of 90° and one of 45°, with normals +z and +x: weights 2:1.
-        let n = super::vertex_normal_by_angles([
+        let n = vertex_normal_by_angles([
             [DVec3::ZERO, DVec3::X, DVec3::Y],
             [DVec3::ZERO, DVec3::Y, DVec3::new(0.0, 1.0, -1.0)],
         ]);
@@ -173,8 +174,6 @@ mod tests {
             .normalize();
         assert!((n - expected).length() < 2e-3, "{n} {expected}");
     }
-
-    use super::*;
 
     #[test]
     fn the_fit_recovers_an_affine_chart_exactly() {

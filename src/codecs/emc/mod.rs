@@ -105,6 +105,13 @@ impl EmcParams {
         }
     }
 
+    /// Whether the face corrections follow `level` (1-based), at whose end `decoded` of the
+    /// header's `vertices` are in the list: the encoder writes them, and the decoder reads them,
+    /// after the first level for which this holds.
+    pub fn corrections_follow(&self, level: usize, decoded: u64, vertices: u64) -> bool {
+        level == self.order.levels as usize || self.faces_when_settled && decoded == vertices
+    }
+
     /// Reads and checks the parameters of a stream in `syntax`.
     pub fn from_stream(stream: &StreamReader, syntax: Syntax) -> Result<EmcParams> {
         stream.require_layered()?;

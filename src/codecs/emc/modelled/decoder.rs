@@ -63,15 +63,21 @@ fn get_list(
     Ok(list)
 }
 
+/// What the face corrections make final: the full mesh's faces and its edges on no face.
+struct SettledFaces {
+    faces: Vec<[u32; 3]>,
+    loose_edges: Vec<[u32; 2]>,
+}
+
 pub struct EmcDecoder<'a> {
     stream: StreamReader<'a>,
     header: Header,
     params: EmcParams,
     walker: Walker,
     levels_done: usize,
-    /// The mesh's faces (and loose edges) once the face corrections are read, with the
-    /// positions of the level they followed.
-    settled: Option<LevelMesh>,
+    /// The mesh's faces and loose edges, once the face corrections are read (every later
+    /// level shows them).
+    settled: Option<SettledFaces>,
 }
 
 impl<'a> EmcDecoder<'a> {
@@ -98,7 +104,6 @@ impl<'a> EmcDecoder<'a> {
             .ok_or_else(|| fault("level payload is not whole 32-bit words".into()))?;
         let mut side = DecoderSide { coder };
         let outcome = (|| {
-            let order = self.walker.state.order;
             self.walker.level(
                 &mut side,
                 level,
@@ -106,11 +111,12 @@ impl<'a> EmcDecoder<'a> {
                 self.header.vertices,
                 self.header.triangles,
             )?;
-            let last = level == order.levels as usize;
-            let all_decoded = self.walker.state.len() as u64 == self.header.vertices;
+            let decoded = self.walker.state.len() as u64;
             if passes >= 3
                 && self.settled.is_none()
-                && (last || self.params.faces_when_settled && all_decoded)
+                && self
+                    .params
+                    .corrections_follow(level, decoded, self.header.vertices)
             {
                 self.read_corrections(&mut side.coder)?;
             }
@@ -146,7 +152,10 @@ impl<'a> EmcDecoder<'a> {
                 self.header.triangles,
             )
             .map_err(Stop::Fault)?;
-        self.settled = Some(mesh);
+        self.settled = Some(SettledFaces {
+            faces: mesh.mesh.faces,
+            loose_edges: mesh.loose_edges,
+        });
         Ok(())
     }
 }
@@ -180,9 +189,9 @@ impl LevelDecoder for EmcDecoder<'_> {
         };
         match &self.settled {
             Some(settled) => Ok(LevelMesh {
-                mesh: TriMesh::new(positions, settled.mesh.faces.clone()),
+                mesh: TriMesh::new(positions, settled.faces.clone()),
                 loose_edges: settled.loose_edges.clone(),
-                attributes: settled.attributes.clone(),
+                attributes: None,
             }),
             None => self
                 .walker

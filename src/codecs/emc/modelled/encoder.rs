@@ -105,7 +105,7 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
             .expect("the encoder's answers agree with the header");
         let mut coder = std::mem::take(&mut side.coder);
         let last = level == order.levels as usize;
-        if !settled && (last || params.faces_when_settled && walker.state.len() as u64 == n) {
+        if !settled && params.corrections_follow(level, walker.state.len() as u64, n) {
             settled = true;
             debug_assert!(
                 walker.leaf.iter().all(|&leaf| leaf),
