@@ -161,6 +161,14 @@ for codec in raw emc emc-paper pm pm-reordered came came-paper; do
     tail -c +7 "$stream" > "$dir/$name.body"
   done
 done
+# emc streams with slabs, every pass of 4 visits or more sliced into 3 slabs (as `emc` writes
+# meshes of 65,536 vertices or more, in small).
+cargo build --release --example emc_slabs
+for mesh in $seeds/read_obj/torus.obj $seeds/read_obj/torus-fin.obj; do
+  name=$(basename "$mesh"); name=${name%.*}
+  target/release/examples/emc_slabs "$mesh" --write "$stream" 3 2
+  tail -c +7 "$stream" > "$seeds/decode_emc/$name-slabs.body"
+done
 # Streams with appearance (every codec that carries it, on the seeds with uvs, normals,
 # materials or colours), with the magic and version cut off: decode_appearance's input.
 mkdir -p $seeds/decode_appearance

@@ -1,6 +1,8 @@
 //! How `emc`'s cost grows with the mesh: bunny-closed-35k as shared and subdivided two and three
 //! times at edge midpoints (35k → 557k → 2.2 M vertices), each encoded and decoded in-process at
-//! 12 bits, with bunny.ply measured in the same run as the anchor of the per-vertex rates.
+//! 12 bits, with bunny.ply measured in the same run as the anchor of the per-vertex rates. The
+//! large meshes' streams have slabs (`codecs::emc::SLABS`): each is decoded on one thread and
+//! on all of them, and encoded once more without slabs for what the slabs cost.
 //! Writes results/emc/scale.json.
 //!
 //! Memory is the process's peak resident size over each phase (Linux with glibc: the allocator
@@ -10,6 +12,8 @@
 //! the program itself (about 20 MB).
 
 use crate::came_extras::table_mesh;
+use crate::codecs::emc::modelled::encode_sliced;
+use crate::codecs::emc::{EmcParams, Syntax, SLICED_VISITS_LOG2};
 use crate::codecs::{self, EncodeOptions, Stop};
 use crate::error::{Error, Result};
 use crate::mesh::io::write_atomically;
@@ -47,15 +51,21 @@ pub struct ScaleRow {
     pub bytes: usize,
     /// Best encode time (canonical mesh → stream).
     pub encode_seconds: f64,
-    /// Best full decode time.
+    /// Best full decode time, on all threads.
     pub decode_seconds: f64,
+    /// Best full decode time on one thread.
+    pub decode_seconds_one_thread: f64,
+    /// Slabs of the stream (1: none).
+    pub slabs: u8,
+    /// Stream bytes without slabs (the same as `bytes` where there are none).
+    pub unsliced_bytes: usize,
     /// Peak resident bytes over an encode, if the system reports it.
     pub encode_peak_bytes: Option<u64>,
     /// Peak resident bytes over a decode, if the system reports it.
     pub decode_peak_bytes: Option<u64>,
     /// Whether the decoded mesh is the canonical mesh exactly.
     pub lossless: bool,
-    /// Threads the coder used (the stream has no parallel path yet).
+    /// Threads the decoder used (all of them); the encoder codes the slabs on one.
     pub threads: usize,
 }
 
@@ -116,7 +126,12 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
         } else {
             5
         };
+        let one_thread = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .map_err(|e| Error::Unsupported(format!("no thread pool: {e}")))?;
         let (mut encode_seconds, mut decode_seconds) = (f64::INFINITY, f64::INFINITY);
+        let mut decode_seconds_one_thread = f64::INFINITY;
         let (mut encode_peak_bytes, mut decode_peak_bytes) = (None, None);
         let mut bytes = Vec::new();
         let mut lossless = false;
@@ -129,11 +144,25 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
             let ((decoded, _), decode_peak) = with_peak(|| codecs::decode(&bytes, Stop::All))?;
             decode_seconds = decode_seconds.min(started.elapsed().as_secs_f64());
             lossless = canonical.check_lossless(&decoded.mesh).is_ok();
+            drop(decoded);
+            let started = Instant::now();
+            let (alone, _) = one_thread.install(|| codecs::decode(&bytes, Stop::All))?;
+            decode_seconds_one_thread =
+                decode_seconds_one_thread.min(started.elapsed().as_secs_f64());
+            lossless &= canonical.check_lossless(&alone.mesh).is_ok();
             encode_peak_bytes = encode_peak_bytes.max(encode_peak);
             decode_peak_bytes = decode_peak_bytes.max(decode_peak);
         }
+        let slabs = EmcParams::for_mesh(&canonical, Syntax::Modelled).slabs;
+        let unsliced_bytes = if slabs > 1 {
+            encode_sliced(&canonical, 1, SLICED_VISITS_LOG2)?
+                .bytes
+                .len()
+        } else {
+            bytes.len()
+        };
         log(format!(
-            "emc on {name} x{}: {} vertices, {} bytes, encode {encode_seconds:.3} s, decode {decode_seconds:.3} s, lossless {lossless}",
+            "emc on {name} x{}: {} vertices, {} bytes ({unsliced_bytes} without slabs), encode {encode_seconds:.3} s, decode {decode_seconds:.3} s ({decode_seconds_one_thread:.3} s on one thread), lossless {lossless}",
             4u32.pow(subdivisions),
             canonical.vertex_count(),
             bytes.len()
@@ -146,10 +175,13 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
             bytes: bytes.len(),
             encode_seconds,
             decode_seconds,
+            decode_seconds_one_thread,
+            slabs,
+            unsliced_bytes,
             encode_peak_bytes,
             decode_peak_bytes,
             lossless,
-            threads: 1,
+            threads: rayon::current_num_threads(),
         });
     }
     let out = results.join("emc").join("scale.json");

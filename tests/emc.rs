@@ -181,6 +181,59 @@ fn decoding_stops_after_any_pass_of(codec: &str) {
 /// `emc` shows every vertex of an intermediate level inside its own cell of that level (where
 /// its neighbours predict it), and from the level that decodes the last vertex on, the mesh's
 /// own faces (its face corrections follow that level).
+/// Every level of `bytes` decoded on a pool of `threads` threads.
+fn levels_on(bytes: &[u8], threads: usize) -> Vec<LevelMesh> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        let mut decoder = codecs::open(bytes).unwrap();
+        let mut levels = Vec::new();
+        while decoder.advance().unwrap() {
+            levels.push(decoder.mesh().unwrap());
+        }
+        levels
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(cases() / 4))]
+
+    /// Streams whose passes are sliced, down to passes of one visit: lossless, and every level
+    /// the same whether the slabs are decoded one after another or at once.
+    #[test]
+    fn sliced_streams_are_lossless_and_decode_alike_on_one_thread_and_on_several(seed in any::<u64>(), bits in 1u8..=14, slabs in 2u8..=8, log2 in 0u8..=6) {
+        let mesh = generate::messy(seed);
+        let options = EncodeOptions { quant_bits: bits, grid: GridShape::Cubic };
+        let Ok(canonical) = codecs::canonical_for(&mesh, &options) else { return Ok(()) };
+        let encoded = codecs::emc::modelled::encode_sliced(&canonical, slabs, log2).unwrap();
+        let one = levels_on(&encoded.bytes, 1);
+        let several = levels_on(&encoded.bytes, 3);
+        prop_assert_eq!(one.len(), bits as usize);
+        prop_assert!(one == several, "the threads changed a level");
+        let (decoded, _) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
+        prop_assert_eq!(canonical.check_lossless(&decoded.mesh), Ok(()));
+        for (level, record) in one.iter().zip(&encoded.levels) {
+            assert_valid(level);
+            prop_assert_eq!(level.mesh.vertex_count(), record.vertices);
+        }
+        // Cut and corrupt, it decodes or fails in one line.
+        let mut state = seed as u32 | 1;
+        for _ in 0..8 {
+            let bytes = common::flip_bits(&encoded.bytes, &mut state, 4);
+            if let Ok((level, _)) = codecs::decode(&bytes, Stop::All) {
+                assert_valid(&level);
+            }
+        }
+        for cut in (0..encoded.bytes.len()).step_by(7) {
+            if let Ok((level, _)) = codecs::decode(&encoded.bytes[..cut], Stop::All) {
+                assert_valid(&level);
+            }
+        }
+    }
+}
+
 #[test]
 fn emc_levels_show_vertices_in_their_cells_and_the_mesh_faces_once_all_are_decoded() {
     use meshcodec::mesh::canonical::rotate_to_smallest;
@@ -232,4 +285,44 @@ fn emc_levels_show_vertices_in_their_cells_and_the_mesh_faces_once_all_are_decod
         );
     }
     assert!(settled_before_the_last > 0);
+}
+
+/// A slab table that lies (too long, or more splits than a slab visits) is refused in one line
+/// naming it, and so is a level whose slab streams are not all read.
+#[test]
+fn a_lying_slab_table_is_refused() {
+    let mesh = generate::messy(5);
+    let options = EncodeOptions {
+        quant_bits: 12,
+        grid: GridShape::Cubic,
+    };
+    let canonical = codecs::canonical_for(&mesh, &options).unwrap();
+    let encoded = codecs::emc::modelled::encode_sliced(&canonical, 3, 2).unwrap();
+    let bytes = &encoded.bytes;
+    let (_, index, start) = meshcodec::container::read_header_and_index(bytes).unwrap();
+    // The first level with a table: its payload starts with the table's length.
+    let level = index
+        .units
+        .iter()
+        .map(|unit| start + unit.offset as usize)
+        .find(|&at| bytes[at] > 0)
+        .expect("some level has a sliced pass");
+    let refused = |edit: &dyn Fn(&mut Vec<u8>), why: &str| {
+        let mut lying = bytes.clone();
+        edit(&mut lying);
+        match codecs::decode(&lying, Stop::All) {
+            Err(e) => assert!(e.to_string().contains(why), "{why}: {e}"),
+            Ok(_) => panic!("{why}: decoded"),
+        }
+    };
+    // The table's length runs past the level.
+    refused(&|b| b[level] = 0x7f, "runs past its payload");
+    // The first slab splits more vertices than it visits.
+    refused(
+        &|b| b[level + 1] = 0x7f,
+        "splits more vertices than a slab visits",
+    );
+    // The first slab's stream is listed shorter: the next slabs read from the wrong place, or
+    // bytes are left over.
+    refused(&|b| b[level + 2] = b[level + 2].saturating_sub(4), "slab");
 }

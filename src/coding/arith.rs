@@ -62,6 +62,30 @@ impl BitContext {
         self.p1 = ((self.fast + self.slow) / 2).clamp(32, ONE - 32);
     }
 
+    /// The context that `copies` of `self`, each adapted apart from the others, hand on: the
+    /// mean of the copies that coded anything (their estimates averaged, the most symbols
+    /// seen), or `self` if none did. Integer arithmetic only, so that an encoder and a decoder
+    /// merge identically.
+    pub fn merged<'c>(&self, copies: impl IntoIterator<Item = &'c BitContext>) -> BitContext {
+        let (mut fast, mut slow, mut seen, mut used) = (0u64, 0u64, self.seen, 0u64);
+        for copy in copies.into_iter().filter(|&copy| copy != self) {
+            fast += copy.fast as u64;
+            slow += copy.slow as u64;
+            seen = seen.max(copy.seen);
+            used += 1;
+        }
+        if used == 0 {
+            return *self;
+        }
+        let (fast, slow) = ((fast / used) as u32, (slow / used) as u32);
+        BitContext {
+            p1: ((fast + slow) / 2).clamp(32, ONE - 32),
+            fast,
+            slow,
+            seen,
+        }
+    }
+
     /// Bits an ideal coder spends on `bit` under this context.
     pub fn cost(&self, bit: bool) -> f64 {
         let p = if bit { self.p1 } else { ONE - self.p1 };

@@ -6,6 +6,8 @@
 //! real faces and transmits only where it is wrong (see `codecs::emc`).
 
 use glam::DVec3;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The edge graph of `faces` over `n` vertices, as sorted adjacency lists.
 pub fn adjacency(n: usize, faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
@@ -56,12 +58,12 @@ impl Cliques {
 /// quadratic for a star. When that sum is large the vertices are ranked by degree and each edge
 /// intersects only the lists of higher-ranked neighbours, which are at most √(2e) long
 /// (Chiba & Nishizeki): O(e^1.5) whatever the graph.
-pub fn triangles<L: AsRef<[u32]>>(adjacency: &[L], limit: usize) -> Option<Cliques> {
-    let edges = adjacency.iter().map(|l| l.as_ref().len()).sum::<usize>() / 2;
-    let merge_cost: usize = adjacency
-        .iter()
-        .map(|l| l.as_ref().len() * l.as_ref().len())
-        .sum();
+pub fn triangles<L: AsRef<[u32]> + Sync>(adjacency: &[L], limit: usize) -> Option<Cliques> {
+    let (ends, merge_cost) = adjacency
+        .par_iter()
+        .map(|l| (l.as_ref().len(), l.as_ref().len() * l.as_ref().len()))
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    let edges = ends / 2;
     if merge_cost <= 64 * edges + (1 << 20) {
         triangles_by_merge(adjacency, limit)
     } else {
@@ -81,50 +83,77 @@ pub fn triangles<L: AsRef<[u32]>>(adjacency: &[L], limit: usize) -> Option<Cliqu
 
 /// Where each vertex's neighbours above it start in its list, and the id of its first edge to
 /// one of them ([`EdgeIds`]); the last entry of the ids is the edge count.
-fn above_and_first<L: AsRef<[u32]>>(adjacency: &[L]) -> (Vec<u32>, Vec<u32>) {
+fn above_and_first<L: AsRef<[u32]> + Sync>(adjacency: &[L]) -> (Vec<u32>, Vec<u32>) {
+    let above: Vec<u32> = adjacency
+        .par_iter()
+        .enumerate()
+        .map(|(a, list)| list.as_ref().partition_point(|&x| x <= a as u32) as u32)
+        .collect();
     let mut first = Vec::with_capacity(adjacency.len() + 1);
-    let mut above = Vec::with_capacity(adjacency.len());
     let mut total = 0u32;
-    for (a, list) in adjacency.iter().enumerate() {
-        let list = list.as_ref();
-        let start = list.partition_point(|&x| x <= a as u32);
+    for (list, &start) in adjacency.iter().zip(&above) {
         first.push(total);
-        above.push(start as u32);
-        total += (list.len() - start) as u32;
+        total += list.as_ref().len() as u32 - start;
     }
     first.push(total);
     (above, first)
 }
 
-fn triangles_by_merge<L: AsRef<[u32]>>(adjacency: &[L], limit: usize) -> Option<Cliques> {
+fn triangles_by_merge<L: AsRef<[u32]> + Sync>(adjacency: &[L], limit: usize) -> Option<Cliques> {
     let (above, first) = above_and_first(adjacency);
     let edge_count = *first.last().unwrap_or(&0) as usize;
-    // A closed mesh has two triangles for every three edges.
-    let expected = (edge_count * 2 / 3).min(limit);
-    let mut out = Cliques {
-        tris: Vec::with_capacity(expected),
-        edges: Vec::with_capacity(expected),
-        edge_count,
-    };
-    for (a, around_a) in adjacency.iter().enumerate() {
-        let above_a = &around_a.as_ref()[above[a] as usize..];
-        for (i, &b) in above_a.iter().enumerate() {
-            let around_b = adjacency[b as usize].as_ref();
-            // c > b and adjacent to both.
-            let above_b = &around_b[above[b as usize] as usize..];
-            let (ab, base_b) = (first[a] + i as u32, first[b as usize]);
-            for_each_common(&above_a[i + 1..], above_b, |c, p, q| {
-                out.tris.push([a as u32, b, c]);
-                out.edges.push([ab, base_b + q as u32, ab + 1 + p as u32]);
-            });
-            if out.tris.len() > limit {
+    // Runs of vertices listed apart (on threads where there are some), then joined in order;
+    // all stop once the runs together found more than `limit`.
+    const RUN: usize = 1 << 14;
+    let found = AtomicUsize::new(0);
+    // Each run's triangles and their edges.
+    type Listed = (Vec<[u32; 3]>, Vec<[u32; 3]>);
+    let runs: Vec<Listed> = (0..adjacency.len().div_ceil(RUN))
+        .into_par_iter()
+        .map(|run| {
+            let (mut tris, mut edges) = (Vec::new(), Vec::new());
+            let mut told = 0;
+            for a in run * RUN..((run + 1) * RUN).min(adjacency.len()) {
+                let above_a = &adjacency[a].as_ref()[above[a] as usize..];
+                for (i, &b) in above_a.iter().enumerate() {
+                    let around_b = adjacency[b as usize].as_ref();
+                    // c > b and adjacent to both.
+                    let above_b = &around_b[above[b as usize] as usize..];
+                    let (ab, base_b) = (first[a] + i as u32, first[b as usize]);
+                    for_each_common(&above_a[i + 1..], above_b, |c, p, q| {
+                        tris.push([a as u32, b, c]);
+                        edges.push([ab, base_b + q as u32, ab + 1 + p as u32]);
+                    });
+                    // Told to the others now and then (each telling costs a shared write).
+                    if tris.len() - told >= 4096 || tris.len() > limit {
+                        let batch = tris.len() - told;
+                        told = tris.len();
+                        if found.fetch_add(batch, Ordering::Relaxed) + batch > limit {
+                            return None;
+                        }
+                    }
+                }
+            }
+            let batch = tris.len() - told;
+            if found.fetch_add(batch, Ordering::Relaxed) + batch > limit {
                 return None;
             }
-        }
+            Some((tris, edges))
+        })
+        .collect::<Option<_>>()?;
+    let total: usize = runs.iter().map(|(tris, _)| tris.len()).sum();
+    if total > limit {
+        return None;
     }
-    // Past the estimate, both grew by doubling: give back what they do not use.
-    out.tris.shrink_to_fit();
-    out.edges.shrink_to_fit();
+    let mut out = Cliques {
+        tris: Vec::with_capacity(total),
+        edges: Vec::with_capacity(total),
+        edge_count,
+    };
+    for (tris, edges) in runs {
+        out.tris.extend_from_slice(&tris);
+        out.edges.extend_from_slice(&edges);
+    }
     Some(out)
 }
 
@@ -194,7 +223,7 @@ pub struct EdgeIds<'g, L> {
     above: Vec<u32>,
 }
 
-impl<'g, L: AsRef<[u32]>> EdgeIds<'g, L> {
+impl<'g, L: AsRef<[u32]> + Sync> EdgeIds<'g, L> {
     /// Numbers the edges of `adjacency` (sorted lists).
     pub fn new(adjacency: &'g [L]) -> Self {
         let (above, first) = above_and_first(adjacency);
@@ -285,25 +314,42 @@ pub fn propagate_orientation(
     // matters), the XOR of their ids (seen from one of two, the other's id) and the XOR of
     // the directions in which they traverse it unflipped (low to high id on their edges
     // (a,b) and (b,c), high to low on (a,c)): 0 when two use it the same way round.
+    // Each thread takes a range of the edges and reads every triangle for those (the reads go
+    // in order; the scattered writes are what costs).
     let mut users = vec![0u8; cliques.edge_count];
     let mut ids = vec![0u32; cliques.edge_count];
     let mut directions = vec![0u8; cliques.edge_count];
-    for (t, edges) in cliques.edges.iter().enumerate() {
-        let keep = !skipped[t];
-        for (slot, &e) in edges.iter().enumerate() {
-            let e = e as usize;
-            users[e] = (users[e] + keep as u8).min(3);
-            ids[e] ^= t as u32 & (keep as u32).wrapping_neg();
-            directions[e] ^= (keep & (slot != 2)) as u8;
-        }
-    }
+    let range = cliques
+        .edge_count
+        .div_ceil(rayon::current_num_threads())
+        .max(1);
+    users
+        .par_chunks_mut(range)
+        .zip(ids.par_chunks_mut(range))
+        .zip(directions.par_chunks_mut(range))
+        .enumerate()
+        .for_each(|(k, ((users, ids), directions))| {
+            let first = k * range;
+            for (t, edges) in cliques.edges.iter().enumerate() {
+                let keep = !skipped[t];
+                for (slot, &e) in edges.iter().enumerate() {
+                    let Some(e) = (e as usize).checked_sub(first).filter(|&e| e < users.len())
+                    else {
+                        continue;
+                    };
+                    users[e] = (users[e] + keep as u8).min(3);
+                    ids[e] ^= t as u32 & (keep as u32).wrapping_neg();
+                    directions[e] ^= (keep & (slot != 2)) as u8;
+                }
+            }
+        });
     // For each triangle, across each of its edges (a,b), (b,c), (a,c): the one other
     // triangle, if exactly two share the edge, and whether the two traverse it the same way
     // round unflipped (bit `slot` of the second field). Side by side, so that reaching a
     // triangle (in an order the cache cannot foresee) reads one place.
     let nodes: Vec<([u32; 3], u8)> = cliques
         .edges
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(t, edges)| {
             let mut same = 0;
@@ -345,6 +391,8 @@ pub fn propagate_orientation(
                     continue;
                 }
                 seen[other as usize] = true;
+                // It is read when the queue reaches it: fetch it into the cache now.
+                prefetch(&nodes[other as usize]);
                 // The neighbour agrees when it traverses the shared edge the other way round:
                 // flipped unlike t where the two traverse it alike unflipped, else like t.
                 let predicted = flip ^ (same >> slot & 1 == 1);
@@ -356,6 +404,19 @@ pub fn propagate_orientation(
         }
     }
     flipped
+}
+
+/// Asks the processor to bring `value`'s cache line in (a hint; nothing where there is none).
+#[inline(always)]
+fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch reads nothing and cannot fault; the address is a valid reference.
+    unsafe {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        _mm_prefetch::<_MM_HINT_T0>(value as *const T as *const i8);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
 }
 
 #[cfg(test)]

@@ -2,7 +2,7 @@
 //! stands for (a range of the key trie), and what a split does to its edges. Both EMC encoders
 //! read every decision off this; only how they code it differs.
 
-use super::state::{EdgeCode, EmcState};
+use super::state::EdgeCode;
 use crate::hierarchy::octree::KeyTrie;
 use crate::mesh::CanonicalMesh;
 use std::ops::Range;
@@ -72,19 +72,31 @@ impl Clusters {
             .bit(self.trie.keys[self.ranges[v].start], step)
     }
 
-    /// Works out the split of `v` at `step` (which must be its next split) into `plan`, and
-    /// assigns the upper half's mesh vertices to the list vertex the split will create.
-    pub fn plan(&mut self, state: &EmcState, v: usize, step: usize, plan: &mut SplitPlan) {
+    /// Works out the split of `v` (whose neighbours are `neighbours`) at `step` (which must be
+    /// its next split) into `plan`, and assigns the upper half's mesh vertices to `r`, the list
+    /// vertex the split will create; `vertices` is more than every list id.
+    pub fn plan(
+        &mut self,
+        neighbours: &[u32],
+        v: usize,
+        r: usize,
+        step: usize,
+        vertices: usize,
+        plan: &mut SplitPlan,
+    ) {
         let range = self.ranges[v].clone();
         let mid = self.trie.partition(range.clone(), step);
         plan.lower = range.start..mid;
         plan.upper = mid..range.end;
-        let r = state.len() as u32;
+        let r = r as u32;
         self.cluster_of[plan.upper.clone()].fill(r);
         // Which clusters each half touches.
         self.stamp += 1;
-        self.stamp_lower.resize(state.len() + 1, 0);
-        self.stamp_upper.resize(state.len() + 1, 0);
+        let size = vertices.max(r as usize + 1);
+        if self.stamp_lower.len() < size {
+            self.stamp_lower.resize(size, 0);
+            self.stamp_upper.resize(size, 0);
+        }
         plan.connecting = false;
         for (half, stamps) in [
             (plan.lower.clone(), &mut self.stamp_lower),
@@ -99,7 +111,7 @@ impl Clusters {
             }
         }
         plan.codes.clear();
-        for &nb in &state.adjacency[v] {
+        for &nb in neighbours {
             let lower = self.stamp_lower[nb as usize] == self.stamp;
             let upper = self.stamp_upper[nb as usize] == self.stamp;
             debug_assert!(lower || upper, "neighbour {nb} lost by both halves");
@@ -122,8 +134,10 @@ impl Clusters {
         self.stamp_upper = Vec::new();
     }
 
-    /// Records the split of `v` by `plan`: `v` keeps the lower half, the new vertex the upper.
-    pub fn commit(&mut self, v: usize, plan: &SplitPlan) {
+    /// Records the split of `v` by `plan`: `v` keeps the lower half, the new vertex `r` the
+    /// upper. Splits create their vertices in id order.
+    pub fn commit(&mut self, v: usize, r: usize, plan: &SplitPlan) {
+        debug_assert_eq!(r, self.ranges.len(), "vertices are created in id order");
         self.ranges[v] = plan.lower.clone();
         self.ranges.push(plan.upper.clone());
     }

@@ -60,7 +60,28 @@ pub struct EmcParams {
     /// former (a fifth parameter byte, 1); `emc-paper`, and `emc` streams written before it,
     /// the latter (four bytes).
     pub faces_when_settled: bool,
+    /// Slabs of a sliced pass (docs/FORMAT.md §7): a pass that visits at least
+    /// 2^`sliced_visits_log2` vertices codes each slab's interior in a stream of its own, so
+    /// that the slabs decode at once. 1 (no sixth and seventh parameter bytes): no pass is
+    /// sliced. `emc` slices meshes of [`SLICED_VERTICES`] vertices or more into [`SLABS`].
+    pub slabs: u8,
+    /// See [`Self::slabs`].
+    pub sliced_visits_log2: u8,
 }
+
+/// Slabs of the `emc` streams that have them: up to four cores decode them at once; each slab
+/// more costs about 0.15% of the stream (bunny-closed-35k ×16 at 12 bits: 2 slabs +0.43%,
+/// 4 +0.66%, 8 +1.29%, 16 +2.29%; BENCHMARKS.md).
+pub const SLABS: u8 = 4;
+
+/// The passes `emc` slices: those of 2^this visits or more (8,192 a slab at four slabs).
+pub const SLICED_VISITS_LOG2: u8 = 15;
+
+/// The meshes whose `emc` streams have slabs: those of this many vertices or more.
+pub const SLICED_VERTICES: usize = 1 << 16;
+
+/// Most slabs a stream may have.
+const MAX_SLABS: u8 = 64;
 
 /// The fifth parameter byte of an `emc` stream whose face corrections follow the level that
 /// decodes the last vertex.
@@ -85,6 +106,12 @@ impl EmcParams {
                 axes: axes_by_extent(extent_of(mesh)),
             },
             faces_when_settled: syntax == Syntax::Modelled,
+            slabs: if syntax == Syntax::Modelled && mesh.vertex_count() >= SLICED_VERTICES {
+                SLABS
+            } else {
+                1
+            },
+            sliced_visits_log2: SLICED_VISITS_LOG2,
         }
     }
 
@@ -94,6 +121,9 @@ impl EmcParams {
         let mut params = vec![syntax as u8, a, b, c];
         if self.faces_when_settled {
             params.push(FACES_WHEN_SETTLED);
+            if self.slabs > 1 {
+                params.extend([self.slabs, self.sliced_visits_log2]);
+            }
         }
         Header {
             codec_id,
@@ -123,9 +153,18 @@ impl EmcParams {
             Some(&FACES_WHEN_SETTLED) if syntax == Syntax::Modelled => true,
             Some(_) => return Err(bad("emc parameters of unknown syntax")),
         };
-        if !(4..=5).contains(&p.len()) || p[0] != syntax as u8 {
+        if ![4, 5, 7].contains(&p.len()) || p[0] != syntax as u8 {
             return Err(bad("emc parameters of unknown syntax"));
         }
+        let (slabs, sliced_visits_log2) = match p.get(5..7) {
+            None => (1, SLICED_VISITS_LOG2),
+            Some(&[slabs, log2]) if (2..=MAX_SLABS).contains(&slabs) && log2 < 32 => (slabs, log2),
+            Some(_) => {
+                return Err(bad(
+                    "emc slabs out of range (2 to 64 slabs, passes of under 2^32 visits)",
+                ))
+            }
+        };
         let axes = [p[1], p[2], p[3]];
         let mut sorted = axes;
         sorted.sort_unstable();
@@ -143,6 +182,8 @@ impl EmcParams {
                 axes,
             },
             faces_when_settled,
+            slabs,
+            sliced_visits_log2,
         })
     }
 }

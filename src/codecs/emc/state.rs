@@ -14,6 +14,7 @@ use crate::mesh::canonical::rotate_to_smallest;
 use crate::mesh::CanonicalMesh;
 use crate::mesh::{Grid, TriMesh};
 use glam::DVec3;
+use rayon::prelude::*;
 use std::ops::Range;
 
 /// What happens to an edge of a splitting vertex.
@@ -111,48 +112,26 @@ impl EmcState {
         self.next_split[v] = next[0];
         self.next_split.push(next[1]);
 
-        let old = std::mem::take(&mut self.adjacency[v]);
-        let mut kept = Neighbours::new();
-        let mut moved = Neighbours::new();
-        for (&n, &code) in old.iter().zip(codes) {
-            let around = &mut self.adjacency[n as usize];
-            match code {
-                EdgeCode::Stay => kept.push(n),
-                EdgeCode::Move => {
-                    if let Ok(i) = around.binary_search(&(v as u32)) {
-                        around.remove(i);
-                    }
-                    around.push(r); // r is the largest id: the list stays sorted
-                    moved.push(n);
-                }
-                EdgeCode::Duplicate => {
-                    around.push(r);
-                    kept.push(n);
-                    moved.push(n);
-                    self.edges += 1;
-                }
-            }
-        }
-        if connecting {
-            self.edges += 1;
-            kept.push(r);
-            let at = moved.partition_point(|&x| x < v as u32);
-            moved.insert(at, v as u32);
-        }
-        self.adjacency[v] = kept;
-        self.adjacency.push(moved);
+        self.adjacency.push(Neighbours::new());
+        self.edges += split_edges(&mut self.adjacency, v, r as usize, connecting, codes);
         r as usize
+    }
+
+    /// Edges of the graph (each counted once).
+    pub fn edge_count(&self) -> u64 {
+        self.edges
+    }
+
+    /// Counts `added` edges that a split made outside [`Self::split`] (a slab of a sliced
+    /// pass).
+    pub fn add_edges(&mut self, added: u64) {
+        self.edges += added;
     }
 
     /// An error once the graph has more edges than a mesh of `triangles` (the header's count)
     /// can have ([`limits::graph_edges`]): a decoder's bound on what a stream may build.
     pub fn check_edges(&self, triangles: u64) -> Result<(), String> {
-        if self.edges > limits::graph_edges(triangles) {
-            return Err(format!(
-                "more edges than the {triangles} triangles the header declares can have"
-            ));
-        }
-        Ok(())
+        check_edge_count(self.edges, triangles)
     }
 
     /// What a decoder shows after the levels decoded so far: `full` once the last level's
@@ -177,6 +156,7 @@ impl EmcState {
             .map(|d| self.order.bits_per_axis(d).map(|b| grid.bits - b))
             .collect();
         (0..self.len())
+            .into_par_iter()
             .map(|v| grid.coarse_centre(self.cells[v], shifts[self.depth[v] as usize]))
             .collect()
     }
@@ -267,6 +247,75 @@ impl EmcState {
             attributes: None,
         })
     }
+}
+
+/// An error if a graph of `edges` edges has more than a mesh of `triangles` (the header's
+/// count) can have ([`limits::graph_edges`]).
+pub fn check_edge_count(edges: u64, triangles: u64) -> Result<(), String> {
+    if edges > limits::graph_edges(triangles) {
+        return Err(format!(
+            "more edges than the {triangles} triangles the header declares can have"
+        ));
+    }
+    Ok(())
+}
+
+/// Where the neighbour lists a split edits are kept: the state's own vector, or the raw view
+/// the slabs of a sliced pass share (`modelled::walk`).
+pub trait NeighbourLists {
+    /// `v`'s sorted neighbour list.
+    fn list(&mut self, v: usize) -> &mut Neighbours;
+}
+
+impl NeighbourLists for Vec<Neighbours> {
+    fn list(&mut self, v: usize) -> &mut Neighbours {
+        &mut self[v]
+    }
+}
+
+/// The edge updates of VS (see [`EmcState::split`]): `v` keeps the edges coded STAY or
+/// DUPLICATE, `r` (whose list is empty) takes those coded MOVE or DUPLICATE and, if
+/// `connecting`, an edge to `v`; each neighbour's list follows. `r` must be larger than every
+/// id in the lists it joins (so they stay sorted). Returns the edges added.
+pub fn split_edges<L: NeighbourLists>(
+    lists: &mut L,
+    v: usize,
+    r: usize,
+    connecting: bool,
+    codes: &[EdgeCode],
+) -> u64 {
+    let old = std::mem::take(lists.list(v));
+    let mut kept = Neighbours::new();
+    let mut moved = Neighbours::new();
+    let mut added = 0;
+    for (&n, &code) in old.iter().zip(codes) {
+        let around = lists.list(n as usize);
+        match code {
+            EdgeCode::Stay => kept.push(n),
+            EdgeCode::Move => {
+                if let Ok(i) = around.binary_search(&(v as u32)) {
+                    around.remove(i);
+                }
+                around.push(r as u32);
+                moved.push(n);
+            }
+            EdgeCode::Duplicate => {
+                around.push(r as u32);
+                kept.push(n);
+                moved.push(n);
+                added += 1;
+            }
+        }
+    }
+    if connecting {
+        added += 1;
+        kept.push(r as u32);
+        let at = moved.partition_point(|&x| x < v as u32);
+        moved.insert(at, v as u32);
+    }
+    *lists.list(v) = kept;
+    *lists.list(r) = moved;
+    added
 }
 
 /// Mean of the positions (the guess for outward orientation looks away from it).

@@ -77,6 +77,29 @@ impl Default for Contexts {
     }
 }
 
+impl Contexts {
+    /// Hands on what the slabs of a sliced pass learnt: each of `self`'s binary contexts becomes
+    /// its slab copies merged ([`BitContext::merged`]). The face-correction contexts are not
+    /// used by passes.
+    pub fn merge(&mut self, slabs: &[Box<Contexts>]) {
+        fn each<const N: usize>(
+            base: &mut [BitContext; N],
+            slabs: &[Box<Contexts>],
+            field: impl Fn(&Contexts) -> &[BitContext; N],
+        ) {
+            for (i, context) in base.iter_mut().enumerate() {
+                *context = context.merged(slabs.iter().map(|slab| &field(slab)[i]));
+            }
+        }
+        each(&mut self.split, slabs, |c| &c.split);
+        each(&mut self.half, slabs, |c| &c.half);
+        each(&mut self.connecting, slabs, |c| &c.connecting);
+        each(&mut self.duplicate, slabs, |c| &c.duplicate);
+        each(&mut self.moves, slabs, |c| &c.moves);
+        each(&mut self.leaf, slabs, |c| &c.leaf);
+    }
+}
+
 /// Does a cluster split now: by how close its neighbours' predicted place is to the split plane
 /// (a cluster straddles the plane where its surface crosses it), its valence (a bigger cluster
 /// has more neighbours) and the levels left.

@@ -6,15 +6,97 @@ use crate::codecs::emc::state::FaceCorrections;
 use crate::codecs::emc::EmcParams;
 use crate::codecs::{LevelDecoder, LevelMesh, PassStops};
 use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
+use crate::coding::varint;
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::mesh::TriMesh;
 
-struct DecoderSide {
+/// The decoder's side: the level's stream and, in a stream with slabs, the level's slab
+/// table and slab streams.
+struct DecoderSide<'p> {
     coder: ArithDecoder,
+    /// The level's slab table, read from `table_at` on.
+    table: &'p [u8],
+    table_at: usize,
+    /// The slab streams, one after another; the next starts at `streams_at`.
+    streams: &'p [u8],
+    streams_at: usize,
+    /// Byte lengths of the current sliced pass's slab streams.
+    lengths: Vec<usize>,
+    /// The level's stream while a slab's is read.
+    parked: Option<ArithDecoder>,
+    /// Whether the slabs of a sliced pass are decoded on threads.
+    threads: bool,
+    slabs: usize,
 }
 
-impl Side for DecoderSide {
+impl<'p> DecoderSide<'p> {
+    /// The side over a level's `payload`: in a stream with slabs (`slabs` > 1) the slab table,
+    /// the level's stream and the slab streams (docs/FORMAT.md §7), else the level's stream.
+    fn new(payload: &'p [u8], slabs: usize, threads: bool) -> Result<Self, String> {
+        let whole = |bytes: &[u8]| {
+            ArithDecoder::new(bytes)
+                .ok_or_else(|| "level payload is not whole 32-bit words".to_string())
+        };
+        if slabs < 2 {
+            return Ok(DecoderSide {
+                coder: whole(payload)?,
+                table: &[],
+                table_at: 0,
+                streams: &[],
+                streams_at: 0,
+                lengths: Vec::new(),
+                parked: None,
+                threads,
+                slabs,
+            });
+        }
+        let mut at = 0;
+        let mut part = |what: &str| -> Result<&'p [u8], String> {
+            let len = varint::get(payload, &mut at)
+                .map_err(|_| format!("level's {what} length is cut or too long"))?;
+            let bytes = usize::try_from(len)
+                .ok()
+                .and_then(|len| payload.get(at..at.checked_add(len)?))
+                .ok_or_else(|| format!("level's {what} runs past its payload"))?;
+            at += bytes.len();
+            Ok(bytes)
+        };
+        let table = part("slab table")?;
+        let main = part("stream")?;
+        Ok(DecoderSide {
+            coder: whole(main)?,
+            table,
+            table_at: 0,
+            streams: &payload[at..],
+            streams_at: 0,
+            lengths: Vec::new(),
+            parked: None,
+            threads,
+            slabs,
+        })
+    }
+
+    /// An error unless the level's slab table and slab streams were read to their ends.
+    fn finish(&self) -> Result<(), Stop> {
+        if self.table_at != self.table.len() || self.streams_at != self.streams.len() {
+            return Err(Stop::Fault(
+                "the level's slab table or slab streams hold more than its passes read".into(),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The next slab stream, of `len` bytes.
+    fn next_stream(&mut self, len: usize) -> Result<ArithDecoder, Stop> {
+        let bytes = &self.streams[self.streams_at..self.streams_at + len];
+        self.streams_at += len;
+        ArithDecoder::new(bytes)
+            .ok_or_else(|| Stop::Fault("a slab stream is not whole 32-bit words".into()))
+    }
+}
+
+impl Side for DecoderSide<'_> {
     fn code(
         &mut self,
         context: &mut BitContext,
@@ -36,6 +118,66 @@ impl Side for DecoderSide {
     ) -> Result<[bool; 3], Stop> {
         let bits = self.coder.bits3(contexts, index).ok_or(Stop::OutOfBits)?;
         Ok([0, 1, 2].map(|k| bits[k] ^ flips[k]))
+    }
+
+    fn begin_sliced_pass(
+        &mut self,
+        interior: &[Vec<u32>],
+        step: Option<usize>,
+    ) -> Result<Vec<u32>, Stop> {
+        let fault = |what: &str| Stop::Fault(format!("the level's slab table {what}"));
+        let mut counts = Vec::with_capacity(self.slabs);
+        self.lengths.clear();
+        let mut left = self.streams.len() - self.streams_at;
+        for visits in interior {
+            let mut get =
+                || varint::get(self.table, &mut self.table_at).map_err(|_| fault("is cut"));
+            let (count, len) = (get()?, get()?);
+            if count > visits.len() as u64 || step.is_none() && count > 0 {
+                return Err(fault("splits more vertices than a slab visits"));
+            }
+            if len > left as u64 {
+                return Err(fault("lists slab streams past the payload's end"));
+            }
+            left -= len as usize;
+            counts.push(count as u32);
+            self.lengths.push(len as usize);
+        }
+        Ok(counts)
+    }
+
+    fn slab_sides(&mut self) -> Result<Option<Vec<Self>>, Stop> {
+        if !self.threads {
+            return Ok(None);
+        }
+        let lengths = std::mem::take(&mut self.lengths);
+        let mut sides = Vec::with_capacity(lengths.len());
+        for len in lengths {
+            sides.push(DecoderSide {
+                coder: self.next_stream(len)?,
+                table: &[],
+                table_at: 0,
+                streams: &[],
+                streams_at: 0,
+                lengths: Vec::new(),
+                parked: None,
+                threads: false,
+                slabs: 1,
+            });
+        }
+        Ok(Some(sides))
+    }
+
+    fn begin_slab(&mut self, slab: usize) -> Result<(), Stop> {
+        let coder = self.next_stream(self.lengths[slab])?;
+        self.parked = Some(std::mem::replace(&mut self.coder, coder));
+        Ok(())
+    }
+
+    fn end_slab(&mut self, _slab: usize) {
+        if let Some(coder) = self.parked.take() {
+            self.coder = coder;
+        }
     }
 }
 
@@ -78,31 +220,53 @@ pub struct EmcDecoder<'a> {
     /// The mesh's faces and loose edges, once the face corrections are read (every later
     /// level shows them).
     settled: Option<SettledFaces>,
+    /// The level whose decoding failed: its passes may have stopped halfway, so neither it
+    /// nor any later level is shown.
+    failed: Option<usize>,
 }
 
 impl<'a> EmcDecoder<'a> {
     pub fn new(stream: StreamReader<'a>, params: EmcParams) -> Self {
         let header = stream.header().clone();
         EmcDecoder {
-            walker: Walker::new(params.order, header.vertices),
+            walker: Walker::new(
+                params.order,
+                header.vertices,
+                params.slabs as usize,
+                1 << params.sliced_visits_log2,
+            ),
             header,
             params,
             stream,
             levels_done: 0,
             settled: None,
+            failed: None,
+        }
+    }
+
+    /// An error once a level failed to decode.
+    fn check_failed(&self) -> Result<()> {
+        match self.failed {
+            Some(level) => Err(Error::malformed(
+                level,
+                0,
+                "an earlier error stopped this level halfway",
+            )),
+            None => Ok(()),
         }
     }
 
     /// Decodes the first `passes` (1..=3) passes of the next level.
     fn decode_passes(&mut self, passes: usize) -> Result<bool> {
+        self.check_failed()?;
         let Some(payload) = self.stream.next_level() else {
             return Ok(false);
         };
         let level = self.levels_done + 1;
         let fault = |what: String| Error::malformed(level, payload.start, what);
-        let coder = ArithDecoder::new(payload.bytes)
-            .ok_or_else(|| fault("level payload is not whole 32-bit words".into()))?;
-        let mut side = DecoderSide { coder };
+        let threads = rayon::current_num_threads() > 1;
+        let mut side =
+            DecoderSide::new(payload.bytes, self.params.slabs as usize, threads).map_err(fault)?;
         let outcome = (|| {
             self.walker.level(
                 &mut side,
@@ -120,8 +284,11 @@ impl<'a> EmcDecoder<'a> {
             {
                 self.read_corrections(&mut side.coder)?;
             }
-            Ok(())
+            side.finish()
         })();
+        if outcome.is_err() {
+            self.failed = Some(level);
+        }
         match outcome {
             Ok(()) => Ok(true),
             Err(Stop::Fault(what)) => Err(fault(what)),
@@ -180,6 +347,7 @@ impl LevelDecoder for EmcDecoder<'_> {
     }
 
     fn mesh(&self) -> Result<LevelMesh> {
+        self.check_failed()?;
         let grid = &self.header.grid;
         // The full level is exact: its cells' centres.
         let positions = if self.levels_done == self.levels() {

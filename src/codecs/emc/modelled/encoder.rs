@@ -3,19 +3,61 @@
 
 use super::walk::{Question, Side, Stop, Walker};
 use crate::codecs::emc::clusters::{Clusters, SplitPlan};
-use crate::codecs::emc::state::{face_corrections, EdgeCode, EmcState};
+use crate::codecs::emc::state::{face_corrections, EdgeCode};
 use crate::codecs::emc::EmcParams;
 use crate::codecs::{Encoded, Stats};
 use crate::coding::arith::{ArithEncoder, BitContext, UintContext};
-use crate::coding::SyntaxClass;
+use crate::coding::{varint, BitLedger, SyntaxClass};
 use crate::container::{Header, LevelCost, StreamWriter};
 use crate::hierarchy::octree::KeyTrie;
 use crate::mesh::CanonicalMesh;
+use std::collections::BTreeMap;
 
 struct EncoderSide {
     coder: ArithEncoder,
     clusters: Clusters,
     plan: SplitPlan,
+    /// The current sliced pass's split counts, and its slab streams' lengths so far.
+    counts: Vec<u32>,
+    lengths: Vec<usize>,
+    /// The level's stream while a slab's is coded.
+    parked: Option<ArithEncoder>,
+    /// The level's slab table and slab streams so far, and what the slab streams cost.
+    table: Vec<u8>,
+    streams: Vec<u8>,
+    slab_bits: BTreeMap<&'static str, f64>,
+    slab_ledger: BitLedger,
+}
+
+impl EncoderSide {
+    /// The level's payload (docs/FORMAT.md §7) and its cost, from the level's stream `coder`:
+    /// in a stream with slabs, the slab table, the level's stream and the slab streams; else
+    /// the level's stream. Clears the level's slab table and streams.
+    fn payload(&mut self, coder: ArithEncoder, slabs: u8) -> (Vec<u8>, BitLedger) {
+        let (main, ledger) = coder.finish();
+        if slabs < 2 {
+            return (main, ledger);
+        }
+        let (table, streams) = (
+            std::mem::take(&mut self.table),
+            std::mem::take(&mut self.streams),
+        );
+        let slab_ledger = std::mem::take(&mut self.slab_ledger);
+        let mut payload = Vec::with_capacity(table.len() + main.len() + streams.len() + 8);
+        varint::put(&mut payload, table.len() as u64);
+        payload.extend_from_slice(&table);
+        varint::put(&mut payload, main.len() as u64);
+        payload.extend_from_slice(&main);
+        payload.extend_from_slice(&streams);
+        // The table and the lengths count as connectivity (they say where splits are coded).
+        let coded = (main.len() + streams.len()) as u64 * 8;
+        let cost = BitLedger {
+            connectivity: ledger.connectivity + slab_ledger.connectivity + payload.len() as u64 * 8
+                - coded,
+            geometry: ledger.geometry + slab_ledger.geometry,
+        };
+        (payload, cost)
+    }
 }
 
 impl Side for EncoderSide {
@@ -61,12 +103,68 @@ impl Side for EncoderSide {
         Ok(answers)
     }
 
-    fn begin_split(&mut self, state: &EmcState, v: usize, step: usize) {
-        self.clusters.plan(state, v, step, &mut self.plan);
+    fn begin_split(
+        &mut self,
+        neighbours: &[u32],
+        v: usize,
+        r: usize,
+        step: usize,
+        vertices: usize,
+    ) {
+        self.clusters
+            .plan(neighbours, v, r, step, vertices, &mut self.plan);
     }
 
-    fn end_split(&mut self, v: usize, _r: usize) {
-        self.clusters.commit(v, &self.plan);
+    fn end_split(&mut self, v: usize, r: usize) {
+        self.clusters.commit(v, r, &self.plan);
+    }
+
+    fn begin_sliced_pass(
+        &mut self,
+        interior: &[Vec<u32>],
+        step: Option<usize>,
+    ) -> Result<Vec<u32>, Stop> {
+        self.counts = interior
+            .iter()
+            .map(|visits| match step {
+                Some(step) => visits
+                    .iter()
+                    .filter(|&&v| self.clusters.next_split(v as usize) == Some(step))
+                    .count() as u32,
+                None => 0,
+            })
+            .collect();
+        self.lengths.clear();
+        Ok(self.counts.clone())
+    }
+
+    fn slab_sides(&mut self) -> Result<Option<Vec<Self>>, Stop> {
+        // The slabs share the clusters: they are coded one after another.
+        Ok(None)
+    }
+
+    fn begin_slab(&mut self, _slab: usize) -> Result<(), Stop> {
+        self.parked = Some(std::mem::take(&mut self.coder));
+        Ok(())
+    }
+
+    fn end_slab(&mut self, _slab: usize) {
+        let slab = std::mem::replace(&mut self.coder, self.parked.take().unwrap_or_default());
+        for (field, bits) in &slab.field_bits {
+            *self.slab_bits.entry(field).or_default() += bits;
+        }
+        let (bytes, ledger) = slab.finish();
+        self.slab_ledger.connectivity += ledger.connectivity;
+        self.slab_ledger.geometry += ledger.geometry;
+        self.lengths.push(bytes.len());
+        self.streams.extend_from_slice(&bytes);
+    }
+
+    fn end_sliced_pass(&mut self) {
+        for (&count, &len) in self.counts.iter().zip(&self.lengths) {
+            varint::put(&mut self.table, count as u64);
+            varint::put(&mut self.table, len as u64);
+        }
     }
 }
 
@@ -88,12 +186,24 @@ pub fn put_list(
 pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate::Result<Encoded> {
     let order = params.order;
     let n = mesh.vertex_count() as u64;
-    let mut walker = Walker::new(order, n);
+    let mut walker = Walker::new(
+        order,
+        n,
+        params.slabs as usize,
+        1 << params.sliced_visits_log2,
+    );
     walker.state.reserve(mesh.vertex_count());
     let mut side = EncoderSide {
         coder: ArithEncoder::default(),
         clusters: Clusters::new(mesh, KeyTrie::new(order, &mesh.cells)),
         plan: SplitPlan::default(),
+        counts: Vec::new(),
+        lengths: Vec::new(),
+        parked: None,
+        table: Vec::new(),
+        streams: Vec::new(),
+        slab_bits: BTreeMap::new(),
+        slab_ledger: BitLedger::default(),
     };
     let mut writer = StreamWriter::new(&header);
     let mut stats = Stats::default();
@@ -135,10 +245,11 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
                 stats.add_named(field, list.len() as f64);
             }
         }
-        for (field, bits) in &coder.field_bits {
+        for (field, bits) in coder.field_bits.iter().chain(&side.slab_bits) {
             stats.add_named(&format!("{field}_bits"), *bits);
         }
-        let (payload, level_ledger) = coder.finish();
+        side.slab_bits.clear();
+        let (payload, level_ledger) = side.payload(coder, params.slabs);
         writer.push_level(
             &payload,
             LevelCost {

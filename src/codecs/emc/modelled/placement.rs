@@ -21,6 +21,7 @@
 use super::walk::{estimate, Walker};
 use crate::mesh::Grid;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// How much the prediction's expected squared error is trusted, per half-width that the
 /// neighbours reach (see the module docs).
@@ -44,6 +45,7 @@ impl Walker {
         let unit = DVec3::from(grid.cell) * 0.5;
         let levels = self.state.order.levels;
         (0..self.state.len())
+            .into_par_iter()
             .map(|v| {
                 let (centre, shifts) = self.cell_of(v);
                 let mut place = centre.map(|c| c as f64);

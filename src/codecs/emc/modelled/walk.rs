@@ -4,8 +4,12 @@
 //! already knows.
 
 use super::contexts::{self, Contexts};
-use crate::codecs::emc::state::{EdgeCode, EmcState, NO_SPLIT};
+use crate::codecs::emc::state::{
+    check_edge_count, split_edges, EdgeCode, EmcState, NeighbourLists, Neighbours, NO_SPLIT,
+};
 use crate::hierarchy::octree::StepOrder;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// A question the walker asks about vertex `v` at the current step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,7 +61,7 @@ pub enum Stop {
 }
 
 /// One side of the coder.
-pub trait Side {
+pub trait Side: Send {
     /// Codes (encoder) or reads (decoder) the answer to `question` about `v`, under `context`.
     /// The bit coded is the answer XOR `flip`, so that 1 always means "as predicted".
     fn code(
@@ -81,11 +85,46 @@ pub trait Side {
         first: usize,
     ) -> Result<[bool; 3], Stop>;
 
-    /// Called when `v` is about to split at `step`, before its connectivity is coded.
-    fn begin_split(&mut self, _state: &EmcState, _v: usize, _step: usize) {}
+    /// Called when `v`, whose neighbours are `neighbours`, is about to split at `step` into
+    /// `v` and the new vertex `r`, before its connectivity is coded; `vertices` is more than
+    /// every vertex id.
+    fn begin_split(
+        &mut self,
+        _neighbours: &[u32],
+        _v: usize,
+        _r: usize,
+        _step: usize,
+        _vertices: usize,
+    ) {
+    }
 
     /// Called after `v` split into `v` (lower half) and `r` (upper half).
     fn end_split(&mut self, _v: usize, _r: usize) {}
+
+    /// A sliced pass begins (`step`: the pass's step; `None` for the leaves' pass), in which
+    /// slab `s` visits `interior[s]`: returns how many of them split in each slab (the
+    /// encoder works it out, the decoder reads it from the level's slab table).
+    fn begin_sliced_pass(
+        &mut self,
+        interior: &[Vec<u32>],
+        step: Option<usize>,
+    ) -> Result<Vec<u32>, Stop>;
+
+    /// Independent sides for the slabs of the current sliced pass, each reading its own slab
+    /// stream, to be run on threads; `None` to code the slabs one after another between
+    /// [`Self::begin_slab`] and [`Self::end_slab`].
+    fn slab_sides(&mut self) -> Result<Option<Vec<Self>>, Stop>
+    where
+        Self: Sized;
+
+    /// Slab `slab` of the current sliced pass is coded next, in a stream of its own.
+    fn begin_slab(&mut self, slab: usize) -> Result<(), Stop>;
+
+    /// Slab `slab` is coded; the level's own stream follows again.
+    fn end_slab(&mut self, slab: usize);
+
+    /// The slabs of the current sliced pass are coded (the encoder writes their table entry).
+    fn end_sliced_pass(&mut self) {}
 }
 
 /// Steepest regression plane used for prediction (squared gradient).
@@ -209,11 +248,53 @@ fn leaf_contexts(m: &Moments, shifts: [u8; 3]) -> ([usize; 3], [bool; 3]) {
     (index, below)
 }
 
-/// Count, mean and covariance of a vertex's neighbours (see [`Walker::moments`]).
+/// Count, mean and covariance of a vertex's neighbours (see [`neighbour_moments`]).
 pub(super) struct Moments {
     k: usize,
     pub(super) mean: [f64; 3],
     pub(super) cov: [[f64; 3]; 3],
+}
+
+/// Count, mean and covariance of the cell centres of `neighbours` (`centre` gives each), relative
+/// to `origin`; `None` without neighbours.
+#[inline(always)]
+fn neighbour_moments(
+    origin: [i32; 3],
+    neighbours: &[u32],
+    centre: impl Fn(usize) -> [i32; 3],
+) -> Option<Moments> {
+    if neighbours.is_empty() {
+        return None;
+    }
+    // Sums of the offsets and their products: x, y, z, xx, yy, zz, xy, xz, yz.
+    let mut s = [0f64; 9];
+    for &n in neighbours {
+        let c = centre(n as usize);
+        let d = [0, 1, 2].map(|a| (c[a] - origin[a]) as f64);
+        s[0] += d[0];
+        s[1] += d[1];
+        s[2] += d[2];
+        s[3] += d[0] * d[0];
+        s[4] += d[1] * d[1];
+        s[5] += d[2] * d[2];
+        s[6] += d[0] * d[1];
+        s[7] += d[0] * d[2];
+        s[8] += d[1] * d[2];
+    }
+    let k = neighbours.len();
+    let inv = 1.0 / k as f64;
+    let mean = [s[0] * inv, s[1] * inv, s[2] * inv];
+    let (xy, xz, yz) = (
+        s[6] * inv - mean[0] * mean[1],
+        s[7] * inv - mean[0] * mean[2],
+        s[8] * inv - mean[1] * mean[2],
+    );
+    let cov = [
+        [s[3] * inv - mean[0] * mean[0], xy, xz],
+        [xy, s[4] * inv - mean[1] * mean[1], yz],
+        [xz, yz, s[5] * inv - mean[2] * mean[2]],
+    ];
+    Some(Moments { k, mean, cov })
 }
 
 /// The state both sides keep, with the modelled coder's extra knowledge of each vertex.
@@ -223,6 +304,11 @@ pub struct Walker {
     /// Known to be a single mesh vertex (no further split).
     pub leaf: Vec<bool>,
     pub contexts: Box<Contexts>,
+    /// Slabs of a sliced pass (1: no pass is sliced), and the fewest visits a sliced pass has.
+    slabs: usize,
+    sliced_visits: usize,
+    /// Where the slabs lie in the current level.
+    slab_cuts: Slabs,
     /// For each depth, the shift from the cell prefix to the full grid per axis.
     shifts: Vec<[u8; 3]>,
     /// Twice each vertex's cell centre, in units of the full grid (kept with the cells: the
@@ -236,13 +322,47 @@ pub struct Walker {
     resting: Vec<u32>,
     /// Per vertex: the serial of the last split that coded its edge to the splitting vertex
     /// (bits 3 and up) and the code (bit 0 stay, 1 move, 2 duplicate).
-    marks: Vec<u64>,
-    /// Serial of the current split.
+    /// Atomic (relaxed loads and stores, plain moves on common processors) because a slab
+    /// walking a neighbour's list reads the marks of vertices another slab may be marking:
+    /// those never carry its own serial, so what it reads of them does not matter.
+    marks: Vec<AtomicU64>,
+    /// Serial of the last split (the serials of a sliced pass's slabs interleave).
     split_serial: u64,
 }
 
+/// What a pass does to the vertices it visits.
+#[derive(Clone, Copy)]
+enum Work {
+    /// The clusters' pass of a step: split, or take a half.
+    Split(usize),
+    /// The leaves' three bits of the level whose first step is this.
+    Leaves(usize),
+}
+
+/// How a sliced pass divides its visits: those of each slab whose neighbours all lie in the
+/// same slab, and the others.
+struct SlabPlan {
+    interior: Vec<Vec<u32>>,
+    boundary: Vec<u32>,
+}
+
+/// Bins of the centres along the longest axis from which the slabs are cut.
+const SLAB_BINS: usize = 1024;
+
+/// Where the slabs lie during a level: the slab of each bin of the centres along the longest
+/// axis (cut at the level's first sliced pass so that the slabs hold about equal shares of its
+/// visits), and the slab of every vertex (by its centre when a pass first needed it: a vertex
+/// keeps its slab for the rest of the level).
+struct Slabs {
+    level: usize,
+    of_bin: Vec<u8>,
+    of_vertex: Vec<u8>,
+}
+
 impl Walker {
-    pub fn new(order: StepOrder, vertices: u64) -> Walker {
+    /// The walker of a stream of `vertices` vertices whose passes of `sliced_visits` visits or
+    /// more are sliced into `slabs` slabs (1: none).
+    pub fn new(order: StepOrder, vertices: u64, slabs: usize, sliced_visits: usize) -> Walker {
         let shifts = (0..=order.steps())
             .map(|d| order.bits_per_axis(d).map(|b| order.levels - b))
             .collect();
@@ -250,15 +370,23 @@ impl Walker {
             state: EmcState::new(order, vertices),
             leaf: vec![vertices <= 1],
             contexts: Box::default(),
+            slabs: slabs.max(1),
+            sliced_visits,
+            slab_cuts: Slabs {
+                level: 0,
+                of_bin: Vec::new(),
+                of_vertex: Vec::new(),
+            },
             shifts,
             centres: Vec::new(),
             codes: Vec::new(),
             active: Vec::new(),
             resting: Vec::new(),
-            marks: Vec::new(),
+            marks: vec![AtomicU64::new(0)],
             split_serial: 0,
         };
-        walker.refresh(0);
+        walker.centres.push([0; 3]);
+        Run::refresh_centre(&mut walker.centres[0], [0; 3], walker.shifts[0]);
         walker
     }
 
@@ -272,28 +400,18 @@ impl Walker {
         self.codes = Vec::new();
     }
 
-    /// Recomputes the cached centre of `v` from its cell.
-    fn refresh(&mut self, v: usize) {
-        let shifts = self.shifts[self.state.depth[v] as usize];
-        // At most 2^25 (24 levels), so i32 holds it; the neighbours' offsets too.
-        let centre = [0, 1, 2].map(|a| (((self.state.cells[v][a] as i32) << 1) | 1) << shifts[a]);
-        if v == self.centres.len() {
-            self.centres.push(centre);
-        } else {
-            self.centres[v] = centre;
-        }
-    }
-
     /// Twice `v`'s cell centre in units of the full grid, and the shifts of its half-widths:
     /// half the width of its cell along axis `a` is 2^`shifts[a]` in those units.
     pub(super) fn cell_of(&self, v: usize) -> ([i32; 3], [u8; 3]) {
         (self.centres[v], self.shifts[self.state.depth[v] as usize])
     }
 
-    /// Half the width of `v`'s cell along `axis` is 2^this, in the units of the centres.
-    #[inline]
-    fn half_width_shift(&self, v: usize, axis: usize) -> u8 {
-        self.shifts[self.state.depth[v] as usize][axis]
+    /// Count, mean and covariance of `v`'s neighbours' cell centres, relative to `v`'s centre;
+    /// `None` without neighbours.
+    pub(super) fn moments(&self, v: usize) -> Option<Moments> {
+        neighbour_moments(self.centres[v], &self.state.adjacency[v], |n| {
+            self.centres[n]
+        })
     }
 
     /// Codes the first `passes` (1..=3) passes of `level` (1-based) and, when all three are
@@ -321,65 +439,511 @@ impl Walker {
         }
         let first = 3 * (level - 1);
         for step in first..first + passes.min(3) {
-            self.pass(side, step, max_vertices, max_triangles)?;
+            // One pass over the active vertices present at its start; those it splits off are
+            // visited from the next pass on.
+            let mut active = std::mem::take(&mut self.active);
+            let created = self.pass(
+                side,
+                &active,
+                Work::Split(step),
+                max_vertices,
+                max_triangles,
+            );
+            active.extend(created?);
+            self.active = active;
         }
         if passes >= 3 {
-            self.leaf_pass(side, first)?;
+            // The three refinement bits of a level of every vertex that was a leaf at the
+            // level's start, vertex by vertex: the neighbours' moments are taken once, and all
+            // three contexts come from them and the vertex's cell at the level's start, before
+            // any of the three bits, so that the bits go through the coder as one symbol.
+            let resting = std::mem::take(&mut self.resting);
+            let done = self.pass(
+                side,
+                &resting,
+                Work::Leaves(first),
+                max_vertices,
+                max_triangles,
+            );
+            self.resting = resting;
+            done?;
         }
         Ok(())
     }
 
-    /// One pass (`step`) over the active vertices present at its start.
+    /// One pass over `visits` (in list order); returns the vertices it created. In a stream
+    /// with slabs, a pass of at least `sliced_visits` visits is sliced: each slab first
+    /// codes its visits whose neighbours all lie in the slab, in a stream of its own and with
+    /// its own copy of the contexts (so the slabs can be coded at once: none reads or writes
+    /// another's vertices), then the contexts are merged and the remaining visits are coded in
+    /// the level's stream, in list order.
     fn pass<S: Side>(
         &mut self,
         side: &mut S,
-        step: usize,
+        visits: &[u32],
+        work: Work,
         max_vertices: u64,
         max_triangles: u64,
-    ) -> Result<(), Stop> {
-        let order = self.state.order;
+    ) -> Result<Vec<u32>, Stop> {
+        if self.slabs < 2 || visits.len() < self.sliced_visits {
+            return self.run_in_order(side, visits, work, max_vertices, max_triangles);
+        }
+        let (step, level) = match work {
+            Work::Split(step) => (Some(step), self.state.order.level(step)),
+            Work::Leaves(first) => (None, self.state.order.level(first)),
+        };
+        let plan = self.slab_plan(visits, level);
+        let counts = side.begin_sliced_pass(&plan.interior, step)?;
+        let mut created =
+            self.run_slabs(side, &plan, &counts, work, max_vertices, max_triangles)?;
+        side.end_sliced_pass();
+        created.extend(self.run_in_order(
+            side,
+            &plan.boundary,
+            work,
+            max_vertices,
+            max_triangles,
+        )?);
+        Ok(created)
+    }
+
+    /// Divides `visits`, a pass of `level`, into slabs (see [`SlabPlan`], [`Slabs`]).
+    fn slab_plan(&mut self, visits: &[u32], level: usize) -> SlabPlan {
+        let axis = self.state.order.axes[0] as usize;
+        // Centres lie below 2^(levels + 1).
+        let shift = (self.state.order.levels as u32 + 1).saturating_sub(SLAB_BINS.ilog2());
+        let centres = &self.centres;
+        let bin = |v: usize| ((centres[v][axis] >> shift) as usize).min(SLAB_BINS - 1);
+        if self.slab_cuts.level != level {
+            let mut histogram = [0usize; SLAB_BINS];
+            for &v in visits {
+                histogram[bin(v as usize)] += 1;
+            }
+            let mut seen = 0;
+            self.slab_cuts.of_bin = histogram
+                .iter()
+                .map(|&count| {
+                    let slab = (seen * self.slabs / visits.len()).min(self.slabs - 1) as u8;
+                    seen += count;
+                    slab
+                })
+                .collect();
+            self.slab_cuts.of_vertex.clear();
+            self.slab_cuts.level = level;
+        }
+        let Slabs {
+            of_bin, of_vertex, ..
+        } = &mut self.slab_cuts;
+        let known = of_vertex.len();
+        of_vertex.par_extend(
+            (known..self.state.len())
+                .into_par_iter()
+                .map(|v| of_bin[bin(v)]),
+        );
+        let slab_of = &*of_vertex;
+        let adjacency = &self.state.adjacency;
+        let kind: Vec<u8> = visits
+            .par_iter()
+            .map(|&v| {
+                let slab = slab_of[v as usize];
+                let inside = adjacency[v as usize]
+                    .iter()
+                    .all(|&n| slab_of[n as usize] == slab);
+                if inside {
+                    slab
+                } else {
+                    u8::MAX
+                }
+            })
+            .collect();
+        let mut interior = vec![Vec::new(); self.slabs];
+        let mut boundary = Vec::new();
+        for (&v, &slab) in visits.iter().zip(&kind) {
+            match interior.get_mut(slab as usize) {
+                Some(list) => list.push(v),
+                None => boundary.push(v),
+            }
+        }
+        SlabPlan { interior, boundary }
+    }
+
+    /// Makes room for `more` vertices after the list's end (each array gets a blank entry).
+    fn grow(&mut self, more: usize) {
+        let n = self.state.len() + more;
+        self.state.cells.resize(n, [0; 3]);
+        self.state.depth.resize(n, 0);
+        self.state.next_split.resize(n, NO_SPLIT);
+        self.state.adjacency.resize(n, Neighbours::new());
+        self.leaf.resize(n, false);
+        self.centres.resize(n, [0; 3]);
+        self.marks.resize_with(n, AtomicU64::default);
+    }
+
+    /// Drops the entries from `n` on (room [`Self::grow`] made that no split took).
+    fn shrink(&mut self, n: usize) {
+        self.state.cells.truncate(n);
+        self.state.depth.truncate(n);
+        self.state.next_split.truncate(n);
+        self.state.adjacency.truncate(n);
+        self.leaf.truncate(n);
+        self.centres.truncate(n);
+        self.marks.truncate(n);
+    }
+
+    /// The arrays a pass reads and writes, for [`Run`]s. Nothing else may touch them while
+    /// the view is in use.
+    fn lanes(&mut self) -> Lanes {
+        Lanes {
+            cells: self.state.cells.as_mut_ptr(),
+            depth: self.state.depth.as_mut_ptr(),
+            next_split: self.state.next_split.as_mut_ptr(),
+            adjacency: self.state.adjacency.as_mut_ptr(),
+            leaf: self.leaf.as_mut_ptr(),
+            centres: self.centres.as_mut_ptr(),
+            marks: self.marks.as_ptr(),
+            len: self.state.len(),
+        }
+    }
+
+    /// Codes `visits` one after another in the level's stream (a pass that is not sliced, or
+    /// the boundary of one that is).
+    fn run_in_order<S: Side>(
+        &mut self,
+        side: &mut S,
+        visits: &[u32],
+        work: Work,
+        max_vertices: u64,
+        max_triangles: u64,
+    ) -> Result<Vec<u32>, Stop> {
+        let start = self.state.len();
+        let room = match work {
+            Work::Split(_) => visits
+                .len()
+                .min(max_vertices.saturating_sub(start as u64) as usize),
+            Work::Leaves(_) => 0,
+        };
+        self.grow(room);
+        let lanes = self.lanes();
+        let mut run = Run {
+            lanes: &lanes,
+            shifts: &self.shifts,
+            order: self.state.order,
+            contexts: &mut self.contexts,
+            slab: None,
+            codes: std::mem::take(&mut self.codes),
+            serial: self.split_serial,
+            serial_step: 1,
+            first_id: start,
+            next_id: start,
+            end_id: start + room,
+            edges: self.state.edge_count(),
+            max_vertices,
+            max_triangles,
+            created: Vec::new(),
+        };
+        let done = run.work(side, visits, work);
+        let Run {
+            codes,
+            serial,
+            next_id,
+            edges,
+            created,
+            ..
+        } = run;
+        self.codes = codes;
+        self.split_serial = serial;
+        self.state.add_edges(edges - self.state.edge_count());
+        // A split takes its id before any list names it: the lists name no dropped entry.
+        self.shrink(next_id);
+        done.map(|()| created)
+    }
+
+    /// Codes each slab's interior visits (see [`Self::pass`]), on threads where the side
+    /// offers a side per slab; `counts[s]` is how many of slab `s`'s visits split. Returns the
+    /// vertices created, slab after slab.
+    fn run_slabs<S: Side>(
+        &mut self,
+        side: &mut S,
+        plan: &SlabPlan,
+        counts: &[u32],
+        work: Work,
+        max_vertices: u64,
+        max_triangles: u64,
+    ) -> Result<Vec<u32>, Stop> {
+        let start = self.state.len();
+        let mut firsts = Vec::with_capacity(self.slabs + 1);
+        firsts.push(start);
+        for (slab, &count) in counts.iter().enumerate() {
+            if count as usize > plan.interior[slab].len() {
+                return Err(Stop::Fault(format!(
+                    "slab {slab} splits {count} of its {} vertices",
+                    plan.interior[slab].len()
+                )));
+            }
+            firsts.push(firsts[slab] + count as usize);
+        }
+        let end = firsts[self.slabs];
+        if end as u64 > max_vertices {
+            return Err(Stop::Fault(format!(
+                "more splits than the {max_vertices} vertices the header declares"
+            )));
+        }
+        self.grow(end - start);
+        let mut contexts: Vec<Box<Contexts>> =
+            (0..self.slabs).map(|_| self.contexts.clone()).collect();
+        let lanes = self.lanes();
+        let slab_of = std::mem::take(&mut self.slab_cuts.of_vertex);
+        let stride = self.slabs as u64;
+        // The slabs' serials interleave above the last one used: slab s's k-th split takes
+        // serial + 1 + s + k · stride.
+        let (shifts, order, serial, edges) = (
+            &self.shifts,
+            self.state.order,
+            self.split_serial + stride,
+            self.state.edge_count(),
+        );
+        let run = |slab: usize, contexts: &mut Contexts, side: &mut S| {
+            let mut run = Run {
+                lanes: &lanes,
+                shifts,
+                order,
+                contexts,
+                slab: Some((&slab_of, slab as u8)),
+                codes: Vec::new(),
+                serial: serial + slab as u64 + 1 - stride,
+                serial_step: stride,
+                first_id: firsts[slab],
+                next_id: firsts[slab],
+                end_id: firsts[slab + 1],
+                edges,
+                max_vertices,
+                max_triangles,
+                created: Vec::new(),
+            };
+            run.work(side, &plan.interior[slab], work)?;
+            if run.next_id != run.end_id {
+                return Err(Stop::Fault(format!(
+                    "slab {slab} splits {} vertices, its table entry says {}",
+                    run.next_id - run.first_id,
+                    run.end_id - run.first_id
+                )));
+            }
+            Ok((run.serial, run.edges - edges, run.created))
+        };
+        let ends: Vec<Result<_, Stop>> = match side.slab_sides()? {
+            Some(mut sides) => sides
+                .par_iter_mut()
+                .zip(contexts.par_iter_mut())
+                .enumerate()
+                .map(|(slab, (side, contexts))| run(slab, contexts, side))
+                .collect(),
+            None => {
+                let mut ends = Vec::with_capacity(self.slabs);
+                for (slab, contexts) in contexts.iter_mut().enumerate() {
+                    side.begin_slab(slab)?;
+                    ends.push(run(slab, contexts, side));
+                    side.end_slab(slab);
+                }
+                ends
+            }
+        };
+        let mut created = Vec::with_capacity(end - start);
+        for end in ends {
+            let (serial, added, slab_created) = end?;
+            self.split_serial = self.split_serial.max(serial);
+            self.state.add_edges(added);
+            created.extend(slab_created);
+        }
+        self.state.check_edges(max_triangles).map_err(Stop::Fault)?;
+        self.contexts.merge(&contexts);
+        self.slab_cuts.of_vertex = slab_of;
+        Ok(created)
+    }
+}
+
+/// Raw views of the per-vertex arrays of a [`Walker`], shared by the [`Run`]s of a pass.
+///
+/// The slabs of a sliced pass run at once over these arrays. That is sound because each reads
+/// and writes only its own vertices: a slab visits only vertices whose neighbours all lie in
+/// the slab; a visit reads and writes the visited vertex, its neighbours and the vertex its
+/// split creates (which takes the slab's own ids); a split gives its vertex's neighbours only
+/// the created vertex, so no slab vertex ever gains a neighbour from elsewhere, whatever the
+/// stream says. Only the marks are read across slabs (the coded ring walks a neighbour's list,
+/// which may name another slab's vertices): they are atomic, and no slab's serial is
+/// another's, so what one slab reads of another's marks never counts.
+struct Lanes {
+    cells: *mut [u32; 3],
+    depth: *mut u16,
+    next_split: *mut u16,
+    adjacency: *mut Neighbours,
+    leaf: *mut bool,
+    centres: *mut [i32; 3],
+    marks: *const AtomicU64,
+    len: usize,
+}
+
+// SAFETY: see the type's docs: the runs sharing a view touch disjoint vertices.
+unsafe impl Sync for Lanes {}
+unsafe impl Send for Lanes {}
+
+/// One vertex's entry in an array of [`Lanes`], bounds-checked, to read.
+macro_rules! lane {
+    ($lanes:expr, $field:ident, $v:expr) => {{
+        let v: usize = $v;
+        assert!(v < $lanes.len, "vertex {v} outside the lanes");
+        // SAFETY: in bounds; the run owns vertex v (see `Lanes`).
+        unsafe { &*$lanes.$field.add(v) }
+    }};
+}
+
+/// One vertex's entry in an array of [`Lanes`], bounds-checked, to write.
+macro_rules! lane_mut {
+    ($lanes:expr, $field:ident, $v:expr) => {{
+        let v: usize = $v;
+        assert!(v < $lanes.len, "vertex {v} outside the lanes");
+        // SAFETY: in bounds; the run owns vertex v (see `Lanes`), and no other reference to
+        // the entry is alive.
+        unsafe { &mut *$lanes.$field.add(v) }
+    }};
+}
+
+/// One run of a pass over some of its visits: the whole pass, or one slab of a sliced pass, or
+/// the boundary that follows the slabs.
+struct Run<'a> {
+    lanes: &'a Lanes,
+    shifts: &'a [[u8; 3]],
+    order: StepOrder,
+    contexts: &'a mut Contexts,
+    /// In a slab: the slab of every vertex at the pass's start, and this slab.
+    slab: Option<(&'a [u8], u8)>,
+    codes: Vec<EdgeCode>,
+    serial: u64,
+    serial_step: u64,
+    /// The ids this run's splits take: from `first_id`, the next one, and the end.
+    first_id: usize,
+    next_id: usize,
+    end_id: usize,
+    /// Edges of the graph as this run knows them.
+    edges: u64,
+    max_vertices: u64,
+    max_triangles: u64,
+    /// Vertices created, in order.
+    created: Vec<u32>,
+}
+
+impl Run<'_> {
+    fn adjacency(&self, v: usize) -> &Neighbours {
+        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
+        lane!(self.lanes, adjacency, v)
+    }
+
+    fn centre(&self, v: usize) -> [i32; 3] {
+        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
+        *lane!(self.lanes, centres, v)
+    }
+
+    fn leaf(&self, v: usize) -> bool {
+        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
+        *lane!(self.lanes, leaf, v)
+    }
+
+    fn depth(&self, v: usize) -> usize {
+        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
+        *lane!(self.lanes, depth, v) as usize
+    }
+
+    /// Whether `v` is this run's to read: every vertex outside a slab; in a slab, its own
+    /// vertices and those its splits created.
+    fn owns(&self, v: usize) -> bool {
+        match self.slab {
+            None => true,
+            Some((slab_of, slab)) => match slab_of.get(v) {
+                Some(&s) => s == slab,
+                None => (self.first_id..self.next_id).contains(&v),
+            },
+        }
+    }
+
+    /// Twice the centre of a cell of prefix `cell`, whose half-widths have shifts `shifts`.
+    fn refresh_centre(centre: &mut [i32; 3], cell: [u32; 3], shifts: [u8; 3]) {
+        // At most 2^25 (24 levels), so i32 holds it; the neighbours' offsets too.
+        *centre = [0, 1, 2].map(|a| (((cell[a] as i32) << 1) | 1) << shifts[a]);
+    }
+
+    /// Recomputes the cached centre of `v` from its cell.
+    fn refresh(&mut self, v: usize) {
+        let shifts = self.shifts[self.depth(v)];
+        let cell = *lane!(self.lanes, cells, v);
+        Run::refresh_centre(lane_mut!(self.lanes, centres, v), cell, shifts);
+    }
+
+    /// RF: `v` takes `bit` at `step`.
+    fn refine(&mut self, v: usize, step: usize, bit: u32) {
+        let axis = self.order.axis(step);
+        let cell = lane_mut!(self.lanes, cells, v);
+        cell[axis] = (cell[axis] << 1) | bit;
+        *lane_mut!(self.lanes, depth, v) += 1;
+    }
+
+    fn work<S: Side>(&mut self, side: &mut S, visits: &[u32], work: Work) -> Result<(), Stop> {
+        match work {
+            Work::Split(step) => self.pass(side, visits, step),
+            Work::Leaves(first) => self.leaf_pass(side, visits, first),
+        }
+    }
+
+    /// The clusters' pass of `step` over `visits`.
+    fn pass<S: Side>(&mut self, side: &mut S, visits: &[u32], step: usize) -> Result<(), Stop> {
+        let order = self.order;
         let axis = order.axis(step);
         let remaining = order.levels as usize - order.level(step);
-        let present = self.active.len();
-        for i in 0..present {
-            let v = self.active[i] as usize;
-            let valence = self.state.adjacency[v].len();
+        for &v in visits {
+            let v = v as usize;
+            let valence = self.adjacency(v).len();
             let (half, flip) = self.half_context(v, axis);
-            let splits = !self.leaf[v] && {
+            let splits = !self.leaf(v) && {
                 let c = contexts::split(half.offset, valence, remaining);
                 side.code(&mut self.contexts.split[c], Question::Split, false, v, step)?
             };
             if !splits {
                 let c = half.index;
                 let bit = side.code(&mut self.contexts.half[c], Question::Half, flip, v, step)?;
-                self.state.refine(v, step, bit as u32);
+                self.refine(v, step, bit as u32);
                 self.refresh(v);
                 continue;
             }
-            if self.state.len() as u64 >= max_vertices {
-                return Err(Stop::Fault(format!(
-                    "more splits than the {max_vertices} vertices the header declares"
-                )));
+            if self.next_id == self.end_id {
+                return Err(Stop::Fault(match self.slab {
+                    None => format!(
+                        "more splits than the {} vertices the header declares",
+                        self.max_vertices
+                    ),
+                    Some((_, slab)) => {
+                        format!("slab {slab} splits more vertices than its table entry says")
+                    }
+                }));
             }
-            let r = self.split(side, v, step, axis, remaining, max_triangles)?;
-            self.active.push(r as u32);
+            let r = self.split(side, v, step, axis, remaining)?;
+            self.created.push(r as u32);
         }
         Ok(())
     }
 
-    /// The three refinement bits of a level (steps `first`..`first + 3`) of every vertex that
-    /// was a leaf at the level's start, vertex by vertex: the neighbours' moments are taken once,
-    /// and all three contexts come from them and the vertex's cell at the level's start, before
-    /// any of the three bits, so that the bits go through the coder as one symbol.
-    fn leaf_pass<S: Side>(&mut self, side: &mut S, first: usize) -> Result<(), Stop> {
-        let axes = [0, 1, 2].map(|k| self.state.order.axis(first + k));
-        for i in 0..self.resting.len() {
-            let v = self.resting[i] as usize;
+    /// The leaves' three bits of the level whose first step is `first`, for `visits`.
+    fn leaf_pass<S: Side>(
+        &mut self,
+        side: &mut S,
+        visits: &[u32],
+        first: usize,
+    ) -> Result<(), Stop> {
+        let axes = [0, 1, 2].map(|k| self.order.axis(first + k));
+        for &v in visits {
+            let v = v as usize;
             let (mut index, mut flips) = ([0; 3], [false; 3]);
             match self.moments(v) {
                 None => index = [contexts::half_isolated(true).index; 3],
                 Some(m) => {
-                    let shifts = self.shifts[self.state.depth[v] as usize];
+                    let shifts = self.shifts[self.depth(v)];
                     let (by_axis, below) = leaf_contexts(&m, shifts);
                     for k in 0..3 {
                         (index[k], flips[k]) = (by_axis[axes[k]], below[axes[k]]);
@@ -388,7 +952,7 @@ impl Walker {
             }
             let bits = side.code3(&mut self.contexts.half, index, flips, v, first)?;
             for (k, bit) in bits.into_iter().enumerate() {
-                self.state.refine(v, first + k, bit as u32);
+                self.refine(v, first + k, bit as u32);
             }
             self.refresh(v);
         }
@@ -397,61 +961,26 @@ impl Walker {
 
     /// Reads `v`'s neighbours' lists and centres (a sum for [`std::hint::black_box`] to keep).
     fn touch(&self, v: usize) -> usize {
-        self.state.adjacency[v]
+        self.adjacency(v)
             .iter()
-            .map(|&n| self.state.adjacency[n as usize].len() + self.centres[n as usize][0] as usize)
+            .map(|&n| self.adjacency(n as usize).len() + self.centre(n as usize)[0] as usize)
             .sum()
     }
 
-    /// Count, mean and covariance of `v`'s neighbours' cell centres, relative to `v`'s centre;
-    /// `None` without neighbours.
-    pub(super) fn moments(&self, v: usize) -> Option<Moments> {
-        let origin = self.centres[v];
-        let neighbours = &self.state.adjacency[v];
-        if neighbours.is_empty() {
-            return None;
-        }
-        // Sums of the offsets and their products: x, y, z, xx, yy, zz, xy, xz, yz.
-        let mut s = [0f64; 9];
-        for &n in neighbours {
-            let c = self.centres[n as usize];
-            let d = [0, 1, 2].map(|a| (c[a] - origin[a]) as f64);
-            s[0] += d[0];
-            s[1] += d[1];
-            s[2] += d[2];
-            s[3] += d[0] * d[0];
-            s[4] += d[1] * d[1];
-            s[5] += d[2] * d[2];
-            s[6] += d[0] * d[1];
-            s[7] += d[0] * d[2];
-            s[8] += d[1] * d[2];
-        }
-        let k = neighbours.len();
-        let inv = 1.0 / k as f64;
-        let mean = [s[0] * inv, s[1] * inv, s[2] * inv];
-        let (xy, xz, yz) = (
-            s[6] * inv - mean[0] * mean[1],
-            s[7] * inv - mean[0] * mean[2],
-            s[8] * inv - mean[1] * mean[2],
-        );
-        let cov = [
-            [s[3] * inv - mean[0] * mean[0], xy, xz],
-            [xy, s[4] * inv - mean[1] * mean[1], yz],
-            [xz, yz, s[5] * inv - mean[2] * mean[2]],
-        ];
-        Some(Moments { k, mean, cov })
+    fn moments(&self, v: usize) -> Option<Moments> {
+        neighbour_moments(self.centre(v), self.adjacency(v), |n| self.centre(n))
     }
 
     /// Context and flip of the half `v` takes along `axis`, from its neighbours' moments `m`
     /// (relative to `v`'s centre); see [`estimate`].
     #[inline]
     fn predict(&self, v: usize, axis: usize, m: &Moments) -> (contexts::HalfContext, bool) {
-        let shifts = self.shifts[self.state.depth[v] as usize];
+        let shifts = self.shifts[self.depth(v)];
         let (prediction, variance) = estimate(m, axis, shifts);
         let scale = per_half_width(shifts[axis]);
         (
             contexts::half(
-                self.leaf[v],
+                self.leaf(v),
                 m.k,
                 prediction.abs() * scale,
                 variance * scale * scale,
@@ -464,7 +993,7 @@ impl Walker {
     /// neighbours as they are now).
     fn half_context(&self, v: usize, axis: usize) -> (contexts::HalfContext, bool) {
         match self.moments(v) {
-            None => (contexts::half_isolated(self.leaf[v]), false),
+            None => (contexts::half_isolated(self.leaf(v)), false),
             Some(m) => self.predict(v, axis, &m),
         }
     }
@@ -475,9 +1004,9 @@ impl Walker {
     /// stayed arc meets the moved one.
     fn coded_ring(&self, n: usize) -> usize {
         let mut seen = 0;
-        for &m in &self.state.adjacency[n] {
-            let mark = self.marks[m as usize];
-            seen |= if mark >> 3 == self.split_serial {
+        for &m in self.adjacency(n) {
+            let mark = lane!(self.lanes, marks, m as usize).load(Ordering::Relaxed);
+            seen |= if mark >> 3 == self.serial {
                 mark & 7
             } else {
                 0
@@ -493,10 +1022,10 @@ impl Walker {
         step: usize,
         axis: usize,
         remaining: usize,
-        max_triangles: u64,
     ) -> Result<usize, Stop> {
-        side.begin_split(&self.state, v, step);
-        let valence = self.state.adjacency[v].len();
+        let r = self.next_id;
+        side.begin_split(self.adjacency(v), v, r, step, self.lanes.len);
+        let valence = self.adjacency(v).len();
         // The neighbours' lists and centres are about to be read (and most lists edited): load
         // them now, side by side, rather than one after another between the questions (which
         // leaves the processor waiting on each in turn).
@@ -509,26 +1038,23 @@ impl Walker {
             v,
             step,
         )?;
-        let centre = self.centres[v];
-        let scale = per_half_width(self.half_width_shift(v, axis));
+        let centre = self.centre(v);
+        let scale = per_half_width(self.shifts[self.depth(v)][axis]);
         let mut codes = std::mem::take(&mut self.codes);
         codes.clear();
         // Marks left by earlier splits are told apart by their serial.
-        self.split_serial += 1;
-        if self.marks.len() < self.state.len() {
-            self.marks.resize(self.state.len() + 1, 0);
-        }
+        self.serial += self.serial_step;
         let mut duplicates = 0;
         for i in 0..valence {
-            let n = self.state.adjacency[v][i] as usize;
-            let offset = self.centres[n].map(|x| x as i64);
+            let n = self.adjacency(v)[i] as usize;
+            let offset = self.centre(n).map(|x| x as i64);
             let along = (offset[axis] - centre[axis] as i64) as f64 * scale;
             let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
             let across = (offset[b] - centre[b] as i64)
                 .abs()
                 .max((offset[c] - centre[c] as i64).abs()) as f64
                 * scale;
-            let place = contexts::edge_place(along.abs(), across, self.leaf[n]);
+            let place = contexts::edge_place(along.abs(), across, self.leaf(n));
             let ring = self.coded_ring(n);
             let c = contexts::duplicate(place, ring, duplicates);
             let code = if side.code(
@@ -552,31 +1078,43 @@ impl Walker {
                 EdgeCode::Stay
             };
             codes.push(code);
-            self.marks[n] = self.split_serial << 3
+            let mark = self.serial << 3
                 | match code {
                     EdgeCode::Stay => 1,
                     EdgeCode::Move => 2,
                     EdgeCode::Duplicate => 4,
                 };
+            lane!(self.lanes, marks, n).store(mark, Ordering::Relaxed);
         }
-        let r = self
-            .state
-            .split(v, step, connecting, &codes, [NO_SPLIT, NO_SPLIT]);
-        self.state.check_edges(max_triangles).map_err(Stop::Fault)?;
+        // VS: `v` keeps the lower half, `r` takes the upper.
+        self.next_id += 1;
+        let mut cell = *lane!(self.lanes, cells, v);
+        lane_mut!(self.lanes, cells, v)[axis] = cell[axis] << 1;
+        cell[axis] = (cell[axis] << 1) | 1;
+        *lane_mut!(self.lanes, cells, r) = cell;
+        let depth = lane_mut!(self.lanes, depth, v);
+        *depth += 1;
+        let depth = *depth;
+        *lane_mut!(self.lanes, depth, r) = depth;
+        *lane_mut!(self.lanes, next_split, v) = NO_SPLIT;
+        *lane_mut!(self.lanes, next_split, r) = NO_SPLIT;
+        *lane_mut!(self.lanes, adjacency, r) = Neighbours::new();
+        self.edges += split_edges(&mut LaneLists(self.lanes), v, r, connecting, &codes);
+        check_edge_count(self.edges, self.max_triangles).map_err(Stop::Fault)?;
         self.refresh(v);
         self.refresh(r);
         self.codes = codes;
-        self.leaf.push(false);
+        *lane_mut!(self.lanes, leaf, r) = false;
         for (half, vertex) in [(0, v), (1, r)] {
-            let valence = self.state.adjacency[vertex].len();
+            let valence = self.adjacency(vertex).len();
             // The upper half's question knows the lower half's answer.
             let kind = if half == 0 {
                 0
             } else {
-                1 + self.leaf[v] as usize
+                1 + self.leaf(v) as usize
             };
             let c = contexts::leaf(kind, valence, remaining);
-            self.leaf[vertex] = side.code(
+            *lane_mut!(self.lanes, leaf, vertex) = side.code(
                 &mut self.contexts.leaf[c],
                 Question::Leaf(half),
                 false,
@@ -586,6 +1124,15 @@ impl Walker {
         }
         side.end_split(v, r);
         Ok(r)
+    }
+}
+
+/// The neighbour lists of [`Lanes`], for [`split_edges`].
+struct LaneLists<'a>(&'a Lanes);
+
+impl NeighbourLists for LaneLists<'_> {
+    fn list(&mut self, v: usize) -> &mut Neighbours {
+        lane_mut!(self.0, adjacency, v)
     }
 }
 

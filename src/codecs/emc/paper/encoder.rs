@@ -99,7 +99,8 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
                     state.refine(v, step, bit);
                     continue;
                 }
-                clusters.plan(&state, v, step, &mut plan);
+                let r = state.len();
+                clusters.plan(&state.adjacency[v], v, r, step, r + 1, &mut plan);
                 sink.put(SyntaxClass::Connectivity, 1, plan.connecting as u32);
                 tally.connecting_flag_bits += 1;
                 for &code in &plan.codes {
@@ -119,7 +120,7 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
                 tally.splits += 1;
                 let next = next.map(|s| s.map_or(NO_SPLIT, |s| s as u16));
                 state.split(v, step, plan.connecting, &plan.codes, next);
-                clusters.commit(v, &plan);
+                clusters.commit(v, r, &plan);
             }
         }
         if level == order.levels as usize {
