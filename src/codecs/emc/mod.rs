@@ -70,8 +70,8 @@ pub struct EmcParams {
 }
 
 /// Slabs of the `emc` streams that have them: up to four cores decode them at once; each slab
-/// more costs about 0.15% of the stream (bunny-closed-35k ×16 at 12 bits: 2 slabs +0.43%,
-/// 4 +0.66%, 8 +1.29%, 16 +2.29%; BENCHMARKS.md).
+/// more costs about 0.2% of the stream (bunny-closed-35k ×16 at 12 bits: 2 slabs +0.52%,
+/// 4 +0.86%, 8 +1.61%, 16 +2.80%; BENCHMARKS.md).
 pub const SLABS: u8 = 4;
 
 /// The passes `emc` slices: those of 2^this visits or more (8,192 a slab at four slabs).

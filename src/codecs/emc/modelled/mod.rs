@@ -52,8 +52,8 @@
 //! shared).
 //!
 //! What they cost and buy, on bunny-closed-35k ×16 at 12 bits (BENCHMARKS.md): 0.86% more bytes
-//! (the slabs learn apart within a pass and each stream is flushed; 2 slabs cost 0.43%, 8 cost
-//! 1.29%, 16 cost 2.29%), and decoding on this machine's two cores takes 0.61–0.67 of the time
+//! (the slabs learn apart within a pass and each stream is flushed; 2 slabs cost 0.52%, 8 cost
+//! 1.61%, 16 cost 2.80%), and decoding on this machine's two cores takes 0.60–0.68 of the time
 //! on one. Meshes under 65,536 vertices have no slabs: their streams are as before.
 //!
 //! # Contexts
