@@ -39,17 +39,7 @@ impl<'p> DecoderSide<'p> {
                 .ok_or_else(|| "level payload is not whole 32-bit words".to_string())
         };
         if slabs < 2 {
-            return Ok(DecoderSide {
-                coder: whole(payload)?,
-                table: &[],
-                table_at: 0,
-                streams: &[],
-                streams_at: 0,
-                lengths: Vec::new(),
-                parked: None,
-                threads,
-                slabs,
-            });
+            return Ok(DecoderSide::over(whole(payload)?, slabs, threads));
         }
         let mut at = 0;
         let mut part = |what: &str| -> Result<&'p [u8], String> {
@@ -65,16 +55,25 @@ impl<'p> DecoderSide<'p> {
         let table = part("slab table")?;
         let main = part("stream")?;
         Ok(DecoderSide {
-            coder: whole(main)?,
             table,
-            table_at: 0,
             streams: &payload[at..],
+            ..DecoderSide::over(whole(main)?, slabs, threads)
+        })
+    }
+
+    /// A side reading `coder` alone (no slab table or slab streams yet).
+    fn over(coder: ArithDecoder, slabs: usize, threads: bool) -> Self {
+        DecoderSide {
+            coder,
+            table: &[],
+            table_at: 0,
+            streams: &[],
             streams_at: 0,
             lengths: Vec::new(),
             parked: None,
             threads,
             slabs,
-        })
+        }
     }
 
     /// An error unless the level's slab table and slab streams were read to their ends.
@@ -153,17 +152,7 @@ impl Side for DecoderSide<'_> {
         let lengths = std::mem::take(&mut self.lengths);
         let mut sides = Vec::with_capacity(lengths.len());
         for len in lengths {
-            sides.push(DecoderSide {
-                coder: self.next_stream(len)?,
-                table: &[],
-                table_at: 0,
-                streams: &[],
-                streams_at: 0,
-                lengths: Vec::new(),
-                parked: None,
-                threads: false,
-                slabs: 1,
-            });
+            sides.push(DecoderSide::over(self.next_stream(len)?, 1, false));
         }
         Ok(Some(sides))
     }
