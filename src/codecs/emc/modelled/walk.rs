@@ -573,7 +573,7 @@ impl Walker {
         self.state.cells.resize(n, [0; 3]);
         self.state.depth.resize(n, 0);
         self.state.next_split.resize(n, NO_SPLIT);
-        self.state.adjacency.resize(n, Neighbours::new());
+        self.state.adjacency.resize_with(n, Neighbours::new);
         self.leaf.resize(n, false);
         self.centres.resize(n, [0; 3]);
         self.marks.resize_with(n, AtomicU64::default);
