@@ -65,7 +65,7 @@ pub struct ScaleRow {
     pub decode_peak_bytes: Option<u64>,
     /// Whether the decoded mesh is the canonical mesh exactly.
     pub lossless: bool,
-    /// Threads the decoder used (all of them); the encoder codes the slabs on one.
+    /// Threads the encoder and the decoder used (all of them).
     pub threads: usize,
 }
 

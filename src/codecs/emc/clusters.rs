@@ -84,43 +84,14 @@ impl Clusters {
         vertices: usize,
         plan: &mut SplitPlan,
     ) {
-        let range = self.ranges[v].clone();
-        let mid = self.trie.partition(range.clone(), step);
-        plan.lower = range.start..mid;
-        plan.upper = mid..range.end;
-        let r = r as u32;
-        self.cluster_of[plan.upper.clone()].fill(r);
-        // Which clusters each half touches.
-        self.stamp += 1;
-        let size = vertices.max(r as usize + 1);
+        let size = vertices.max(r + 1);
         if self.stamp_lower.len() < size {
             self.stamp_lower.resize(size, 0);
             self.stamp_upper.resize(size, 0);
         }
-        plan.connecting = false;
-        for (half, stamps) in [
-            (plan.lower.clone(), &mut self.stamp_lower),
-            (plan.upper.clone(), &mut self.stamp_upper),
-        ] {
-            let is_lower = half.start == range.start;
-            let run = self.edge_starts[half.start] as usize..self.edge_starts[half.end] as usize;
-            for &w in &self.edges[run] {
-                let c = self.cluster_of[w as usize];
-                stamps[c as usize] = self.stamp;
-                plan.connecting |= is_lower && c == r;
-            }
-        }
-        plan.codes.clear();
-        for &nb in neighbours {
-            let lower = self.stamp_lower[nb as usize] == self.stamp;
-            let upper = self.stamp_upper[nb as usize] == self.stamp;
-            debug_assert!(lower || upper, "neighbour {nb} lost by both halves");
-            plan.codes.push(match (lower, upper) {
-                (true, true) => EdgeCode::Duplicate,
-                (false, true) => EdgeCode::Move,
-                _ => EdgeCode::Stay,
-            });
-        }
+        let mut lanes = self.lanes(self.stamp, 1);
+        lanes.plan(neighbours, v, r, step, plan);
+        self.stamp = lanes.stamp;
     }
 
     /// Frees what only splits need (the mesh's edges, the cluster of each vertex), once every
@@ -135,11 +106,198 @@ impl Clusters {
     }
 
     /// Records the split of `v` by `plan`: `v` keeps the lower half, the new vertex `r` the
-    /// upper. Splits create their vertices in id order.
+    /// upper (the next list vertex, or one [`Self::make_room`] made).
     pub fn commit(&mut self, v: usize, r: usize, plan: &SplitPlan) {
-        debug_assert_eq!(r, self.ranges.len(), "vertices are created in id order");
+        if r == self.ranges.len() {
+            self.ranges.push(0..0);
+        }
         self.ranges[v] = plan.lower.clone();
-        self.ranges.push(plan.upper.clone());
+        self.ranges[r] = plan.upper.clone();
+    }
+
+    /// Makes room for `more` list vertices after the last: the splits of a sliced pass's slabs,
+    /// whose ids are known before any slab is coded.
+    pub fn make_room(&mut self, more: usize) {
+        let n = self.ranges.len() + more;
+        self.ranges.resize(n, 0..0);
+        if self.stamp_lower.len() < n {
+            self.stamp_lower.resize(n, 0);
+            self.stamp_upper.resize(n, 0);
+        }
+    }
+
+    /// Views for the slabs of a sliced pass, which plan and commit their splits at once: slab s
+    /// of `slabs` stamps its splits with serials that no other slab's and no earlier split's
+    /// take, for `visits` visits at most. `None` if the serials would run out (the slabs are
+    /// then coded one after another, to the same stream).
+    pub fn slab_lanes(&mut self, slabs: usize, visits: usize) -> Option<Vec<ClusterLanes>> {
+        let stride = slabs as u64;
+        let needed = stride * (visits as u64 + 2);
+        if self.stamp as u64 + needed > u32::MAX as u64 {
+            // Start the serials again: no stamp left from earlier splits may match.
+            self.stamp_lower.fill(0);
+            self.stamp_upper.fill(0);
+            self.stamp = 0;
+        }
+        if needed > u32::MAX as u64 {
+            return None;
+        }
+        let base = self.stamp + stride as u32;
+        Some(
+            (0..slabs)
+                .map(|slab| self.lanes(base + slab as u32 + 1 - stride as u32, stride as u32))
+                .collect(),
+        )
+    }
+
+    /// After the slabs: the serials go on above every one they used.
+    pub fn join_slab_lanes(&mut self, lanes: &[ClusterLanes]) {
+        for lanes in lanes {
+            self.stamp = self.stamp.max(lanes.stamp);
+        }
+    }
+
+    /// Raw views of the arrays splits read and write, stamping from `stamp` + `stamp_step` on.
+    fn lanes(&mut self, stamp: u32, stamp_step: u32) -> ClusterLanes {
+        ClusterLanes {
+            trie: &self.trie,
+            edge_starts: self.edge_starts.as_ptr(),
+            starts: self.edge_starts.len(),
+            edges: self.edges.as_ptr(),
+            edge_count: self.edges.len(),
+            ranges: self.ranges.as_mut_ptr(),
+            vertices: self.ranges.len(),
+            cluster_of: self.cluster_of.as_mut_ptr(),
+            positions: self.cluster_of.len(),
+            stamp_lower: self.stamp_lower.as_mut_ptr(),
+            stamp_upper: self.stamp_upper.as_mut_ptr(),
+            stamps: self.stamp_lower.len(),
+            stamp,
+            stamp_step,
+        }
+    }
+}
+
+/// Raw views of what the splits of [`Clusters`] read and write, shared by the slabs of a sliced
+/// pass that the encoder codes at once. Sound for the reason `modelled::walk`'s `Lanes` is: a
+/// slab splits only its own list vertices, whose neighbours are its own, so it writes only its
+/// own vertices' ranges, the trie positions of its own clusters (their `cluster_of`), and the
+/// stamps of its own vertices (the clusters its clusters' mesh edges reach are its splitting
+/// vertex's neighbours, or the two halves); it reads nothing another slab writes. Valid while
+/// the [`Clusters`] it views is neither moved, resized nor otherwise touched.
+pub struct ClusterLanes {
+    trie: *const KeyTrie,
+    edge_starts: *const u32,
+    starts: usize,
+    edges: *const u32,
+    edge_count: usize,
+    ranges: *mut Range<usize>,
+    vertices: usize,
+    cluster_of: *mut u32,
+    positions: usize,
+    stamp_lower: *mut u32,
+    stamp_upper: *mut u32,
+    stamps: usize,
+    /// The last stamp used, and how far each split moves it.
+    stamp: u32,
+    stamp_step: u32,
+}
+
+// SAFETY: see the type's docs: the slabs sharing the arrays touch disjoint entries.
+unsafe impl Send for ClusterLanes {}
+
+/// Entry `i` of one of [`ClusterLanes`]' arrays of `len` entries, bounds-checked, as a place.
+macro_rules! entry {
+    ($pointer:expr, $len:expr, $i:expr) => {{
+        let i: usize = $i;
+        assert!(i < $len, "entry {i} outside the clusters' arrays");
+        // SAFETY: in bounds; the slab owns the entry (see `ClusterLanes`).
+        unsafe { &mut *$pointer.add(i) }
+    }};
+}
+
+/// Entry `i` of a read-only array of [`ClusterLanes`] of `len` entries, bounds-checked.
+macro_rules! read {
+    ($pointer:expr, $len:expr, $i:expr) => {{
+        let i: usize = $i;
+        assert!(i < $len, "entry {i} outside the clusters' arrays");
+        // SAFETY: in bounds; nothing writes these arrays while views exist.
+        unsafe { *$pointer.add(i) }
+    }};
+}
+
+impl ClusterLanes {
+    fn trie(&self) -> &KeyTrie {
+        // SAFETY: the trie is only read, and outlives the view (see the type's docs).
+        unsafe { &*self.trie }
+    }
+
+    fn range(&self, v: usize) -> Range<usize> {
+        entry!(self.ranges, self.vertices, v).clone()
+    }
+
+    /// The step at which list vertex `v` splits next, if it does.
+    pub fn next_split(&self, v: usize) -> Option<usize> {
+        self.trie().next_split(self.range(v))
+    }
+
+    /// The bit list vertex `v` takes at `step` when it does not split.
+    pub fn bit(&self, v: usize, step: usize) -> u32 {
+        let trie = self.trie();
+        trie.order.bit(trie.keys[self.range(v).start], step)
+    }
+
+    /// [`Clusters::plan`], for a split whose new vertex `r` has room.
+    pub fn plan(
+        &mut self,
+        neighbours: &[u32],
+        v: usize,
+        r: usize,
+        step: usize,
+        plan: &mut SplitPlan,
+    ) {
+        let range = self.range(v);
+        let mid = self.trie().partition(range.clone(), step);
+        plan.lower = range.start..mid;
+        plan.upper = mid..range.end;
+        let r = r as u32;
+        for position in plan.upper.clone() {
+            *entry!(self.cluster_of, self.positions, position) = r;
+        }
+        // Which clusters each half touches.
+        self.stamp += self.stamp_step;
+        plan.connecting = false;
+        for (half, stamps) in [
+            (plan.lower.clone(), self.stamp_lower),
+            (plan.upper.clone(), self.stamp_upper),
+        ] {
+            let is_lower = half.start == range.start;
+            let start = read!(self.edge_starts, self.starts, half.start);
+            let end = read!(self.edge_starts, self.starts, half.end);
+            for e in start as usize..end as usize {
+                let w = read!(self.edges, self.edge_count, e);
+                let c = *entry!(self.cluster_of, self.positions, w as usize);
+                *entry!(stamps, self.stamps, c as usize) = self.stamp;
+                plan.connecting |= is_lower && c == r;
+            }
+        }
+        plan.codes.clear();
+        for &nb in neighbours {
+            let lower = *entry!(self.stamp_lower, self.stamps, nb as usize) == self.stamp;
+            let upper = *entry!(self.stamp_upper, self.stamps, nb as usize) == self.stamp;
+            debug_assert!(lower || upper, "neighbour {nb} lost by both halves");
+            plan.codes.push(match (lower, upper) {
+                (true, true) => EdgeCode::Duplicate,
+                (false, true) => EdgeCode::Move,
+                _ => EdgeCode::Stay,
+            });
+        }
+    }
+
+    /// [`Clusters::commit`], for a split whose new vertex `r` has room.
+    pub fn commit(&mut self, v: usize, r: usize, plan: &SplitPlan) {
+        *entry!(self.ranges, self.vertices, v) = plan.lower.clone();
+        *entry!(self.ranges, self.vertices, r) = plan.upper.clone();
     }
 }
 

@@ -2,7 +2,7 @@
 //! mesh's edges ([`Clusters`]), each answer arithmetic-coded under the walker's context.
 
 use super::walk::{Question, Side, Stop, Walker};
-use crate::codecs::emc::clusters::{Clusters, SplitPlan};
+use crate::codecs::emc::clusters::{ClusterLanes, Clusters, SplitPlan};
 use crate::codecs::emc::state::{face_corrections, EdgeCode};
 use crate::codecs::emc::EmcParams;
 use crate::codecs::{Encoded, Stats};
@@ -13,13 +13,45 @@ use crate::hierarchy::octree::KeyTrie;
 use crate::mesh::CanonicalMesh;
 use std::collections::BTreeMap;
 
+/// The clusters an encoder side plans its splits on: the encoder's own, or a slab's view of
+/// them while the slabs of a sliced pass are coded at once.
+enum ClusterAccess {
+    Owned(Clusters),
+    Slab(ClusterLanes),
+}
+
+impl ClusterAccess {
+    fn owned(&mut self) -> &mut Clusters {
+        match self {
+            ClusterAccess::Owned(clusters) => clusters,
+            ClusterAccess::Slab(_) => unreachable!("a slab's side is not the encoder's"),
+        }
+    }
+
+    fn next_split(&self, v: usize) -> Option<usize> {
+        match self {
+            ClusterAccess::Owned(clusters) => clusters.next_split(v),
+            ClusterAccess::Slab(lanes) => lanes.next_split(v),
+        }
+    }
+
+    fn bit(&self, v: usize, step: usize) -> u32 {
+        match self {
+            ClusterAccess::Owned(clusters) => clusters.bit(v, step),
+            ClusterAccess::Slab(lanes) => lanes.bit(v, step),
+        }
+    }
+}
+
 struct EncoderSide {
     coder: ArithEncoder,
-    clusters: Clusters,
+    clusters: ClusterAccess,
     plan: SplitPlan,
-    /// The current sliced pass's split counts, and its slab streams' lengths so far.
+    /// The current sliced pass's split counts, its slab streams' lengths so far, and the
+    /// most visits a slab has.
     counts: Vec<u32>,
     lengths: Vec<usize>,
+    visits: usize,
     /// The level's stream while a slab's is coded.
     parked: Option<ArithEncoder>,
     /// The level's slab table and slab streams so far, and what the slab streams cost.
@@ -30,6 +62,23 @@ struct EncoderSide {
 }
 
 impl EncoderSide {
+    /// A side coding into a fresh stream, planning on `clusters`.
+    fn over(clusters: ClusterAccess) -> Self {
+        EncoderSide {
+            coder: ArithEncoder::default(),
+            clusters,
+            plan: SplitPlan::default(),
+            counts: Vec::new(),
+            lengths: Vec::new(),
+            visits: 0,
+            parked: None,
+            table: Vec::new(),
+            streams: Vec::new(),
+            slab_bits: BTreeMap::new(),
+            slab_ledger: BitLedger::default(),
+        }
+    }
+
     /// The level's payload (docs/FORMAT.md §7) and its cost, from the level's stream `coder`:
     /// in a stream with slabs, the slab table, the level's stream and the slab streams; else
     /// the level's stream. Clears the level's slab table and streams.
@@ -111,12 +160,19 @@ impl Side for EncoderSide {
         step: usize,
         vertices: usize,
     ) {
-        self.clusters
-            .plan(neighbours, v, r, step, vertices, &mut self.plan);
+        match &mut self.clusters {
+            ClusterAccess::Owned(clusters) => {
+                clusters.plan(neighbours, v, r, step, vertices, &mut self.plan)
+            }
+            ClusterAccess::Slab(lanes) => lanes.plan(neighbours, v, r, step, &mut self.plan),
+        }
     }
 
     fn end_split(&mut self, v: usize, r: usize) {
-        self.clusters.commit(v, r, &self.plan);
+        match &mut self.clusters {
+            ClusterAccess::Owned(clusters) => clusters.commit(v, r, &self.plan),
+            ClusterAccess::Slab(lanes) => lanes.commit(v, r, &self.plan),
+        }
     }
 
     fn begin_sliced_pass(
@@ -135,12 +191,40 @@ impl Side for EncoderSide {
             })
             .collect();
         self.lengths.clear();
+        self.visits = interior.iter().map(Vec::len).max().unwrap_or(0);
+        // The slabs' splits take their ids now.
+        let splits = self.counts.iter().map(|&c| c as usize).sum();
+        self.clusters.owned().make_room(splits);
         Ok(self.counts.clone())
     }
 
     fn slab_sides(&mut self) -> Result<Option<Vec<Self>>, Stop> {
-        // The slabs share the clusters: they are coded one after another.
-        Ok(None)
+        if rayon::current_num_threads() < 2 {
+            return Ok(None);
+        }
+        let slabs = self.counts.len();
+        let Some(lanes) = self.clusters.owned().slab_lanes(slabs, self.visits) else {
+            return Ok(None);
+        };
+        Ok(Some(
+            lanes
+                .into_iter()
+                .map(|lanes| EncoderSide::over(ClusterAccess::Slab(lanes)))
+                .collect(),
+        ))
+    }
+
+    fn join_slab_sides(&mut self, sides: Vec<Self>) {
+        let mut lanes = Vec::with_capacity(sides.len());
+        for (slab, side) in sides.into_iter().enumerate() {
+            // As if coded here between begin_slab and end_slab.
+            self.parked = Some(std::mem::replace(&mut self.coder, side.coder));
+            self.end_slab(slab);
+            if let ClusterAccess::Slab(view) = side.clusters {
+                lanes.push(view);
+            }
+        }
+        self.clusters.owned().join_slab_lanes(&lanes);
     }
 
     fn begin_slab(&mut self, _slab: usize) -> Result<(), Stop> {
@@ -193,18 +277,10 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
         1 << params.sliced_visits_log2,
     );
     walker.state.reserve(mesh.vertex_count());
-    let mut side = EncoderSide {
-        coder: ArithEncoder::default(),
-        clusters: Clusters::new(mesh, KeyTrie::new(order, &mesh.cells)),
-        plan: SplitPlan::default(),
-        counts: Vec::new(),
-        lengths: Vec::new(),
-        parked: None,
-        table: Vec::new(),
-        streams: Vec::new(),
-        slab_bits: BTreeMap::new(),
-        slab_ledger: BitLedger::default(),
-    };
+    let mut side = EncoderSide::over(ClusterAccess::Owned(Clusters::new(
+        mesh,
+        KeyTrie::new(order, &mesh.cells),
+    )));
     let mut writer = StreamWriter::new(&header);
     let mut stats = Stats::default();
     // Whether the face corrections are coded (the edge graph is final from then on).
@@ -222,16 +298,13 @@ pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate
                 "every vertex decoded is a leaf: no split follows"
             );
             // What only splits read goes before the corrections, the encoder's peak of memory.
-            side.clusters.release_edges();
+            let clusters = side.clusters.owned();
+            clusters.release_edges();
             if last {
                 walker.release_caches();
             }
-            let corrections = face_corrections(
-                mesh,
-                &walker.state,
-                &side.clusters.ranges,
-                &side.clusters.trie,
-            )?;
+            let corrections =
+                face_corrections(mesh, &walker.state, &clusters.ranges, &clusters.trie)?;
             let lists = [
                 (&corrections.false_triangles, "false_triangles"),
                 (&corrections.double_sided, "double_sided"),

@@ -48,13 +48,13 @@
 //! the pass), and the visits on the slabs' boundaries (about 3%) follow in the level's stream.
 //! A slab never reads or writes another slab's vertices, so the decoder codes them on threads
 //! at once (`walk::Lanes` says why that is sound); on one thread it codes them one after
-//! another, to the same mesh. The encoder codes them one after another (its clusters are
-//! shared).
+//! another, to the same mesh. The encoder codes them at once too, each slab planning its splits
+//! on its own clusters (`clusters::ClusterLanes`), to the same bytes as on one thread.
 //!
 //! What they cost and buy, on bunny-closed-35k ×16 at 12 bits (BENCHMARKS.md): 0.86% more bytes
 //! (the slabs learn apart within a pass and each stream is flushed; 2 slabs cost 0.52%, 8 cost
-//! 1.61%, 16 cost 2.80%), and decoding on this machine's two cores takes 0.60–0.68 of the time
-//! on one. Meshes under 65,536 vertices have no slabs: their streams are as before.
+//! 1.61%, 16 cost 2.80%), and on this machine's two cores decoding takes 0.60–0.70 of the time
+//! on one, encoding about 0.67. Meshes under 65,536 vertices have no slabs: their streams are as before.
 //!
 //! # Contexts
 //! - *Which half*: a smooth surface puts a vertex near its ring's plane and near the ring's

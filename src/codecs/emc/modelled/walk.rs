@@ -125,6 +125,15 @@ pub trait Side: Send {
 
     /// The slabs of the current sliced pass are coded (the encoder writes their table entry).
     fn end_sliced_pass(&mut self) {}
+
+    /// The sides [`Self::slab_sides`] gave, once their slabs are coded, in slab order (the
+    /// encoder takes their streams as if each slab had been coded between
+    /// [`Self::begin_slab`] and [`Self::end_slab`]).
+    fn join_slab_sides(&mut self, _sides: Vec<Self>)
+    where
+        Self: Sized,
+    {
+    }
 }
 
 /// Steepest regression plane used for prediction (squared gradient).
@@ -731,12 +740,16 @@ impl Walker {
             Ok((run.serial, run.edges - edges, run.created))
         };
         let ends: Vec<Result<_, Stop>> = match side.slab_sides()? {
-            Some(mut sides) => sides
-                .par_iter_mut()
-                .zip(contexts.par_iter_mut())
-                .enumerate()
-                .map(|(slab, (side, contexts))| run(slab, contexts, side))
-                .collect(),
+            Some(mut sides) => {
+                let ends = sides
+                    .par_iter_mut()
+                    .zip(contexts.par_iter_mut())
+                    .enumerate()
+                    .map(|(slab, (side, contexts))| run(slab, contexts, side))
+                    .collect();
+                side.join_slab_sides(sides);
+                ends
+            }
             None => {
                 let mut ends = Vec::with_capacity(self.slabs);
                 for (slab, contexts) in contexts.iter_mut().enumerate() {
