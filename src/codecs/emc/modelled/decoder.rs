@@ -27,7 +27,6 @@ struct DecoderSide<'p> {
     parked: Option<ArithDecoder>,
     /// Whether the slabs of a sliced pass are decoded on threads.
     threads: bool,
-    slabs: usize,
 }
 
 impl<'p> DecoderSide<'p> {
@@ -39,7 +38,7 @@ impl<'p> DecoderSide<'p> {
                 .ok_or_else(|| "level payload is not whole 32-bit words".to_string())
         };
         if slabs < 2 {
-            return Ok(DecoderSide::over(whole(payload)?, slabs, threads));
+            return Ok(DecoderSide::over(whole(payload)?, threads));
         }
         let mut at = 0;
         let mut part = |what: &str| -> Result<&'p [u8], String> {
@@ -57,12 +56,12 @@ impl<'p> DecoderSide<'p> {
         Ok(DecoderSide {
             table,
             streams: &payload[at..],
-            ..DecoderSide::over(whole(main)?, slabs, threads)
+            ..DecoderSide::over(whole(main)?, threads)
         })
     }
 
     /// A side reading `coder` alone (no slab table or slab streams yet).
-    fn over(coder: ArithDecoder, slabs: usize, threads: bool) -> Self {
+    fn over(coder: ArithDecoder, threads: bool) -> Self {
         DecoderSide {
             coder,
             table: &[],
@@ -72,7 +71,6 @@ impl<'p> DecoderSide<'p> {
             lengths: Vec::new(),
             parked: None,
             threads,
-            slabs,
         }
     }
 
@@ -125,7 +123,7 @@ impl Side for DecoderSide<'_> {
         step: Option<usize>,
     ) -> Result<Vec<u32>, Stop> {
         let fault = |what: &str| Stop::Fault(format!("the level's slab table {what}"));
-        let mut counts = Vec::with_capacity(self.slabs);
+        let mut counts = Vec::with_capacity(interior.len());
         self.lengths.clear();
         let mut left = self.streams.len() - self.streams_at;
         for visits in interior {
@@ -152,7 +150,7 @@ impl Side for DecoderSide<'_> {
         let lengths = std::mem::take(&mut self.lengths);
         let mut sides = Vec::with_capacity(lengths.len());
         for len in lengths {
-            sides.push(DecoderSide::over(self.next_stream(len)?, 1, false));
+            sides.push(DecoderSide::over(self.next_stream(len)?, false));
         }
         Ok(Some(sides))
     }

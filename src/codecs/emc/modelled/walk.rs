@@ -394,8 +394,7 @@ impl Walker {
             marks: vec![AtomicU64::new(0)],
             split_serial: 0,
         };
-        walker.centres.push([0; 3]);
-        Run::refresh_centre(&mut walker.centres[0], [0; 3], walker.shifts[0]);
+        walker.centres.push(cell_centre([0; 3], walker.shifts[0]));
         walker
     }
 
@@ -774,6 +773,12 @@ impl Walker {
     }
 }
 
+/// Twice the centre of a cell of prefix `cell`, whose half-widths have shifts `shifts`.
+fn cell_centre(cell: [u32; 3], shifts: [u8; 3]) -> [i32; 3] {
+    // At most 2^25 (24 levels), so i32 holds it; the neighbours' offsets too.
+    [0, 1, 2].map(|a| (((cell[a] as i32) << 1) | 1) << shifts[a])
+}
+
 /// Raw views of the per-vertex arrays of a [`Walker`], shared by the [`Run`]s of a pass.
 ///
 /// The slabs of a sliced pass run at once over these arrays. That is sound because each reads
@@ -877,17 +882,11 @@ impl Run<'_> {
         }
     }
 
-    /// Twice the centre of a cell of prefix `cell`, whose half-widths have shifts `shifts`.
-    fn refresh_centre(centre: &mut [i32; 3], cell: [u32; 3], shifts: [u8; 3]) {
-        // At most 2^25 (24 levels), so i32 holds it; the neighbours' offsets too.
-        *centre = [0, 1, 2].map(|a| (((cell[a] as i32) << 1) | 1) << shifts[a]);
-    }
-
     /// Recomputes the cached centre of `v` from its cell.
     fn refresh(&mut self, v: usize) {
         let shifts = self.shifts[self.depth(v)];
         let cell = *lane!(self.lanes, cells, v);
-        Run::refresh_centre(lane_mut!(self.lanes, centres, v), cell, shifts);
+        *lane_mut!(self.lanes, centres, v) = cell_centre(cell, shifts);
     }
 
     /// RF: `v` takes `bit` at `step`.
