@@ -1,5 +1,5 @@
 //! What `emc`'s slabs cost and buy on a mesh: its stream without slabs and with 2, 4, 8 and 16
-//! (passes of 2^15 visits or more sliced, as `emc` writes large meshes), each stream's bytes and
+//! (passes of 2^13 visits or more sliced, as `emc` writes large meshes), each stream's bytes and
 //! its decode time on one thread and on all (best of N), as one JSON line per slab count.
 //! Run: cargo run --release --example emc_slabs -- MESH [N]
 //! With `--write OUT.mc SLABS LOG2` it writes one stream sliced into SLABS slabs for passes of

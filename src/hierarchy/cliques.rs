@@ -7,6 +7,8 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
+use std::ops::Range;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The edge graph of `faces` over `n` vertices, as sorted adjacency lists.
 pub fn adjacency(n: usize, faces: &[[u32; 3]]) -> Vec<Vec<u32>> {
@@ -57,14 +59,18 @@ impl Cliques {
 /// quadratic for a star. When that sum is large the vertices are ranked by degree and each edge
 /// intersects only the lists of higher-ranked neighbours, which are at most √(2e) long
 /// (Chiba & Nishizeki): O(e^1.5) whatever the graph.
-pub fn triangles<L: AsRef<[u32]> + Sync>(adjacency: &[L], limit: usize) -> Option<Cliques> {
+pub fn triangles<L: AsRef<[u32]> + Sync>(
+    adjacency: &[L],
+    limit: usize,
+    listing: Listing,
+) -> Option<Cliques> {
     let (ends, merge_cost) = adjacency
         .par_iter()
         .map(|l| (l.as_ref().len(), l.as_ref().len() * l.as_ref().len()))
         .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     let edges = ends / 2;
     if merge_cost <= 64 * edges + (1 << 20) {
-        triangles_by_merge(adjacency, limit)
+        triangles_by_merge(adjacency, limit, listing)
     } else {
         let tris = triangles_by_degree_rank(adjacency, limit)?;
         let ids = EdgeIds::new(adjacency);
@@ -78,6 +84,16 @@ pub fn triangles<L: AsRef<[u32]> + Sync>(adjacency: &[L], limit: usize) -> Optio
             edge_count: ids.len(),
         })
     }
+}
+
+/// How [`triangles`] lists: in the least memory, or faster with memory to spare.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Listing {
+    /// On one thread, straight into the result (for a caller listing at its memory peak).
+    InPlace,
+    /// In runs on rayon's threads, then joined: for a moment the runs' lists and the result
+    /// are held at once, twice the triangles' memory.
+    OnThreads,
 }
 
 /// Where each vertex's neighbours above it start in its list, and the id of its first edge to
@@ -98,38 +114,103 @@ fn above_and_first<L: AsRef<[u32]> + Sync>(adjacency: &[L]) -> (Vec<u32>, Vec<u3
     (above, first)
 }
 
-fn triangles_by_merge<L: AsRef<[u32]> + Sync>(adjacency: &[L], limit: usize) -> Option<Cliques> {
-    // One thread: listed in parallel, the runs' lists would be joined at the end, holding every
-    // triangle twice (on the ×16 mesh, 30 bytes a triangle more at the encoder's peak); counted
-    // first and then listed into place, twice the work, which two cores only win back.
+fn triangles_by_merge<L: AsRef<[u32]> + Sync>(
+    adjacency: &[L],
+    limit: usize,
+    listing: Listing,
+) -> Option<Cliques> {
     let (above, first) = above_and_first(adjacency);
     let edge_count = *first.last().unwrap_or(&0) as usize;
-    // A closed mesh has two triangles for every three edges.
-    let expected = (edge_count * 2 / 3).min(limit);
-    let mut out = Cliques {
-        tris: Vec::with_capacity(expected),
-        edges: Vec::with_capacity(expected),
-        edge_count,
-    };
-    for (a, around_a) in adjacency.iter().enumerate() {
-        let above_a = &around_a.as_ref()[above[a] as usize..];
-        for (i, &b) in above_a.iter().enumerate() {
-            let around_b = adjacency[b as usize].as_ref();
-            // c > b and adjacent to both.
-            let above_b = &around_b[above[b as usize] as usize..];
-            let (ab, base_b) = (first[a] + i as u32, first[b as usize]);
-            for_each_common(&above_a[i + 1..], above_b, |c, p, q| {
-                out.tris.push([a as u32, b, c]);
-                out.edges.push([ab, base_b + q as u32, ab + 1 + p as u32]);
-            });
-            if out.tris.len() > limit {
+    let list = |vertices: Range<usize>, capacity: usize, report: &mut dyn FnMut(usize) -> bool| {
+        let mut run = Cliques {
+            tris: Vec::with_capacity(capacity),
+            edges: Vec::with_capacity(capacity),
+            edge_count,
+        };
+        for a in vertices {
+            let above_a = &adjacency[a].as_ref()[above[a] as usize..];
+            for (i, &b) in above_a.iter().enumerate() {
+                let around_b = adjacency[b as usize].as_ref();
+                // c > b and adjacent to both.
+                let above_b = &around_b[above[b as usize] as usize..];
+                let (ab, base_b) = (first[a] + i as u32, first[b as usize]);
+                for_each_common(&above_a[i + 1..], above_b, |c, p, q| {
+                    run.tris.push([a as u32, b, c]);
+                    run.edges.push([ab, base_b + q as u32, ab + 1 + p as u32]);
+                });
+            }
+            if !report(run.tris.len()) {
                 return None;
             }
         }
+        Some(run)
+    };
+    // A closed mesh has two triangles for every three edges.
+    let expected = |edges: usize| (edges * 2 / 3).min(limit);
+    let threads = rayon::current_num_threads();
+    let runs = match listing {
+        Listing::OnThreads if threads > 1 => 16 * threads,
+        _ => 1,
+    };
+    if runs == 1 {
+        let mut out = list(0..adjacency.len(), expected(edge_count), &mut |n| {
+            n <= limit
+        })?;
+        // Past the estimate, both grew by doubling: give back what they do not use.
+        out.tris.shrink_to_fit();
+        out.edges.shrink_to_fit();
+        return Some(out);
     }
-    // Past the estimate, both grew by doubling: give back what they do not use.
-    out.tris.shrink_to_fit();
-    out.edges.shrink_to_fit();
+    // Runs of about equal numbers of edges, each listing its vertices' triangles; every run
+    // adds what it lists to one count now and then, so that all of them stop soon after the
+    // count passes the limit.
+    let ends: Vec<usize> = (0..=runs)
+        .map(|k| {
+            let edges = (edge_count * k / runs) as u32;
+            first.partition_point(|&f| f < edges).min(adjacency.len())
+        })
+        .collect();
+    let listed = AtomicUsize::new(0);
+    let parts: Vec<Cliques> = ends
+        .par_windows(2)
+        .map(|run| {
+            // Room for a triangle an edge, which no run of a mesh reaches (untouched room
+            // costs no memory): past it a run would grow by doubling, and copy.
+            let capacity = (first[run[1]] - first[run[0]]) as usize;
+            let mut reported = 0;
+            list(run[0]..run[1], capacity, &mut |n| {
+                if n - reported < 1024 {
+                    return n <= limit;
+                }
+                let total = listed.fetch_add(n - reported, Ordering::Relaxed) + n - reported;
+                reported = n;
+                total <= limit
+            })
+        })
+        .collect::<Option<_>>()?;
+    let total: usize = parts.iter().map(Cliques::len).sum();
+    if total > limit {
+        return None;
+    }
+    // Joined on the threads too: the result is fresh memory, and its first touches cost as
+    // much as the copy (zeroed pages come from the system untouched).
+    let mut out = Cliques {
+        tris: vec![[0; 3]; total],
+        edges: vec![[0; 3]; total],
+        edge_count,
+    };
+    let mut places = Vec::with_capacity(parts.len());
+    let (mut tris, mut edges) = (&mut out.tris[..], &mut out.edges[..]);
+    for part in &parts {
+        let (tris_here, tris_rest) = std::mem::take(&mut tris).split_at_mut(part.len());
+        let (edges_here, edges_rest) = std::mem::take(&mut edges).split_at_mut(part.len());
+        places.push((part, tris_here, edges_here));
+        (tris, edges) = (tris_rest, edges_rest);
+    }
+    places.into_par_iter().for_each(|(part, tris, edges)| {
+        tris.copy_from_slice(&part.tris);
+        edges.copy_from_slice(&part.edges);
+    });
     Some(out)
 }
 
@@ -286,36 +367,43 @@ pub fn propagate_orientation(
     mut decide: impl FnMut(usize, usize, bool) -> bool,
 ) -> Vec<bool> {
     let tris = &cliques.tris;
-    // For each edge: how many non-skipped triangles use it (saturating at 3: only "two"
-    // matters), the XOR of their ids (seen from one of two, the other's id) and the XOR of
-    // the directions in which they traverse it unflipped (low to high id on their edges
-    // (a,b) and (b,c), high to low on (a,c)): 0 when two use it the same way round.
-    // Each thread takes a range of the edges and reads every triangle for those (the reads go
-    // in order; the scattered writes are what costs).
-    let mut users = vec![0u8; cliques.edge_count];
-    let mut ids = vec![0u32; cliques.edge_count];
-    let mut directions = vec![0u8; cliques.edge_count];
+    // For each edge, in one word so that a triangle's update touches one place: the XOR of
+    // the ids of the non-skipped triangles using it (bits 0–31: seen from one of two, the
+    // other's id), how many they are (bits 32–33, saturating at 3: only "two" matters) and
+    // the XOR of the directions in which they traverse it unflipped (bit 34; low to high id on
+    // their edges (a,b) and (b,c), high to low on (a,c)): 0 when two use it the same way
+    // round. Each thread takes a range of the edges and reads every triangle for those (the
+    // reads go in order; the scattered writes are what costs).
+    const USERS: u64 = 1 << 32;
+    const DIRECTION: u64 = 1 << 34;
+    let users = |tally: u64| (tally / USERS) & 3;
+    let mut tallies = vec![0u64; cliques.edge_count];
     let range = cliques
         .edge_count
         .div_ceil(rayon::current_num_threads())
         .max(1);
-    users
+    tallies
         .par_chunks_mut(range)
-        .zip(ids.par_chunks_mut(range))
-        .zip(directions.par_chunks_mut(range))
         .enumerate()
-        .for_each(|(k, ((users, ids), directions))| {
+        .for_each(|(k, tallies)| {
             let first = k * range;
+            // Touched in order first: pages first touched by scattered writes from several
+            // threads fault in each other's way (18 → 50 ms on the ×16 mesh's decode).
+            tallies.fill(0);
             for (t, edges) in cliques.edges.iter().enumerate() {
-                let keep = !skipped[t];
+                if skipped[t] {
+                    continue;
+                }
                 for (slot, &e) in edges.iter().enumerate() {
-                    let Some(e) = (e as usize).checked_sub(first).filter(|&e| e < users.len())
+                    let Some(tally) = (e as usize)
+                        .checked_sub(first)
+                        .and_then(|e| tallies.get_mut(e))
                     else {
                         continue;
                     };
-                    users[e] = (users[e] + keep as u8).min(3);
-                    ids[e] ^= t as u32 & (keep as u32).wrapping_neg();
-                    directions[e] ^= (keep & (slot != 2)) as u8;
+                    let direction = DIRECTION * (slot != 2) as u64;
+                    let more = USERS * (users(*tally) < 3) as u64;
+                    *tally = (*tally ^ t as u32 as u64 ^ direction) + more;
                 }
             }
         });
@@ -330,10 +418,10 @@ pub fn propagate_orientation(
         .map(|(t, edges)| {
             let mut same = 0;
             let across = std::array::from_fn(|slot| {
-                let e = edges[slot] as usize;
-                same |= ((directions[e] == 0) as u8) << slot;
-                if users[e] == 2 && !skipped[t] {
-                    ids[e] ^ t as u32
+                let tally = tallies[edges[slot] as usize];
+                same |= ((tally & DIRECTION == 0) as u8) << slot;
+                if users(tally) == 2 && !skipped[t] {
+                    tally as u32 ^ t as u32
                 } else {
                     u32::MAX
                 }
@@ -341,6 +429,7 @@ pub fn propagate_orientation(
             (across, same)
         })
         .collect();
+    drop(tallies);
     let mut flipped = vec![false; tris.len()];
     let mut seen = skipped.to_vec();
     let mut queue = Vec::with_capacity(tris.len());
@@ -404,7 +493,7 @@ mod tests {
     fn a_sphere_is_rebuilt_with_outward_orientation() {
         let sphere = generate::icosphere(2);
         let adj = adjacency(sphere.positions.len(), &sphere.faces);
-        let cliques = triangles(&adj, usize::MAX).unwrap();
+        let cliques = triangles(&adj, usize::MAX, Listing::OnThreads).unwrap();
         let tris = &cliques.tris;
         assert_eq!(tris.len(), sphere.faces.len());
         let skipped = vec![false; tris.len()];
@@ -442,7 +531,7 @@ mod tests {
         let n = adj.len() as u32;
         adj.push(vec![0]);
         adj[0].push(n);
-        let cliques = triangles(&adj, usize::MAX).unwrap();
+        let cliques = triangles(&adj, usize::MAX, Listing::OnThreads).unwrap();
         assert_eq!(loose_edges(&adj, &cliques, None), vec![[0, n]]);
     }
 
@@ -468,7 +557,14 @@ mod tests {
                 faces.push([0, v, v + 1]);
             }
             let adj = adjacency(n, &faces);
-            let merged = triangles_by_merge(&adj, usize::MAX).unwrap();
+            let merged = triangles_by_merge(&adj, usize::MAX, Listing::InPlace).unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(3)
+                .build()
+                .unwrap();
+            let on_threads =
+                pool.install(|| triangles_by_merge(&adj, usize::MAX, Listing::OnThreads));
+            assert_eq!(on_threads.as_ref(), Some(&merged));
             let ranked = triangles_by_degree_rank(&adj, usize::MAX).unwrap();
             assert_eq!(merged.tris, ranked);
             let ids = EdgeIds::new(&adj);
@@ -479,8 +575,12 @@ mod tests {
             let merged = merged.tris;
             assert!(merged.windows(2).all(|w| w[0] < w[1]));
             let k = merged.len();
-            assert_eq!(triangles(&adj, k).unwrap().len(), k);
-            assert!(triangles_by_merge(&adj, k - 1).is_none());
+            for listing in [Listing::InPlace, Listing::OnThreads] {
+                assert_eq!(triangles(&adj, k, listing).unwrap().len(), k);
+                assert!(pool
+                    .install(|| triangles_by_merge(&adj, k - 1, listing))
+                    .is_none());
+            }
             assert!(triangles_by_degree_rank(&adj, k - 1).is_none());
         }
     }

@@ -74,8 +74,10 @@ pub struct EmcParams {
 /// 4 +0.86%, 8 +1.61%, 16 +2.80%; BENCHMARKS.md).
 pub const SLABS: u8 = 4;
 
-/// The passes `emc` slices: those of 2^this visits or more (8,192 a slab at four slabs).
-pub const SLICED_VISITS_LOG2: u8 = 15;
+/// The passes `emc` slices: those of 2^this visits or more (2,048 a slab at four slabs). On
+/// bunny-closed-35k ×16, 2^13 costs 0.18% more than 2^15 and slices the levels' first
+/// passes from level 7 on, whose serial time kept two cores from 1.6× one (BENCHMARKS.md).
+pub const SLICED_VISITS_LOG2: u8 = 13;
 
 /// The meshes whose `emc` streams have slabs: those of this many vertices or more.
 pub const SLICED_VERTICES: usize = 1 << 16;

@@ -5,7 +5,7 @@
 use crate::codecs::LevelMesh;
 use crate::container::Header;
 use crate::hierarchy::cliques::{
-    loose_edges, oriented, propagate_orientation, triangles as list_triangles, Cliques,
+    loose_edges, oriented, propagate_orientation, triangles as list_triangles, Cliques, Listing,
 };
 use crate::hierarchy::octree::KeyTrie;
 use crate::hierarchy::octree::StepOrder;
@@ -164,9 +164,9 @@ impl EmcState {
     /// The 3-cliques of the edge graph, ascending triples in lexicographic order; an error if
     /// there are more than a stream of `triangles` (the header's count) may show
     /// ([`limits::level_triangles`]).
-    pub fn cliques(&self, triangles: u64) -> Result<Cliques, String> {
+    pub fn cliques(&self, triangles: u64, listing: Listing) -> Result<Cliques, String> {
         let limit = limits::level_triangles(triangles);
-        list_triangles(&self.adjacency, limit).ok_or_else(|| {
+        list_triangles(&self.adjacency, limit, listing).ok_or_else(|| {
             format!("the edge graph has more than {limit} triangles ({triangles} declared)")
         })
     }
@@ -180,7 +180,7 @@ impl EmcState {
                 self.len()
             ));
         }
-        self.cliques(triangles)
+        self.cliques(triangles, Listing::OnThreads)
     }
 
     /// The full mesh: `cliques` (from [`Self::final_cliques`]) with `corrections` applied,
@@ -200,19 +200,25 @@ impl EmcState {
             return Err("a triangle is listed both false and double-sided".into());
         }
         let positions = self.positions(grid);
-        let faces = final_faces(cliques, &positions, corrections);
+        // The orientation's walk is serial: the loose edges are found beside it.
+        let (faces, loose_edges) = rayon::join(
+            || final_faces(cliques, &positions, corrections),
+            || {
+                let mut is_false = vec![false; cliques.len()];
+                for &i in &corrections.false_triangles {
+                    is_false[i as usize] = true;
+                }
+                loose_edges(&self.adjacency, cliques, Some(&is_false))
+            },
+        );
         if faces.len() as u64 != triangles {
             return Err(format!(
                 "{} triangles decoded, the header declares {triangles}",
                 faces.len()
             ));
         }
-        let mut is_false = vec![false; cliques.len()];
-        for &i in &corrections.false_triangles {
-            is_false[i as usize] = true;
-        }
         Ok(LevelMesh {
-            loose_edges: loose_edges(&self.adjacency, cliques, Some(&is_false)),
+            loose_edges,
             mesh: TriMesh::new(positions, faces),
             attributes: None,
         })
@@ -231,7 +237,7 @@ impl EmcState {
         positions: Vec<DVec3>,
         triangles: u64,
     ) -> Result<LevelMesh, String> {
-        let cliques = self.cliques(triangles)?;
+        let cliques = self.cliques(triangles, Listing::OnThreads)?;
         let skipped = vec![false; cliques.len()];
         let centre = centroid(&positions);
         let flipped = propagate_orientation(&cliques, &skipped, &positions, centre, |_, _, p| p);
@@ -419,7 +425,8 @@ pub fn face_corrections(
         .collect();
     faces.sort_unstable();
     let cliques = state
-        .cliques(mesh.face_count() as u64)
+        // In place: the encoder's memory peaks here.
+        .cliques(mesh.face_count() as u64, Listing::InPlace)
         .map_err(|why| crate::Error::Unsupported(format!("EMC cannot code this mesh: {why}")))?;
     // Per clique: how the mesh has it (0: not at all).
     let mut sides = vec![0u8; cliques.len()];

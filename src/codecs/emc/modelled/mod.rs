@@ -42,7 +42,7 @@
 //! # Slabs: the passes of large meshes on several cores
 //! Every question's context reads the vertex's neighbours as the passes left them, so a pass is
 //! one chain of decisions. A mesh of 65,536 vertices or more is coded with **slabs**
-//! (docs/FORMAT.md §7, "Slabs"): each pass of 2^15 visits or more is cut along the longest axis
+//! (docs/FORMAT.md §7, "Slabs"): each pass of 2^13 visits or more is cut along the longest axis
 //! into four slabs of about equal visits; each slab first codes its visits whose neighbours
 //! all lie in it, in a stream of its own and with its own copy of the contexts (merged after
 //! the pass), and the visits on the slabs' boundaries (about 3%) follow in the level's stream.

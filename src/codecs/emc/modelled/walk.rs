@@ -564,14 +564,21 @@ impl Walker {
                 }
             })
             .collect();
-        let mut interior = vec![Vec::new(); self.slabs];
-        let mut boundary = Vec::new();
-        for (&v, &slab) in visits.iter().zip(&kind) {
-            match interior.get_mut(slab as usize) {
-                Some(list) => list.push(v),
-                None => boundary.push(v),
-            }
-        }
+        // Each slab's interior, then the boundary, in list order: a scan per list, the
+        // lists on threads.
+        let mut interior: Vec<Vec<u32>> = (0..=self.slabs)
+            .into_par_iter()
+            .map(|list| {
+                let kind_listed = if list < self.slabs {
+                    list as u8
+                } else {
+                    u8::MAX
+                };
+                let listed = visits.iter().zip(&kind).filter(|&(_, &k)| k == kind_listed);
+                listed.map(|(&v, _)| v).collect()
+            })
+            .collect();
+        let boundary = interior.pop().unwrap_or_default();
         SlabPlan { interior, boundary }
     }
 
