@@ -145,17 +145,15 @@ fn triangles_by_merge<L: AsRef<[u32]> + Sync>(
         }
         Some(run)
     };
-    // A closed mesh has two triangles for every three edges.
-    let expected = |edges: usize| (edges * 2 / 3).min(limit);
     let threads = rayon::current_num_threads();
     let runs = match listing {
         Listing::OnThreads if threads > 1 => 16 * threads,
         _ => 1,
     };
     if runs == 1 {
-        let mut out = list(0..adjacency.len(), expected(edge_count), &mut |n| {
-            n <= limit
-        })?;
+        // A closed mesh has two triangles for every three edges.
+        let expected = (edge_count * 2 / 3).min(limit);
+        let mut out = list(0..adjacency.len(), expected, &mut |n| n <= limit)?;
         // Past the estimate, both grew by doubling: give back what they do not use.
         out.tris.shrink_to_fit();
         out.edges.shrink_to_fit();
@@ -174,8 +172,8 @@ fn triangles_by_merge<L: AsRef<[u32]> + Sync>(
     let parts: Vec<Cliques> = ends
         .par_windows(2)
         .map(|run| {
-            // Room for a triangle an edge, which no run of a mesh reaches (untouched room
-            // costs no memory): past it a run would grow by doubling, and copy.
+            // Room for a triangle an edge, more than a run of a manifold mesh lists (untouched
+            // room costs no memory): past it a run grows by doubling, and copies.
             let capacity = (first[run[1]] - first[run[0]]) as usize;
             let mut reported = 0;
             list(run[0]..run[1], capacity, &mut |n| {
