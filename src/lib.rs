@@ -34,6 +34,7 @@ pub mod error;
 pub mod hierarchy;
 pub mod limits;
 pub mod mesh;
+mod prefetch;
 
 #[cfg(feature = "lab")]
 pub mod came_extras;

@@ -5,6 +5,7 @@
 //! The propagation is the same in encoder and decoder; the encoder compares its result with the
 //! real faces and transmits only where it is wrong (see `codecs::emc`).
 
+use crate::prefetch::prefetch;
 use glam::DVec3;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -467,19 +468,6 @@ pub fn propagate_orientation(
         }
     }
     flipped
-}
-
-/// Asks the processor to bring `value`'s cache line in (a hint; nothing where there is none).
-#[inline(always)]
-fn prefetch<T>(value: &T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch reads nothing and cannot fault; the address is a valid reference.
-    unsafe {
-        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-        _mm_prefetch::<_MM_HINT_T0>(value as *const T as *const i8);
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
 }
 
 #[cfg(test)]
