@@ -178,6 +178,9 @@ pub struct ViewMesh {
     /// The active nodes, and each node's place among them.
     active: Vec<u32>,
     active_slot: Vec<u32>,
+    /// The active nodes again, a bit a node (bit v % 64 of word v / 64): a pass lists them
+    /// in node order from it.
+    active_bits: Vec<u64>,
     // Per triangle.
     leaf_corners: Vec<[NodeId; 3]>,
     corners: Vec<[u32; 3]>,
@@ -232,6 +235,7 @@ impl ViewMesh {
             faces_at: Vec::new(),
             active: Vec::new(),
             active_slot: Vec::new(),
+            active_bits: Vec::new(),
             leaf_corners: Vec::new(),
             corners: Vec::new(),
             present: Vec::new(),
@@ -258,9 +262,7 @@ impl ViewMesh {
             return Err(Error::malformed(1, 0, format!("the root meta-node: {e}")));
         }
         vm.take_in(root);
-        vm.state[0] = State::Active;
-        vm.active_slot[0] = 0;
-        vm.active.push(0);
+        vm.activate(0);
         Ok(vm)
     }
 
@@ -356,6 +358,7 @@ impl ViewMesh {
             self.active_slot.push(NONE);
             self.planned.push(false);
         }
+        self.active_bits.resize(self.ids.len().div_ceil(64), 0);
         for (birth, corners) in delta.triangles {
             self.born[birth as usize].push(self.leaf_corners.len() as u32);
             self.leaf_corners.push(corners);
@@ -389,6 +392,7 @@ impl ViewMesh {
         self.state[v as usize] = State::Active;
         self.active_slot[v as usize] = self.active.len() as u32;
         self.active.push(v);
+        self.active_bits[v as usize / 64] |= 1 << (v % 64);
     }
 
     fn deactivate(&mut self, v: u32, to: State) {
@@ -399,6 +403,7 @@ impl ViewMesh {
             self.active_slot[moved as usize] = slot as u32;
         }
         self.active_slot[v as usize] = NONE;
+        self.active_bits[v as usize / 64] &= !(1 << (v % 64));
     }
 
     /// The active node on leaf path `leaf`; `None` if the path ends at a split node (a
@@ -742,14 +747,33 @@ impl ViewMesh {
             done.blocked = 0;
             self.waited_now.clear();
             // In node order (the loader's, which keeps a meta-node's nodes together) rather
-            // than the list's: the nodes' records are then read nearly in memory order.
+            // than the list's: the nodes' records are then read nearly in memory order. The
+            // bits list them so (sorting the list cost more), from the cursor on.
             pass.clear();
-            pass.extend_from_slice(&self.active);
-            pass.sort_unstable();
+            for (k, &word) in self.active_bits.iter().enumerate() {
+                let mut word = word;
+                while word != 0 {
+                    pass.push((64 * k) as u32 + word.trailing_zeros());
+                    word &= word - 1;
+                }
+            }
             let start = pass.partition_point(|&v| v < self.cursor);
             pass.rotate_left(start);
             self.cursor = 0;
-            for &v in pass.iter() {
+            for (i, &v) in pass.iter().enumerate() {
+                // The records the visit of a node a few visits on reads first: its sphere and
+                // its parent's (the active nodes are sparse among all, too far apart for the
+                // processor to foresee).
+                if let Some(&ahead) = pass.get(i + 8) {
+                    crate::prefetch::prefetch(self.spheres.as_ptr().wrapping_add(ahead as usize));
+                    crate::prefetch::prefetch(self.parent.as_ptr().wrapping_add(ahead as usize));
+                }
+                if let Some(&ahead) = pass.get(i + 4) {
+                    let p = self.parent[ahead as usize] as usize;
+                    crate::prefetch::prefetch(self.spheres.as_ptr().wrapping_add(p));
+                    crate::prefetch::prefetch(self.children.as_ptr().wrapping_add(p));
+                    crate::prefetch::prefetch(self.split_dependants.as_ptr().wrapping_add(p));
+                }
                 if done.splits + done.collapses >= budget.operations {
                     self.cursor = v;
                     return;
@@ -935,7 +959,10 @@ impl ViewMesh {
             if st == State::Split && !inner {
                 return Err(format!("leaf {v} is split"));
             }
-            if (st == State::Active) != (self.active_slot[v] != NONE) {
+            let bit = self.active_bits[v / 64] >> (v % 64) & 1 == 1;
+            if (st == State::Active) != (self.active_slot[v] != NONE)
+                || (st == State::Active) != bit
+            {
                 return Err(format!("node {v} is {st:?} but listed otherwise"));
             }
             if st == State::Split {
