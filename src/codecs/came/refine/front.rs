@@ -35,6 +35,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::NormalCone;
 use crate::hierarchy::came::NodeId;
 use crate::mesh::TriMesh;
+use crate::prefetch::prefetch;
 use glam::DVec3;
 use smallvec::SmallVec;
 use std::path::Path;
@@ -765,14 +766,14 @@ impl ViewMesh {
                 // its parent's (the active nodes are sparse among all, too far apart for the
                 // processor to foresee).
                 if let Some(&ahead) = pass.get(i + 8) {
-                    crate::prefetch::prefetch(self.spheres.as_ptr().wrapping_add(ahead as usize));
-                    crate::prefetch::prefetch(self.parent.as_ptr().wrapping_add(ahead as usize));
+                    prefetch(self.spheres.as_ptr().wrapping_add(ahead as usize));
+                    prefetch(self.parent.as_ptr().wrapping_add(ahead as usize));
                 }
                 if let Some(&ahead) = pass.get(i + 4) {
                     let p = self.parent[ahead as usize] as usize;
-                    crate::prefetch::prefetch(self.spheres.as_ptr().wrapping_add(p));
-                    crate::prefetch::prefetch(self.children.as_ptr().wrapping_add(p));
-                    crate::prefetch::prefetch(self.split_dependants.as_ptr().wrapping_add(p));
+                    prefetch(self.spheres.as_ptr().wrapping_add(p));
+                    prefetch(self.children.as_ptr().wrapping_add(p));
+                    prefetch(self.split_dependants.as_ptr().wrapping_add(p));
                 }
                 if done.splits + done.collapses >= budget.operations {
                     self.cursor = v;
