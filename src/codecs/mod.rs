@@ -425,7 +425,17 @@ pub enum Stop {
 /// of levels decoded. A prefix too short to hold the header and index is an error, and so is a
 /// stop the stream or its codec cannot honour.
 pub fn decode(bytes: &[u8], stop: Stop) -> Result<(LevelMesh, usize)> {
-    decode_with(open(bytes)?.as_mut(), stop)
+    on_pool(|| decode_with(open(bytes)?.as_mut(), stop))
+}
+
+/// Runs `work` on rayon's pool, the calling thread waiting; inside the pool, where it is
+/// called. From a thread outside the pool (a program's main thread) every parallel loop of a
+/// decoder hands its work over to the pool and waits, hundreds of times a decode, and what it
+/// allocates comes from that thread's heap; on the pool the thread running the decode takes
+/// part in its loops. bunny-closed-35k ×16, `emc` on two cores: 0.42–0.45 → 0.40–0.41 s
+/// (best of 8 in one process), 0.447–0.453 → 0.432–0.436 s (one decode a process).
+pub(crate) fn on_pool<R: Send>(work: impl FnOnce() -> R + Send) -> R {
+    rayon::scope(|_| work())
 }
 
 /// [`decode`] with a decoder already opened (where the caller also wants its

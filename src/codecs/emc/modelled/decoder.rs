@@ -4,6 +4,7 @@
 use super::walk::{Question, Side, Stop, Walker};
 use crate::codecs::emc::state::FaceCorrections;
 use crate::codecs::emc::EmcParams;
+use crate::codecs::on_pool;
 use crate::codecs::{LevelDecoder, LevelMesh, PassStops};
 use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
 use crate::coding::varint;
@@ -243,8 +244,13 @@ impl<'a> EmcDecoder<'a> {
         }
     }
 
-    /// Decodes the first `passes` (1..=3) passes of the next level.
+    /// Decodes the first `passes` (1..=3) passes of the next level, on rayon's pool
+    /// ([`on_pool`]: for callers that drive the levels themselves, outside the pool).
     fn decode_passes(&mut self, passes: usize) -> Result<bool> {
+        on_pool(|| self.decode_passes_here(passes))
+    }
+
+    fn decode_passes_here(&mut self, passes: usize) -> Result<bool> {
         self.check_failed()?;
         let Some(payload) = self.stream.next_level() else {
             return Ok(false);
@@ -334,6 +340,16 @@ impl LevelDecoder for EmcDecoder<'_> {
     }
 
     fn mesh(&self) -> Result<LevelMesh> {
+        on_pool(|| self.mesh_here())
+    }
+
+    fn pass_stops(&mut self) -> Option<&mut dyn PassStops> {
+        Some(self)
+    }
+}
+
+impl EmcDecoder<'_> {
+    fn mesh_here(&self) -> Result<LevelMesh> {
         self.check_failed()?;
         let grid = &self.header.grid;
         // The full level is exact: its cells' centres.
@@ -354,10 +370,6 @@ impl LevelDecoder for EmcDecoder<'_> {
                 .level_mesh_at(positions, self.header.triangles)
                 .map_err(Error::Limit),
         }
-    }
-
-    fn pass_stops(&mut self) -> Option<&mut dyn PassStops> {
-        Some(self)
     }
 }
 

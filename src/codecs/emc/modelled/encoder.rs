@@ -5,6 +5,7 @@ use super::walk::{Question, Side, Stop, Walker};
 use crate::codecs::emc::clusters::{ClusterLanes, Clusters, SplitPlan};
 use crate::codecs::emc::state::{face_corrections, EdgeCode};
 use crate::codecs::emc::EmcParams;
+use crate::codecs::on_pool;
 use crate::codecs::{Encoded, Stats};
 use crate::coding::arith::{ArithEncoder, BitContext, UintContext};
 use crate::coding::{varint, BitLedger, SyntaxClass};
@@ -267,7 +268,12 @@ pub fn put_list(
     }
 }
 
+/// Encodes on rayon's pool ([`on_pool`]).
 pub fn encode(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate::Result<Encoded> {
+    on_pool(|| encode_here(mesh, params, header))
+}
+
+fn encode_here(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crate::Result<Encoded> {
     let order = params.order;
     let n = mesh.vertex_count() as u64;
     let mut walker = Walker::new(
