@@ -2,20 +2,17 @@
 //! meta-node loaded, then everything collapsed back to the root, twice, in-process (one
 //! `adapt` each, no operation budget); splits and collapses per second, best of the rounds.
 //! Run: cargo run --release --example came_bulk -- [MESH [SUBDIVISIONS]] (default: bunny)
+use meshcodec::came_extras::table_mesh;
 use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
 use meshcodec::codecs::{self, EncodeOptions};
 use meshcodec::mesh::quantize::GridShape;
-use meshcodec::mesh::{generate, io::read_mesh};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     let name = args.get(1).map_or("bunny", |s| s.as_str());
-    let subdivisions: usize = args.get(2).map_or(Ok(0), |s| s.parse())?;
-    let mut mesh = read_mesh(&meshcodec::mesh::io::resolve(name)?)?;
-    for _ in 0..subdivisions {
-        mesh = generate::subdivide(&mesh);
-    }
+    let subdivisions: u32 = args.get(2).map_or(Ok(0), |s| s.parse())?;
+    let (_, mesh) = table_mesh(name, subdivisions)?;
     let options = EncodeOptions {
         quant_bits: 12,
         grid: GridShape::Cubic,
@@ -49,7 +46,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     println!(
         "{name} x{}: {} triangles, {splits} splits: {:.2} M splits/s, {:.2} M collapses/s",
-        4usize.pow(subdivisions as u32),
+        4usize.pow(subdivisions),
         canonical.face_count(),
         split_rate / 1e6,
         collapse_rate / 1e6
