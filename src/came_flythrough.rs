@@ -74,10 +74,22 @@ pub struct Frame {
     /// Share of the full mesh's surface (by area) inside the view frustum.
     pub surface_in_view: f64,
     /// Present faces turned over against the same triangle of the full mesh (their normals
-    /// more than 90° apart): fold-overs, which nothing in the build prevents.
+    /// 90° or more apart): fold-overs. The orientation guard keeps them out of view.
     pub fold_overs: usize,
     /// Of those, the ones whose full-mesh triangle faces the eye.
     pub fold_overs_facing: usize,
+    /// Of those, the ones meeting the view frustum (0 by the guard).
+    pub fold_overs_in_view: usize,
+    /// Faces in view the guard left not certain of their orientation (`Adapted::unsure`).
+    pub unsure: usize,
+    /// The same front without the orientation guard (`View::keep_orientation(false)`): faces,
+    /// adaptation time (meta-node waits excluded), splits + collapses, fold-overs in view and
+    /// those of them whose full-mesh triangle faces the eye.
+    pub faces_unguarded: usize,
+    pub adapt_ms_unguarded: f64,
+    pub operations_unguarded: usize,
+    pub fold_overs_in_view_unguarded: usize,
+    pub fold_overs_in_view_facing_unguarded: usize,
     /// Full-mesh vertices inside the frustum with a face towards the eye, and the measured
     /// screen-space error over them.
     pub visible_vertices: usize,
@@ -117,6 +129,8 @@ pub struct Flythrough {
     pub fov_degrees: f64,
     /// Splits plus collapses per second of adaptation over the path.
     pub operations_per_second: f64,
+    /// The same without the orientation guard.
+    pub operations_per_second_unguarded: f64,
     pub frames: Vec<Frame>,
     /// The frame whose view holds the share of the surface nearest a tenth, from a cold start.
     pub tenth_of_surface: ColdView,
@@ -262,27 +276,44 @@ fn facing_the_eye(mesh: &TriMesh, eye: DVec3, two_sided: bool, out: &mut Vec<boo
     }
 }
 
-/// Present faces of `front` whose normal points against their full-resolution counterpart's
-/// (`at`: each vertex's position by leaf path): all of them, and those whose counterpart faces
-/// `eye` (fold-overs on the side a one-sided surface shows).
+/// Fold-overs of a front.
+#[derive(Clone, Copy, Default)]
+struct FoldOvers {
+    all: usize,
+    /// Whose full-resolution counterpart faces the eye.
+    facing: usize,
+    /// Meeting the view frustum (the face's bounding sphere about its centroid does).
+    in_view: usize,
+    in_view_facing: usize,
+}
+
+/// Present faces of `front` whose normal makes 90° or more with their full-resolution
+/// counterpart's (`at`: each vertex's position by leaf path), seen from `view`.
 fn fold_overs(
     front: &ViewMesh,
     at: &std::collections::HashMap<u64, DVec3>,
-    eye: DVec3,
-) -> (usize, usize) {
+    view: &View,
+) -> FoldOvers {
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
-    let (mut all, mut facing) = (0, 0);
+    let mut out = FoldOvers::default();
     for (leaves, adapted) in front.present_triangles() {
         let full = leaves.map(|l| at.get(&l.packed()).copied().unwrap_or(DVec3::ZERO));
         let n = normal(full);
-        if normal(adapted).dot(n) < 0.0 {
-            all += 1;
-            if (full[0] - eye).dot(n) < 0.0 {
-                facing += 1;
-            }
+        if normal(adapted).dot(n) <= 0.0 && n != DVec3::ZERO {
+            let facing = (full[0] - view.eye()).dot(n) < 0.0;
+            let centre = (adapted[0] + adapted[1] + adapted[2]) / 3.0;
+            let radius = adapted
+                .iter()
+                .map(|&p| p.distance(centre))
+                .fold(0.0, f64::max);
+            let in_view = view.sees(centre, radius);
+            out.all += 1;
+            out.facing += facing as usize;
+            out.in_view += in_view as usize;
+            out.in_view_facing += (in_view && facing) as usize;
         }
     }
-    (all, facing)
+    out
 }
 
 /// The stream's path under the system's temporary folder (the stream is rebuilt each run and
@@ -389,6 +420,8 @@ fn fly(
     let mut facing = Vec::new();
     let mut front = ViewMesh::open_file(path)?;
     let mut two_sided = ViewMesh::open_file(path)?;
+    let mut unguarded = ViewMesh::open_file(path)?;
+    let (mut operations_unguarded, mut adapting_unguarded) = (0usize, 0.0f64);
     let units = front.fetched().units;
     let mut frames = Vec::with_capacity(FRAMES);
     let (mut operations, mut adapting) = (0usize, 0.0f64);
@@ -396,7 +429,7 @@ fn fly(
         let camera = camera_at(i, centre, radius, spot);
         let view = View::new(&camera, TOLERANCE_PX)?;
         let (mut splits, mut collapses, mut adapt_s, mut wait_s) = (0, 0, 0.0, 0.0);
-        let (mut passes, mut adaptations) = (0, 0);
+        let (mut passes, mut adaptations, mut unsure) = (0, 0, 0);
         // Adapt, wait for the meta-nodes asked for, adapt again, until the front settles.
         for _ in 0..256 {
             let started = Instant::now();
@@ -406,6 +439,7 @@ fn fly(
             collapses += done.collapses;
             passes += done.passes;
             adaptations += 1;
+            unsure = done.unsure;
             if done.settled {
                 break;
             }
@@ -418,8 +452,25 @@ fn fly(
         let started = Instant::now();
         two_sided.settle(&view.clone().two_sided(true), Budget::UNLIMITED, 256);
         let settle_ms_two_sided = started.elapsed().as_secs_f64() * 1e3;
+        // The front without the guard, timed alike (adaptation only).
+        let free_view = view.clone().keep_orientation(false);
+        let mut ops_unguarded = 0;
+        let mut ms_unguarded = 0.0;
+        for _ in 0..256 {
+            let started = Instant::now();
+            let done = unguarded.adapt(&free_view, Budget::UNLIMITED);
+            ms_unguarded += started.elapsed().as_secs_f64() * 1e3;
+            ops_unguarded += done.splits + done.collapses;
+            if done.settled {
+                break;
+            }
+            unguarded.wait_for_units();
+        }
+        operations_unguarded += ops_unguarded;
+        adapting_unguarded += ms_unguarded / 1e3;
         facing_the_eye(full, camera.eye, view.is_two_sided(), &mut facing);
-        let (fold_overs, fold_overs_facing) = fold_overs(&front, &at, camera.eye);
+        let folds = fold_overs(&front, &at, &view);
+        let folds_unguarded = fold_overs(&unguarded, &at, &view);
         let (max_error_px, mean_error_px, visible_vertices) =
             measured_error(&front, leaves, &facing, &camera, &view)?;
         let fetched = front.fetched();
@@ -441,19 +492,29 @@ fn fly(
             units_loaded: fetched.units_loaded,
             bytes_fetched_two_sided: two_sided.fetched().bytes_read,
             surface_in_view: surface_in_view(&triangles, &view),
-            fold_overs,
-            fold_overs_facing,
+            fold_overs: folds.all,
+            fold_overs_facing: folds.facing,
+            fold_overs_in_view: folds.in_view,
+            unsure,
+            faces_unguarded: unguarded.face_count(),
+            adapt_ms_unguarded: ms_unguarded,
+            operations_unguarded: ops_unguarded,
+            fold_overs_in_view_unguarded: folds_unguarded.in_view,
+            fold_overs_in_view_facing_unguarded: folds_unguarded.in_view_facing,
             visible_vertices,
             max_error_px,
             mean_error_px,
         };
         if i % 10 == 0 || i + 1 == FRAMES {
             log(format!(
-                "frame {i}: {} faces ({} two-sided, {} folded over, {} of them facing the eye), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
+                "frame {i}: {} faces ({} two-sided, {} without the orientation guard), {} folded over ({} in view; unguarded {} in view, {} of them facing the eye), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
                 frame.faces,
                 frame.faces_two_sided,
+                frame.faces_unguarded,
                 frame.fold_overs,
-                frame.fold_overs_facing,
+                frame.fold_overs_in_view,
+                frame.fold_overs_in_view_unguarded,
+                frame.fold_overs_in_view_facing_unguarded,
                 splits,
                 collapses,
                 frame.adapt_ms,
@@ -481,6 +542,7 @@ fn fly(
     }
     drop(front);
     drop(two_sided);
+    drop(unguarded);
     // The view nearest a tenth of the surface, alone from a cold start.
     let tenth = frames
         .iter()
@@ -530,6 +592,7 @@ fn fly(
         height: HEIGHT,
         fov_degrees: FOV_DEGREES,
         operations_per_second: operations as f64 / adapting.max(1e-9),
+        operations_per_second_unguarded: operations_unguarded as f64 / adapting_unguarded.max(1e-9),
         frames,
         tenth_of_surface,
     })
@@ -537,11 +600,11 @@ fn fly(
 
 fn csv(report: &Flythrough) -> String {
     let mut out = String::from(
-        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,fold_overs_facing,visible_vertices,max_error_px,mean_error_px\n",
+        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,fold_overs_facing,fold_overs_in_view,unsure,faces_unguarded,adapt_ms_unguarded,operations_unguarded,fold_overs_in_view_unguarded,fold_overs_in_view_facing_unguarded,visible_vertices,max_error_px,mean_error_px\n",
     );
     for f in &report.frames {
         out += &format!(
-            "{},{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{:.5},{},{},{},{:.4},{:.4}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{:.5},{},{},{},{},{},{:.3},{},{},{},{},{:.4},{:.4}\n",
             f.frame,
             f.faces,
             f.vertices,
@@ -558,6 +621,13 @@ fn csv(report: &Flythrough) -> String {
             f.surface_in_view,
             f.fold_overs,
             f.fold_overs_facing,
+            f.fold_overs_in_view,
+            f.unsure,
+            f.faces_unguarded,
+            f.adapt_ms_unguarded,
+            f.operations_unguarded,
+            f.fold_overs_in_view_unguarded,
+            f.fold_overs_in_view_facing_unguarded,
             f.visible_vertices,
             f.max_error_px,
             f.mean_error_px
@@ -597,9 +667,22 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
                 series("two-sided (no back-face culling)", &|f| {
                     f.faces_two_sided as f64
                 }),
-                series("folded over", &|f| f.fold_overs as f64),
-                series("folded over, facing the eye", &|f| {
-                    f.fold_overs_facing as f64
+                series("without the orientation guard", &|f| {
+                    f.faces_unguarded as f64
+                }),
+            ],
+        ),
+        panel(
+            "Fold-overs in view",
+            "faces",
+            false,
+            vec![
+                series("with the orientation guard", &|f| {
+                    f.fold_overs_in_view as f64
+                }),
+                series("without", &|f| f.fold_overs_in_view_unguarded as f64),
+                series("without, facing the eye", &|f| {
+                    f.fold_overs_in_view_facing_unguarded as f64
                 }),
             ],
         ),
@@ -611,6 +694,9 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
                 series("splits", &|f| f.splits as f64),
                 series("collapses", &|f| f.collapses as f64),
                 series("adapt time (ms)", &|f| f.adapt_ms),
+                series("adapt time without the guard (ms)", &|f| {
+                    f.adapt_ms_unguarded
+                }),
             ],
         ),
         panel(

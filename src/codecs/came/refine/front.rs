@@ -25,9 +25,30 @@
 //! even between a loaded meta-node and one still on its way (tested against the projection
 //! computed from the whole stream).
 //!
-//! Not guaranteed: fold-overs. A split can turn a face around it over, since the hierarchy's
-//! build does not test Hoppe's fold-over conditions (the stored dependencies make a split's
-//! neighbourhood the one the encoder saw, but nothing checked that neighbourhood for flips).
+//! No fold-overs in view: every present face that meets the view frustum turns the way of the full mesh's triangle it stands for
+//! (its *counterpart*: the same triangle with each corner at its leaf), the normals of the two
+//! making an angle under 90°. The hierarchy's build does not test Hoppe's fold-over conditions
+//! (the stored dependencies make a split's neighbourhood the one the encoder saw, but nothing
+//! checked that neighbourhood for flips), and the counterpart's corners are not known where
+//! their meta-nodes are not loaded, so the front makes sure of it from what it holds
+//! ([`ViewMesh::orientation_certain`]): a face is certain when
+//! - its corners are leaves (it is its counterpart); or
+//! - its corners' error spheres are small beside it: with e₁ = b − a, e₂ = c − a, and each
+//!   counterpart corner within r of its node, n·n' ≥ |n|(|n| − |e₁|R₂ − R₁|e₂| − R₁R₂) where
+//!   R₁ = r_a + r_b, R₂ = r_a + r_c (for some choice of the corner a); or
+//! - its normal n is within 90° − α_v of the axis of a corner v's normal cone (which holds the
+//!   counterpart's normal, a face with a corner under v).
+//!
+//! The faces a split or collapse moves or makes are listed and checked at the end of the
+//! adaptation; a face in view that is not certain has its coarsest corner that can be split
+//! split in turn (with its dependencies) until it is — at worst down to the leaves — and a
+//! collapse that would leave a face in view not certain is not made. Faces out of view that
+//! are not certain stay listed, to be made certain when a view sees them (certainty out of
+//! view would refine the whole surface: 7× the faces close up, in the fly-through). A face
+//! waiting for a meta-node is also kept listed (the front is not settled meanwhile). The
+//! invariant checked: every present face is certain or listed, and after an adaptation that
+//! settled, every listed face in view waits for nothing (it could not be split: a refused
+//! meta-node).
 
 use super::loader::{ByteSource, Dependency, Fetch, Loaded, Loader, SeekSource, UnitDelta, NONE};
 use super::view::View;
@@ -60,6 +81,17 @@ enum UnitState {
     Loaded,
     /// Corrupt or cut: its branch stays as coarse as its parent unit leaves it.
     Refused,
+}
+
+/// Whether a triangle's orientation is to be checked.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Suspicion {
+    /// Not listed: certain, or not present.
+    None,
+    /// Listed: its corners moved since it was last checked.
+    Moved,
+    /// Listed: found not certain, out of view.
+    Uncertain,
 }
 
 /// Whether an active node can be split.
@@ -109,6 +141,9 @@ pub struct Adapted {
     /// Whether the front is settled for this view: a pass found nothing more to do, nothing
     /// was held back and nothing waits for a meta-node.
     pub settled: bool,
+    /// Faces in view left not certain of their orientation (module docs): waiting for a
+    /// meta-node, held back by a budget, or on a branch the stream cannot refine.
+    pub unsure: usize,
 }
 
 impl Adapted {
@@ -123,6 +158,7 @@ impl Adapted {
             blocked: next.blocked,
             capped: next.capped,
             settled: next.settled,
+            unsure: next.unsure,
         }
     }
 }
@@ -174,6 +210,19 @@ pub struct ViewMesh {
     depends_on: Vec<SmallVec<[Dependency; 2]>>,
     /// Split nodes depending on the node.
     split_dependants: Vec<u32>,
+    /// The face that last kept the node split (a face in view its collapse would leave not
+    /// certain of its orientation, or that the guard split it for): checked first.
+    held_by: Vec<u32>,
+    /// Whether the node is in `refused`.
+    refused_listed: Vec<bool>,
+    /// Split nodes whose collapse was refused for a face's orientation: tried again after the
+    /// passes of every adaptation (not by the passes themselves, which would check the same
+    /// faces again and again while a view lasts).
+    refused: Vec<u32>,
+    /// Split nodes whose collapse to try again after the passes, a face it would move having
+    /// moved (`in_retry`: whether listed).
+    retry: Vec<u32>,
+    in_retry: Vec<bool>,
     /// Present triangles with a corner at the node (active nodes only).
     faces_at: Vec<SmallVec<[u32; 6]>>,
     /// The active nodes, and each node's place among them.
@@ -186,7 +235,12 @@ pub struct ViewMesh {
     leaf_corners: Vec<[NodeId; 3]>,
     corners: Vec<[u32; 3]>,
     present: Vec<bool>,
+    /// Where the triangle stands in `suspects`.
+    suspected: Vec<Suspicion>,
     faces: usize,
+    /// Present triangles whose orientation is to be made certain: those splits moved or made
+    /// since the last adaptation's guard, and those it could not yet make certain.
+    suspects: Vec<u32>,
     /// Where an interrupted pass resumes: the node it stopped at (passes go in node order).
     cursor: u32,
     /// κ's scale, regulated to a face budget.
@@ -233,6 +287,11 @@ impl ViewMesh {
             born: Vec::new(),
             depends_on: Vec::new(),
             split_dependants: Vec::new(),
+            held_by: Vec::new(),
+            refused_listed: Vec::new(),
+            refused: Vec::new(),
+            retry: Vec::new(),
+            in_retry: Vec::new(),
             faces_at: Vec::new(),
             active: Vec::new(),
             active_slot: Vec::new(),
@@ -240,7 +299,9 @@ impl ViewMesh {
             leaf_corners: Vec::new(),
             corners: Vec::new(),
             present: Vec::new(),
+            suspected: Vec::new(),
             faces: 0,
+            suspects: Vec::new(),
             cursor: 0,
             scale: 1.0,
             pass: Vec::new(),
@@ -355,6 +416,9 @@ impl ViewMesh {
             self.born.push(SmallVec::new());
             self.depends_on.push(SmallVec::new());
             self.split_dependants.push(0);
+            self.held_by.push(NONE);
+            self.refused_listed.push(false);
+            self.in_retry.push(false);
             self.faces_at.push(SmallVec::new());
             self.active_slot.push(NONE);
             self.planned.push(false);
@@ -365,6 +429,7 @@ impl ViewMesh {
             self.leaf_corners.push(corners);
             self.corners.push([NONE; 3]);
             self.present.push(false);
+            self.suspected.push(Suspicion::None);
         }
         for (s, deps) in delta.splits {
             self.depends_on[s as usize] = deps;
@@ -540,6 +605,7 @@ impl ViewMesh {
                     self.faces_at[child as usize].push(f);
                 }
             }
+            self.suspect(f);
         }
         for (i, corners) in born.into_iter().enumerate() {
             let f = self.born[su][i];
@@ -548,12 +614,254 @@ impl ViewMesh {
             }
             self.corners[f as usize] = corners;
             self.present[f as usize] = true;
+            self.suspect(f);
         }
         self.faces += self.born[su].len();
         for &d in &self.depends_on[su] {
             self.split_dependants[d.node as usize] += 1;
         }
         true
+    }
+
+    /// Lists triangle `f` to have its orientation checked.
+    fn suspect(&mut self, f: u32) {
+        if self.suspected[f as usize] == Suspicion::None {
+            self.suspects.push(f);
+        }
+        self.suspected[f as usize] = Suspicion::Moved;
+        self.retry_around(f);
+    }
+
+    /// Lists the collapses that moving, making or removing present triangle `f` may have made
+    /// possible for its orientation (those of its corners' parents) to be tried again.
+    fn retry_around(&mut self, f: u32) {
+        for c in self.corners[f as usize] {
+            let p = self.parent[c as usize];
+            if p != NONE && !self.in_retry[p as usize] {
+                self.in_retry[p as usize] = true;
+                self.retry.push(p);
+            }
+        }
+    }
+
+    /// Whether present triangle `f` meets the view's frustum (its bounding sphere does).
+    fn in_view(&self, view: &View, corners: [u32; 3]) -> bool {
+        let p = corners.map(|v| self.spheres[v as usize].0);
+        let centre = (p[0] + p[1] + p[2]) / 3.0;
+        let radius = p.iter().map(|&q| q.distance(centre)).fold(0.0, f64::max);
+        view.sees(centre, radius * (1.0 + 1e-9))
+    }
+
+    /// Whether node `v` is a leaf of the hierarchy (not a node whose split is still to load).
+    fn is_leaf(&self, v: u32) -> bool {
+        self.children[v as usize][0] == NONE && self.opens[v as usize] == NONE
+    }
+
+    /// Whether a face on active nodes `corners` surely turns the way of its counterpart (the
+    /// module docs' three tests: leaves, error spheres, normal cones).
+    pub(super) fn orientation_certain(&self, corners: [u32; 3]) -> bool {
+        if corners.iter().all(|&v| self.is_leaf(v)) {
+            return true;
+        }
+        let p = corners.map(|v| self.spheres[v as usize].0);
+        let r = corners.map(|v| self.spheres[v as usize].1);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let area = n.length();
+        // A margin for the rounding of the products below (relative to their size).
+        const SLACK: f64 = 1.0 + 1e-9;
+        if !(area > 0.0 && area.is_finite()) {
+            return false;
+        }
+        let spheres = (0..3).any(|a| {
+            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+            let (e1, e2) = ((p[b] - p[a]).length(), (p[c] - p[a]).length());
+            let (r1, r2) = (r[a] + r[b], r[a] + r[c]);
+            area > (e1 * r2 + r1 * e2 + r1 * r2) * SLACK
+        });
+        spheres
+            || corners.iter().any(|&v| {
+                let cone = &self.cones[v as usize];
+                let axis = DVec3::new(
+                    cone.axis[0] as f64,
+                    cone.axis[1] as f64,
+                    cone.axis[2] as f64,
+                );
+                // θ + α < 90° ⇔ cos θ > sin α (α widened by the cone's margin).
+                cone.is_some() && n.dot(axis) > cone.sin as f64 * area * SLACK
+            })
+    }
+
+    /// Whether ecol of split node `s` leaves every face it moves that is in view certain of
+    /// its orientation (the faces born at `s`, on both children, go).
+    /// A refused node is listed (`refused`), and the face that refused it is checked first the
+    /// next time (a node the guard split is refused again and again while its view lasts: one
+    /// face checked, not its dozen). `retry`: check a listed node again.
+    ///
+    /// While the front holds more faces than a face budget allows, the budget comes first: the
+    /// collapse is made, and the faces it leaves not certain stay listed.
+    fn collapse_keeps_orientation(
+        &mut self,
+        s: u32,
+        view: &View,
+        budget: Budget,
+        retry: bool,
+    ) -> bool {
+        let su = s as usize;
+        if !view.keeps_orientation() {
+            return true;
+        }
+        // (Not when trying again after the guard, which would undo its splits over and over.)
+        if !retry && budget.faces.is_some_and(|target| self.faces > target) {
+            return true;
+        }
+        if self.refused_listed[su] && !retry {
+            return false;
+        }
+        let [t, u] = self.children[su];
+        // Face `f` once `s` is collapsed: in view and not certain?
+        let spoilt = |f: u32| {
+            let corners = self.corners[f as usize];
+            if !self.present[f as usize] || corners.contains(&t) && corners.contains(&u) {
+                return false;
+            }
+            if !corners.contains(&t) && !corners.contains(&u) {
+                return false;
+            }
+            let moved = corners.map(|v| if v == t || v == u { s } else { v });
+            self.in_view(view, moved) && !self.orientation_certain(moved)
+        };
+        let held = self.held_by[su];
+        let culprit = if held != NONE && spoilt(held) {
+            Some(held)
+        } else {
+            [t, u].iter().find_map(|&c| {
+                self.faces_at[c as usize]
+                    .iter()
+                    .copied()
+                    .find(|&f| spoilt(f))
+            })
+        };
+        match culprit {
+            Some(f) => {
+                self.held_by[su] = f;
+                if !self.refused_listed[su] {
+                    self.refused_listed[su] = true;
+                    self.refused.push(s);
+                }
+                false
+            }
+            None => true,
+        }
+    }
+
+    /// Makes every listed face certain of its orientation (the module docs): splits its
+    /// coarsest corner that can be split, with that split's dependencies, and the children
+    /// those splits activate on down as far as the view wants; a face that must wait for a
+    /// meta-node, or for the next call's budget, stays listed.
+    fn guard(&mut self, view: &View, budget: Budget, done: &mut Adapted, below: &mut Vec<u32>) {
+        if !view.keeps_orientation() {
+            // The faces stay listed, for a view that keeps orientation.
+            return;
+        }
+        let mut held = Vec::new();
+        let mut unsure = 0;
+        let mut activated = Vec::new();
+        let waiting_before = done.waiting;
+        // The view's splits that wait, of the children the guard's splits activate.
+        self.waited_now.clear();
+        while let Some(f) = self.suspects.pop() {
+            let fu = f as usize;
+            let corners = self.corners[fu];
+            let certain = match self.suspected[fu] {
+                _ if !self.present[fu] => true,
+                Suspicion::Moved => self.orientation_certain(corners),
+                _ => false,
+            };
+            if certain {
+                self.suspected[fu] = Suspicion::None;
+                continue;
+            }
+            self.suspected[fu] = Suspicion::Uncertain;
+            if !self.in_view(view, corners) {
+                held.push(f);
+                continue;
+            }
+            if done.splits + done.collapses >= budget.operations
+                || self.faces >= budget.faces.unwrap_or(usize::MAX)
+            {
+                held.push(f);
+                unsure += 1;
+                continue;
+            }
+            let mut corners = corners;
+            corners.sort_by(|&a, &b| {
+                let radius = |v: u32| self.spheres[v as usize].1;
+                radius(b).total_cmp(&radius(a))
+            });
+            let mut outcome = Ready::Never;
+            for x in corners {
+                if self.is_leaf(x) {
+                    continue;
+                }
+                activated.clear();
+                self.held_by[x as usize] = f;
+                let (splits, stop) = self.force_split(x, &mut activated);
+                done.splits += splits;
+                // The view did not ask for these splits: their collapses are tried again
+                // after the guard and whenever a face they would move moves (the plan's own
+                // later splits may already have made them certain).
+                for i in 0..splits {
+                    let v = self.plan[i];
+                    if !self.refused_listed[v as usize] {
+                        self.refused_listed[v as usize] = true;
+                        self.refused.push(v);
+                    }
+                    if !self.in_retry[v as usize] {
+                        self.in_retry[v as usize] = true;
+                        self.retry.push(v);
+                    }
+                }
+                for &c in &activated {
+                    if self.state[c as usize] == State::Active && self.wants(view, c) {
+                        self.refine_down(c, view, budget, done, below);
+                    }
+                }
+                outcome = stop;
+                if stop != Ready::Never {
+                    break;
+                }
+            }
+            match outcome {
+                // Its corner moved: it is checked again.
+                Ready::Now => self.suspects.push(f),
+                Ready::Waiting => {
+                    done.waiting += 1;
+                    held.push(f);
+                    unsure += 1;
+                }
+                Ready::Never => {
+                    done.blocked += 1;
+                    held.push(f);
+                    unsure += 1;
+                }
+            }
+        }
+        self.suspects = held;
+        done.unsure = unsure;
+        if done.waiting > waiting_before {
+            // The next call with the same view revisits the view's splits that wait (as after
+            // the passes) and then these faces.
+            let waited = std::mem::take(&mut self.waited_now);
+            self.waiting_nodes.extend_from_slice(&waited);
+            self.waited_now = waited;
+            if !done.capped && self.cursor == 0 {
+                self.waited_for = Some(view.clone());
+            }
+            done.settled = false;
+        }
+        if done.splits + done.collapses >= budget.operations && !self.suspects.is_empty() {
+            done.settled = false;
+        }
     }
 
     /// Whether ecol of split node `s` is legal: both children active, no split dependant.
@@ -571,6 +879,7 @@ impl ViewMesh {
         let su = s as usize;
         for i in 0..self.born[su].len() {
             let f = self.born[su][i];
+            self.retry_around(f);
             for c in self.corners[f as usize] {
                 let list = &mut self.faces_at[c as usize];
                 if let Some(at) = list.iter().position(|&g| g == f) {
@@ -589,6 +898,7 @@ impl ViewMesh {
                     }
                 }
                 self.faces_at[su].push(f);
+                self.suspect(f);
             }
             self.deactivate(c, State::Below);
         }
@@ -680,7 +990,8 @@ impl ViewMesh {
             ..Adapted::default()
         };
         let mut pass = std::mem::take(&mut self.pass);
-        self.adapt_passes(view, budget, &mut done, &mut pass);
+        let new_view = self.adapt_passes(view, budget, &mut done, &mut pass);
+        self.settle_orientation(view, budget, &mut done, &mut pass, new_view);
         self.pass = pass;
         self.regulate(budget.faces, done.capped);
         done
@@ -708,13 +1019,15 @@ impl ViewMesh {
         view.wants_split(center, radius, &self.cones[v as usize], self.scale)
     }
 
+    /// Returns whether it passed over the front (rather than revisiting the splits that
+    /// waited).
     fn adapt_passes(
         &mut self,
         view: &View,
         budget: Budget,
         done: &mut Adapted,
         pass: &mut Vec<u32>,
-    ) {
+    ) -> bool {
         let mut below: Vec<u32> = Vec::new();
         // The same view again, its last pass having changed nothing, with splits waiting for
         // meta-nodes: only those splits can go further (the rest of the front is where that
@@ -739,7 +1052,7 @@ impl ViewMesh {
             } else {
                 self.waited_for = Some(view.clone());
             }
-            return;
+            return false;
         }
         loop {
             let before = *done;
@@ -777,7 +1090,7 @@ impl ViewMesh {
                 }
                 if done.splits + done.collapses >= budget.operations {
                     self.cursor = v;
-                    return;
+                    return true;
                 }
                 if self.state[v as usize] != State::Active {
                     continue;
@@ -789,27 +1102,14 @@ impl ViewMesh {
                 // Up the tree while the parent may and should go; then the same from each
                 // node those collapses freed of its last split dependant (so that a chain of
                 // dependencies unwinds in one pass, not one pass a link).
-                let mut p = self.parent[v as usize];
-                loop {
-                    while p != NONE
-                        && done.splits + done.collapses < budget.operations
-                        && self.can_collapse(p)
-                        && !self.wants(view, p)
-                    {
-                        self.collapse(p);
-                        done.collapses += 1;
-                        p = self.parent[p as usize];
-                    }
-                    match self.freed.pop() {
-                        Some(d) if done.splits + done.collapses < budget.operations => p = d,
-                        _ => break,
-                    }
-                }
+                self.collapse_from(self.parent[v as usize], view, budget, done, false);
             }
             // Without limits, a pass leaves nothing for the next: a refined node goes down its
             // subtree at once, a collapse goes on up the tree and on from every node it frees of
             // its last split dependant, and forced splits are made only whole (their nodes'
-            // dependants keep them). So the pass that would confirm it is skipped.
+            // dependants keep them); the collapses refused for a face's orientation are tried
+            // again after the pass (`settle_orientation`). So the pass that would confirm it is
+            // skipped.
             let complete = budget == Budget::UNLIMITED && !done.capped;
             if complete || (done.splits, done.collapses) == (before.splits, before.collapses) {
                 done.settled = !done.capped && done.waiting == 0;
@@ -817,8 +1117,89 @@ impl ViewMesh {
                 if done.waiting > 0 && !done.capped {
                     self.waited_for = Some(view.clone());
                 }
-                return;
+                return true;
             }
+        }
+    }
+
+    /// Collapses split node `p` and on up the tree while the parent may and should go; then
+    /// the same from each node those collapses freed of its last split dependant (so that a
+    /// chain of dependencies unwinds in one pass, not one pass a link). `retry`: try again
+    /// the collapses refused for a face's orientation in this adaptation.
+    fn collapse_from(
+        &mut self,
+        mut p: u32,
+        view: &View,
+        budget: Budget,
+        done: &mut Adapted,
+        retry: bool,
+    ) {
+        loop {
+            while p != NONE
+                && done.splits + done.collapses < budget.operations
+                && self.can_collapse(p)
+                && !self.wants(view, p)
+                && self.collapse_keeps_orientation(p, view, budget, retry)
+            {
+                self.collapse(p);
+                done.collapses += 1;
+                p = self.parent[p as usize];
+            }
+            match self.freed.pop() {
+                Some(d) if done.splits + done.collapses < budget.operations => p = d,
+                _ => break,
+            }
+        }
+    }
+
+    /// After the passes: the collapses a face's orientation may have refused tried again, and
+    /// the guard ([`Self::guard`]), until neither does anything. Tried again: those near a face
+    /// that moved, appeared or went since they were last tried (`retry`: the parents of its
+    /// corners), as nothing else changes what the orientation allows under one view; and after
+    /// whole passes (a view that may be new), every refused one.
+    fn settle_orientation(
+        &mut self,
+        view: &View,
+        budget: Budget,
+        done: &mut Adapted,
+        below: &mut Vec<u32>,
+        new_view: bool,
+    ) {
+        let mut nodes = std::mem::take(&mut self.retry);
+        if new_view {
+            nodes.append(&mut self.refused);
+        }
+        loop {
+            let before = (done.splits, done.collapses);
+            for &p in &nodes {
+                self.refused_listed[p as usize] = false;
+                self.in_retry[p as usize] = false;
+            }
+            for &p in &nodes {
+                if done.splits + done.collapses >= budget.operations {
+                    // Kept for the next call.
+                    if !self.in_retry[p as usize] {
+                        self.in_retry[p as usize] = true;
+                        self.retry.push(p);
+                    }
+                    continue;
+                }
+                self.collapse_from(p, view, budget, done, true);
+            }
+            self.guard(view, budget, done, below);
+            nodes.clear();
+            std::mem::swap(&mut nodes, &mut self.retry);
+            let spent = done.splits + done.collapses >= budget.operations;
+            if spent || (done.splits, done.collapses) == before && nodes.is_empty() {
+                break;
+            }
+        }
+        // Empty, or (the budget having run out) those left for the next call.
+        self.retry = nodes;
+        if done.splits + done.collapses >= budget.operations {
+            // The budget ran out here, after the passes: a collapse chain may have stopped
+            // short, so the next call makes whole passes rather than revisiting what waited.
+            self.waited_for = None;
         }
     }
 
@@ -1020,6 +1401,28 @@ impl ViewMesh {
         if faces != self.faces {
             return Err(format!("{faces} triangles present, {} counted", self.faces));
         }
+        if let Some(t) = (0..self.present.len()).find(|&t| {
+            self.present[t]
+                && self.suspected[t] == Suspicion::None
+                && !self.orientation_certain(self.corners[t])
+        }) {
+            return Err(format!(
+                "triangle {t} is not certain of its orientation and not listed"
+            ));
+        }
+        let marked = self
+            .suspected
+            .iter()
+            .filter(|&&m| m != Suspicion::None)
+            .count();
+        if marked != self.suspects.len()
+            || self
+                .suspects
+                .iter()
+                .any(|&t| self.suspected[t as usize] == Suspicion::None)
+        {
+            return Err("the listed triangles and their marks disagree".into());
+        }
         for &v in &self.active {
             let list = &self.faces_at[v as usize];
             if list.len() != listed[v as usize]
@@ -1057,10 +1460,11 @@ mod tests {
     use crate::mesh::generate;
     use crate::mesh::quantize::GridShape;
     use proptest::prelude::*;
+    use std::collections::HashMap;
     use std::sync::OnceLock;
 
     /// A came stream of two spheres, a torus and a loose triangle sharing a vertex.
-    fn stream() -> &'static [u8] {
+    pub(super) fn stream() -> &'static [u8] {
         static STREAM: OnceLock<Vec<u8>> = OnceLock::new();
         STREAM.get_or_init(|| {
             let mut mesh = generate::icosphere(3);
@@ -1132,7 +1536,7 @@ mod tests {
         assert_eq!((vm.vertex_count(), vm.face_count()), (1, 0));
     }
 
-    fn camera(eye: DVec3) -> Camera {
+    pub(super) fn camera(eye: DVec3) -> Camera {
         Camera {
             eye,
             target: DVec3::new(0.5, 0.8, 0.0),
@@ -1420,6 +1824,73 @@ mod tests {
         }
     }
 
+    /// Present faces meeting `view`'s frustum whose normal makes 90° or more with their
+    /// counterpart's (the full mesh's triangle, on the leaves' positions `full`), and the present faces that are not the full mesh's own.
+    fn fold_overs_in_view(
+        vm: &ViewMesh,
+        full: &HashMap<u64, DVec3>,
+        view: &View,
+    ) -> (usize, usize) {
+        let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
+        let (mut folded, mut coarse) = (0, 0);
+        for t in (0..vm.present.len()).filter(|&t| vm.present[t]) {
+            let at = vm.corners[t].map(|v| vm.spheres[v as usize].0);
+            let counterpart = vm.leaf_corners[t].map(|l| full[&l.packed()]);
+            if at != counterpart {
+                coarse += 1;
+            }
+            if vm.in_view(view, vm.corners[t]) && normal(at).dot(normal(counterpart)) <= 0.0 {
+                folded += 1;
+            }
+        }
+        (folded, coarse)
+    }
+
+    /// Every leaf's position (by packed path) in the test stream refined everywhere, found once.
+    fn full_positions() -> &'static HashMap<u64, DVec3> {
+        static FULL: OnceLock<HashMap<u64, DVec3>> = OnceLock::new();
+        FULL.get_or_init(|| {
+            let (full, _) = refine_everything(stream());
+            full.present_triangles()
+                .flat_map(|(leaves, at)| (0..3).map(move |k| (leaves[k].packed(), at[k])))
+                .collect()
+        })
+    }
+
+    #[test]
+    fn no_face_in_view_turns_against_the_full_meshs_triangle() {
+        let full = full_positions();
+        let mut vm = ViewMesh::from_stream(stream()).unwrap();
+        let mut coarse = 0;
+        for (i, eye) in [
+            DVec3::new(0.5, 0.8, 6.0),
+            DVec3::new(3.0, 0.5, 1.0),
+            DVec3::new(0.0, 2.5, 2.0),
+            DVec3::new(-4.0, -1.0, -3.0),
+            DVec3::new(0.5, 0.8, 30.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            for tolerance in [0.5, 4.0, 40.0] {
+                let view = View::new(&camera(eye), tolerance + i as f64).unwrap();
+                let done = vm.settle(&view, Budget::UNLIMITED, 64);
+                assert!(done.settled);
+                vm.check_invariants().unwrap();
+                let (folded, not_full) = fold_overs_in_view(&vm, full, &view);
+                assert_eq!(folded, 0, "eye {eye}, tolerance {tolerance}");
+                // Every listed face is out of view once settled.
+                assert!(vm
+                    .suspects
+                    .iter()
+                    .all(|&t| !vm.in_view(&view, vm.corners[t as usize])));
+                coarse += not_full;
+            }
+        }
+        // The views left coarse faces to check.
+        assert!(coarse > 100, "{coarse}");
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(48))]
         #[test]
@@ -1447,6 +1918,7 @@ mod tests {
                     // Settled means settled: another adaptation to the view changes nothing.
                     let done = vm.settle(&view, Budget::UNLIMITED, 64);
                     prop_assert!(done.settled);
+                    prop_assert_eq!(fold_overs_in_view(&vm, full_positions(), &view).0, 0);
                     let again = vm.adapt(&view, Budget { operations: usize::MAX - 1, faces: None });
                     prop_assert_eq!((again.splits, again.collapses), (0, 0));
                 }

@@ -30,6 +30,9 @@ pub struct View {
     /// Whether nodes all of whose faces turn away from the eye are left unrefined (the
     /// surface is drawn one-sided).
     cull_back_faces: bool,
+    /// Whether the front keeps every face in view turned as its full-mesh counterpart (the
+    /// orientation guard of `ViewMesh`).
+    keep_orientation: bool,
 }
 
 impl View {
@@ -66,6 +69,7 @@ impl View {
             planes,
             kappa: 2.0 * tolerance * tan_y / camera.height as f64,
             cull_back_faces: true,
+            keep_orientation: true,
         })
     }
 
@@ -76,6 +80,21 @@ impl View {
             cull_back_faces: !two_sided,
             ..self
         }
+    }
+
+    /// The same view with the orientation guard on (`true`, the default: no face in view
+    /// folds over) or off (`false`: faster, fewer faces, and fold-overs where the hierarchy
+    /// makes them).
+    pub fn keep_orientation(self, keep: bool) -> View {
+        View {
+            keep_orientation: keep,
+            ..self
+        }
+    }
+
+    /// Whether the orientation guard is on.
+    pub fn keeps_orientation(&self) -> bool {
+        self.keep_orientation
     }
 
     /// Whether every face a node with this sphere and normal cone stands for turns away from
@@ -117,6 +136,7 @@ impl View {
             planes: Vec::new(),
             kappa: 0.0,
             cull_back_faces: false,
+            keep_orientation: true,
         }
     }
 
@@ -128,6 +148,7 @@ impl View {
             planes: Vec::new(),
             kappa: f64::INFINITY,
             cull_back_faces: false,
+            keep_orientation: true,
         }
     }
 
@@ -146,8 +167,12 @@ impl View {
         !self.cull_back_faces
     }
 
-    /// Whether a sphere at `center` of `radius` meets the frustum.
+    /// Whether a sphere at `center` of `radius` meets the frustum ([`View::nothing`] sees
+    /// nothing).
     pub fn sees(&self, center: DVec3, radius: f64) -> bool {
+        if self.planes.is_empty() && self.kappa == f64::INFINITY {
+            return false;
+        }
         let d = center - self.eye;
         self.planes.iter().all(|n| d.dot(*n) >= -radius)
     }
