@@ -355,6 +355,17 @@ fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
         .filter_map(|w| w.parse().ok())
         .collect();
     assert!(numbers[0] < numbers[1], "{read}");
+    assert!(out
+        .stdout
+        .contains("orientation: every face in view turns as its full-mesh triangle does"));
+    far.push("--allow-fold-overs");
+    let out = run(MESHCODEC, &far, d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    assert!(
+        out.stdout.contains("orientation: not guarded"),
+        "{}",
+        out.stdout
+    );
     assert!(full.face_count() > 100 && d.join("v.png").is_file());
     ok(&with(&["--faces", "500"]));
     let budgeted = meshcodec::mesh::io::read_mesh(&d.join("v.ply")).unwrap();

@@ -48,6 +48,7 @@ def view(
     tolerance: float,
     faces: Optional[int] = None,
     two_sided: bool = False,
+    keep_orientation: bool = True,
 ) -> Tuple[_Arrays, Dict[str, Any]]: ...
 
 class LevelIterator(Iterator[Tuple[_Arrays, Optional[_Appearance], int]]):

@@ -430,7 +430,7 @@ fn decode<'py>(
 /// (view-dependent refinement, reading only the meta-nodes the view needs): the adapted mesh's
 /// arrays and a dict of what it took.
 #[pyfunction]
-#[pyo3(signature = (stream, eye, target, up, fov, width, height, tolerance, faces=None, two_sided=false))]
+#[pyo3(signature = (stream, eye, target, up, fov, width, height, tolerance, faces=None, two_sided=false, keep_orientation=true))]
 #[allow(clippy::too_many_arguments)]
 fn view<'py>(
     py: Python<'py>,
@@ -444,6 +444,7 @@ fn view<'py>(
     tolerance: f64,
     faces: Option<usize>,
     two_sided: bool,
+    keep_orientation: bool,
 ) -> PyResult<(MeshArrays<'py>, Bound<'py, PyDict>)> {
     use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
     let camera = Camera {
@@ -456,7 +457,9 @@ fn view<'py>(
     };
     let (mesh, done, fetched, scale, culled) = py
         .detach(|| {
-            let view = View::new(&camera, tolerance)?.two_sided(two_sided);
+            let view = View::new(&camera, tolerance)?
+                .two_sided(two_sided)
+                .keep_orientation(keep_orientation);
             let mut front = ViewMesh::from_stream(stream)?;
             let budget = Budget {
                 operations: usize::MAX,
@@ -477,6 +480,7 @@ fn view<'py>(
     d.set_item("splits", done.splits)?;
     d.set_item("collapses", done.collapses)?;
     d.set_item("settled", done.settled)?;
+    d.set_item("unsure", done.unsure)?;
     d.set_item("tolerance", tolerance * scale)?;
     d.set_item("back_faces_culled", culled)?;
     d.set_item("bytes_read", fetched.bytes_read)?;

@@ -188,7 +188,9 @@ def test_view_refines_a_came_stream_where_the_camera_looks():
     centre = (bunny.vertices.min(axis=0) + bunny.vertices.max(axis=0)) / 2
     eye = centre + np.array([0.0, 0.0, 0.25])
     near, stats = meshcodec.view(stream, eye, centre, size=(640, 480))
-    assert stats["back_faces_culled"] and stats["settled"]
+    assert stats["back_faces_culled"] and stats["settled"] and stats["unsure"] == 0
+    free, free_stats = meshcodec.view(stream, eye, centre, size=(640, 480), keep_orientation=False)
+    assert free_stats["settled"] and free.face_count <= near.face_count
     assert 0 < near.face_count < bunny.face_count
     assert stats["bytes_read"] <= stats["stream_bytes"]
     both, _ = meshcodec.view(stream, eye, centre, size=(640, 480), two_sided=True)

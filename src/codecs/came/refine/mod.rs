@@ -25,6 +25,10 @@
 //!   hold over the sphere. The surface is then drawn one-sided; [`View::two_sided`] turns it
 //!   off. `came-paper` streams and `came` streams written before cones have none: every node
 //!   is refined as if it faced the eye.
+//! - counterpart: the full mesh's triangle an adapted face stands for (each corner at its
+//!   leaf); a fold-over is a face turned 90° or more from its counterpart. The front keeps
+//!   every face in view certain not to be one (`front`'s module docs: the orientation guard;
+//!   [`View::keep_orientation`] turns it off).
 
 mod front;
 mod loader;
