@@ -549,6 +549,10 @@ pub fn adapt_came(data: &[u8]) {
         let Ok(view) = View::new(&camera, byte(3) as f64 / 32.0) else {
             continue;
         };
+        // Both sides and the orientation guard off, now and then.
+        let view = view
+            .two_sided(byte(0) % 3 == 0)
+            .keep_orientation(byte(1) % 5 != 0);
         let budget = Budget {
             operations: 1 + 16 * byte(3) as usize,
             faces: (byte(3) % 2 == 1).then_some(64 * byte(2) as usize),

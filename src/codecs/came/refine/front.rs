@@ -25,9 +25,9 @@
 //! even between a loaded meta-node and one still on its way (tested against the projection
 //! computed from the whole stream).
 //!
-//! No fold-overs in view: every present face that meets the view frustum turns the way of the full mesh's triangle it stands for
-//! (its *counterpart*: the same triangle with each corner at its leaf), the normals of the two
-//! making an angle under 90°. The hierarchy's build does not test Hoppe's fold-over conditions
+//! No fold-overs in view: every present face that meets the view frustum turns the way of the
+//! full mesh's triangle it stands for (its *counterpart*: the same triangle with each corner at
+//! its leaf), the normals of the two making an angle under 90°. The hierarchy's build does not test Hoppe's fold-over conditions
 //! (the stored dependencies make a split's neighbourhood the one the encoder saw, but nothing
 //! checked that neighbourhood for flips), and the counterpart's corners are not known where
 //! their meta-nodes are not loaded, so the front makes sure of it from what it holds
@@ -90,7 +90,7 @@ enum Suspicion {
     None,
     /// Listed: its corners moved since it was last checked.
     Moved,
-    /// Listed: found not certain, out of view.
+    /// Listed: found not certain (out of view, or its split waits for a meta-node or a budget).
     Uncertain,
 }
 
@@ -693,6 +693,7 @@ impl ViewMesh {
 
     /// Whether ecol of split node `s` leaves every face it moves that is in view certain of
     /// its orientation (the faces born at `s`, on both children, go).
+    ///
     /// A refused node is listed (`refused`), and the face that refused it is checked first the
     /// next time (a node the guard split is refused again and again while its view lasts: one
     /// face checked, not its dozen). `retry`: check a listed node again.
