@@ -800,13 +800,22 @@ impl ViewMesh {
                 radius(b).total_cmp(&radius(a))
             });
             let mut outcome = Ready::Never;
+            let mut no_room = false;
             for x in corners {
                 if self.is_leaf(x) {
                     continue;
                 }
                 activated.clear();
                 self.held_by[x as usize] = f;
-                let (splits, stop) = self.force_split(x, &mut activated);
+                // Within a face budget: a split that would take the front past it waits.
+                let room = budget
+                    .faces
+                    .map_or(usize::MAX, |f| f.saturating_sub(self.faces));
+                let (splits, stop) = self.force_split(x, &mut activated, room);
+                if splits == 0 && stop == Ready::Now {
+                    no_room = true;
+                    break;
+                }
                 done.splits += splits;
                 // The view did not ask for these splits: their collapses are tried again
                 // after the guard and whenever a face they would move moves (the plan's own
@@ -831,6 +840,11 @@ impl ViewMesh {
                 if stop != Ready::Never {
                     break;
                 }
+            }
+            if no_room {
+                held.push(f);
+                unsure += 1;
+                continue;
             }
             match outcome {
                 // Its corner moved: it is checked again.
@@ -926,9 +940,10 @@ impl ViewMesh {
     /// Splits active node `s`, and first whatever its dependencies need (Hoppe's forced
     /// split), all or nothing: the splits are planned first, and made only if every one can be
     /// (none waits for a meta-node) — so that a chain cut short is not left half made for the
-    /// next pass to collapse and the one after to make again. Returns the splits made and
+    /// next pass to collapse and the one after to make again; and only if they add at most
+    /// `room` faces (else none is made, and (0, `Ready::Now`) returned). Returns the splits made and
     /// whether it stopped short, and appends the children it activated to `activated`.
-    fn force_split(&mut self, s: u32, activated: &mut Vec<u32>) -> (usize, Ready) {
+    fn force_split(&mut self, s: u32, activated: &mut Vec<u32>, room: usize) -> (usize, Ready) {
         let mut plan = std::mem::take(&mut self.plan);
         plan.clear();
         let mut stack = std::mem::take(&mut self.stack);
@@ -965,7 +980,8 @@ impl ViewMesh {
         }
         let mut made = 0;
         let mut outcome = outcome;
-        if outcome == Ready::Now {
+        let added: usize = plan.iter().map(|&v| self.born[v as usize].len()).sum();
+        if outcome == Ready::Now && added <= room {
             for &v in &plan {
                 if !self.split(v) {
                     outcome = Ready::Never;
@@ -1237,7 +1253,7 @@ impl ViewMesh {
                 done.capped = true;
                 continue;
             }
-            let (splits, stop) = self.force_split(x, below);
+            let (splits, stop) = self.force_split(x, below, usize::MAX);
             done.splits += splits;
             match stop {
                 Ready::Now => {}
