@@ -45,7 +45,8 @@
 //! collapse that would leave a face in view not certain is not made. Faces out of view that
 //! are not certain stay listed, to be made certain when a view sees them (certainty out of
 //! view would refine the whole surface: 7× the faces close up, in the fly-through). A face
-//! waiting for a meta-node is also kept listed (the front is not settled meanwhile). The
+//! waiting for a meta-node is also kept listed (the front is not settled meanwhile), and so
+//! is one whose split would take the front past a face budget (the budget comes first). The
 //! invariant checked: every present face is certain or listed, and after an adaptation that
 //! settled, every listed face in view waits for nothing (it could not be split: a refused
 //! meta-node).
