@@ -282,7 +282,7 @@ struct FoldOvers {
     all: usize,
     /// Whose full-resolution counterpart faces the eye.
     facing: usize,
-    /// Meeting the view frustum (the face's bounding sphere about its centroid does).
+    /// Meeting the view frustum ([`View::sees_triangle`], the guard's test).
     in_view: usize,
     in_view_facing: usize,
 }
@@ -301,12 +301,7 @@ fn fold_overs(
         let n = normal(full);
         if normal(adapted).dot(n) <= 0.0 && n != DVec3::ZERO {
             let facing = (full[0] - view.eye()).dot(n) < 0.0;
-            let centre = (adapted[0] + adapted[1] + adapted[2]) / 3.0;
-            let radius = adapted
-                .iter()
-                .map(|&p| p.distance(centre))
-                .fold(0.0, f64::max);
-            let in_view = view.sees(centre, radius);
+            let in_view = view.sees_triangle(adapted);
             out.all += 1;
             out.facing += facing as usize;
             out.in_view += in_view as usize;

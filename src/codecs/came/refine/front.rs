@@ -645,12 +645,9 @@ impl ViewMesh {
         }
     }
 
-    /// Whether present triangle `f` meets the view's frustum (its bounding sphere does).
+    /// Whether the face on active nodes `corners` meets the view's frustum.
     fn in_view(&self, view: &View, corners: [u32; 3]) -> bool {
-        let p = corners.map(|v| self.spheres[v as usize].0);
-        let centre = (p[0] + p[1] + p[2]) / 3.0;
-        let radius = p.iter().map(|&q| q.distance(centre)).fold(0.0, f64::max);
-        view.sees(centre, radius * (1.0 + 1e-9))
+        view.sees_triangle(corners.map(|v| self.spheres[v as usize].0))
     }
 
     /// Whether node `v` is a leaf of the hierarchy (not a node whose split is still to load).
@@ -660,7 +657,7 @@ impl ViewMesh {
 
     /// Whether a face on active nodes `corners` surely turns the way of its counterpart (the
     /// module docs' three tests: leaves, error spheres, normal cones).
-    pub(super) fn orientation_certain(&self, corners: [u32; 3]) -> bool {
+    fn orientation_certain(&self, corners: [u32; 3]) -> bool {
         if corners.iter().all(|&v| self.is_leaf(v)) {
             return true;
         }
@@ -1186,6 +1183,16 @@ impl ViewMesh {
         let mut nodes = std::mem::take(&mut self.retry);
         if new_view {
             nodes.append(&mut self.refused);
+        }
+        if !view.keeps_orientation() {
+            // Nothing was refused for orientation: the faces' moves need no retrying.
+            for &p in &nodes {
+                self.in_retry[p as usize] = false;
+                self.refused_listed[p as usize] = false;
+            }
+            nodes.clear();
+            self.retry = nodes;
+            return;
         }
         loop {
             let before = (done.splits, done.collapses);

@@ -177,6 +177,14 @@ impl View {
         self.planes.iter().all(|n| d.dot(*n) >= -radius)
     }
 
+    /// Whether triangle `p` meets the frustum (its bounding sphere about its centroid does,
+    /// widened a hair for rounding).
+    pub fn sees_triangle(&self, p: [DVec3; 3]) -> bool {
+        let centre = (p[0] + p[1] + p[2]) / 3.0;
+        let radius = p.iter().map(|&q| q.distance(centre)).fold(0.0, f64::max);
+        self.sees(centre, radius * (1.0 + 1e-9))
+    }
+
     /// Whether a node with this error sphere and normal cone is to be refined, κ scaled by
     /// `scale` (the face budget's regulation): in the frustum, not facing away
     /// ([`View::faces_away`]) and spanning the tolerance or more.
