@@ -9,7 +9,7 @@ use meshcodec::codecs::{self, EncodeOptions, LevelMesh};
 use meshcodec::mesh::io::{read_mesh, resolve};
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::Grid;
-use meshcodec::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
+use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SEED};
 
 /// `level` with every vertex moved to the centre of its cell at `level` (whole levels of a
 /// cubic grid: each axis has taken `level` bits).
@@ -40,7 +40,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mesh = read_mesh(&resolve(&name)?)?;
         let canonical = codecs::canonical_for(&mesh, &options)?;
         let encoded = codecs::by_name("emc")?.encode(&canonical)?;
-        let reference = Reference::new(&mesh, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED);
+        let reference = Reference::new(&mesh, SampleBudget::default(), DEFAULT_SEED);
         let mut decoder = codecs::open(&encoded.bytes)?;
         let grid = decoder.header().grid;
         let levels = decoder.levels();

@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::mesh::io::{read_mesh, resolve, vrml::write_vrml, write_atomically};
 use crate::mesh::quantize::GridShape;
 use crate::mesh::{generate, TriMesh};
-use crate::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
+use crate::metrics::{Reference, SampleBudget, DEFAULT_SEED};
 use serde::{Deserialize, Serialize};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -183,7 +183,7 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
     }
     let (_, bunny) = table_mesh("bunny", 0)?;
     let canonical = codecs::canonical_for(&bunny, &options)?;
-    let reference = Reference::new(&bunny, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED);
+    let reference = Reference::new(&bunny, SampleBudget::default(), DEFAULT_SEED);
     let mut fig4 = Vec::new();
     for component_bits in FIG4_BITS {
         let codec = CamePaper { component_bits };

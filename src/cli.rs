@@ -4,16 +4,59 @@
 use crate::mesh::quantize::GridShape;
 
 /// Ends a binary: exit status 0, or 1 with the error on one line of stderr (docs/CONTRACT.md §7),
-/// whatever line breaks the error's text holds.
+/// whatever line breaks the error's text holds; an unknown codec name is followed by the list
+/// of codecs.
 pub fn exit_code(outcome: anyhow::Result<()>) -> std::process::ExitCode {
     match outcome {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {
             let message = format!("{e:#}").replace(['\n', '\t'], " ");
             eprintln!("error: {message}");
+            if e.chain().any(|cause| cause.is::<UnknownCodec>()) {
+                eprint!("{}", codec_list(None));
+            }
             std::process::ExitCode::FAILURE
         }
     }
+}
+
+/// A codec name that names no codec of this build: the binaries list the codecs after the
+/// error line.
+#[derive(Debug)]
+pub struct UnknownCodec(crate::Error);
+
+impl std::fmt::Display for UnknownCodec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for UnknownCodec {}
+
+/// The codec called `name`, for the binaries: an unknown name is an [`UnknownCodec`].
+pub fn codec_by_name(name: &str) -> Result<&'static dyn crate::codecs::Codec, UnknownCodec> {
+    crate::codecs::by_name(name).map_err(UnknownCodec)
+}
+
+/// Every codec of this build, one line each with what it is, under a heading: for `--help` and
+/// after an unknown codec name; `default` is marked as such.
+pub fn codec_list(default: Option<&str>) -> String {
+    let codecs = crate::codecs::registry();
+    let width = codecs.iter().map(|c| c.name().len()).max().unwrap_or(0);
+    let mut text = String::from("Codecs:\n");
+    for codec in codecs {
+        let marker = if Some(codec.name()) == default {
+            " (default)"
+        } else {
+            ""
+        };
+        text.push_str(&format!(
+            "  {:width$}  {}{marker}\n",
+            codec.name(),
+            codec.summary()
+        ));
+    }
+    text
 }
 
 /// Writes `text` to standard output for a binary. A reader that has gone away (`meshcodec info

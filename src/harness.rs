@@ -11,21 +11,22 @@ use crate::mesh::canonical_attributes::CanonicalAttributes;
 use crate::mesh::io::{mesh_name, read_attributed, read_mesh_and_appearance, Appearance};
 use crate::mesh::quantize::GridShape;
 use crate::metrics::appearance::AppearanceReference;
-use crate::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
+use crate::metrics::{Reference, SampleBudget, DEFAULT_SEED};
 use crate::plot;
+use crate::progress::Progress;
 use crate::results::{self, levels_csv, AppearanceRun, LevelRow, RunResult};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// What to run with; `None` fields take the codec's defaults.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct RunOptions {
     /// Quantization bits.
     pub quant_bits: Option<u8>,
     /// Grid shape.
     pub grid: Option<GridShape>,
-    /// Random samples per original triangle.
-    pub samples_per_triangle: usize,
+    /// Random samples the metrics take on each surface.
+    pub samples: SampleBudget,
     /// Show a progress bar.
     pub progress: bool,
     /// Code the file's appearance at these bits when the codec carries appearance
@@ -34,19 +35,6 @@ pub struct RunOptions {
     /// With appearance, code it inside the levels by this rule for collapsed wedges, for codecs
     /// that can (`pm`; `None`: an appearance unit after the last level).
     pub appearance_in_levels: Option<codecs::AttributeFit>,
-}
-
-impl Default for RunOptions {
-    fn default() -> Self {
-        RunOptions {
-            quant_bits: None,
-            grid: None,
-            samples_per_triangle: DEFAULT_SAMPLES_PER_TRIANGLE,
-            progress: false,
-            appearance: None,
-            appearance_in_levels: None,
-        }
-    }
 }
 
 /// The encode options a run uses.
@@ -117,6 +105,9 @@ fn read_input(
 /// Runs `codec` on the mesh file at `path`.
 pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOutput> {
     let encode = encode_options(codec, options);
+    let progress = Progress::new(options.progress);
+    let label = format!("{} {}", codec.name(), mesh_name(path));
+    progress.step(format!("{label}: reading"));
     let Input {
         original,
         uncoded,
@@ -124,6 +115,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
         appearance,
     } = read_input(codec, path, options, &encode)?;
 
+    progress.step(format!("{label}: encoding"));
     let started = Instant::now();
     let encoded = codecs::encode_attributed_with(
         codec,
@@ -134,6 +126,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
     let encode_seconds = started.elapsed().as_secs_f64();
 
     // Time the bare decode (no metrics); repeat short ones so the figure is not timer noise.
+    progress.step(format!("{label}: decoding"));
     let mut decode_seconds = f64::INFINITY;
     let mut spent = 0.0;
     let mut final_mesh = None;
@@ -158,17 +151,25 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
             None => Some("the full decode has no appearance".into()),
         },
     };
+    progress.step(format!(
+        "{label}: sampling the original ({} points a direction)",
+        options.samples.count(original.mesh.faces.len())
+    ));
     let original_appearance = appearance.as_ref().and_then(|_| {
         AppearanceReference::new(
             &original,
-            options.samples_per_triangle * original.mesh.faces.len(),
+            options.samples.count(original.mesh.faces.len()),
             DEFAULT_SEED ^ 2,
         )
     });
     let original = original.mesh;
 
-    let reference = Reference::new(&original, options.samples_per_triangle, DEFAULT_SEED);
-    let bar = progress_bar(options.progress, encoded.levels.len(), codec.name(), path);
+    let reference = Reference::new(&original, options.samples, DEFAULT_SEED);
+    progress.count(
+        format!("{label}: measuring levels"),
+        encoded.levels.len(),
+        "level",
+    );
     let mut decoder = codecs::open(&encoded.bytes)?;
     let (v, t) = (
         canonical.vertex_count() as f64,
@@ -192,9 +193,9 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
             v,
             t,
         )?);
-        bar.inc(1);
+        progress.advance();
     }
-    bar.finish_and_clear();
+    progress.finish();
     drop(decoder);
 
     let mut codec_stats = encoded.stats;
@@ -202,7 +203,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
     let result = RunResult {
         codec: codec.name().to_string(),
         mesh: mesh_name(path),
-        source: path.display().to_string(),
+        source: crate::mesh::io::portable_source(path),
         vertices: canonical.vertex_count(),
         triangles: canonical.face_count(),
         quant_bits: encode.quant_bits,
@@ -212,7 +213,8 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
         lossless: lossless_error.is_none(),
         lossless_error,
         grid: encode.grid,
-        samples_per_triangle: options.samples_per_triangle,
+        samples_per_triangle: options.samples.per_triangle,
+        max_samples: Some(options.samples.max),
         appearance: appearance.as_ref().map(|a| AppearanceRun {
             uv_bits: a.bits.uv,
             normal_bits: a.bits.normal,
@@ -273,23 +275,11 @@ fn measure_level(
         hausdorff: distance.map(|d| d.hausdorff),
         rms: distance.map(|d| d.rms),
         hausdorff_paper: distance.map(|d| d.hausdorff_paper),
+        samples: distance.map(|d| d.uncertainty.samples),
+        rms_uncertainty: distance.map(|d| d.uncertainty.rms),
+        hausdorff_uncertainty: distance.map(|d| d.uncertainty.hausdorff),
         appearance,
     })
-}
-
-fn progress_bar(show: bool, levels: usize, codec: &str, path: &Path) -> indicatif::ProgressBar {
-    if !show {
-        return indicatif::ProgressBar::hidden();
-    }
-    let bar = indicatif::ProgressBar::new(levels as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{msg} [{elapsed_precise}] {wide_bar} level {pos}/{len} (eta {eta})",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    bar.set_message(format!("{codec} {}: measuring levels", mesh_name(path)));
-    bar
 }
 
 /// Writes `<out>/<codec>/<stem>.json`, `.csv` and the two plots (PNG and SVG); returns the

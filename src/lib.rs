@@ -51,6 +51,8 @@ pub mod metrics;
 #[cfg(feature = "lab")]
 pub mod plot;
 #[cfg(feature = "lab")]
+pub mod progress;
+#[cfg(feature = "lab")]
 pub mod render;
 #[cfg(feature = "lab")]
 pub mod results;

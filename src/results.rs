@@ -34,6 +34,17 @@ pub struct LevelRow {
     pub rms: Option<f64>,
     /// Largest original-vertex-to-level distance, over the diagonal (EMC's measure).
     pub hausdorff_paper: Option<f64>,
+    /// Samples the distances were measured at: original → level, level → original, vertices
+    /// included (§5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<[usize; 2]>,
+    /// Relative standard error of `rms` from the samples (§5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rms_uncertainty: Option<f64>,
+    /// What `hausdorff` gained from half the random samples to all of them, relative to it:
+    /// about what doubling them would still add (§5).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hausdorff_uncertainty: Option<f64>,
     /// Appearance error (§5.1) of a run that codes appearance, at the levels that carry it.
     #[serde(flatten, default)]
     pub appearance: AppearanceError,
@@ -71,6 +82,10 @@ pub struct RunResult {
     /// Random samples per original triangle used by the metrics.
     #[serde(default)]
     pub samples_per_triangle: usize,
+    /// Most random samples a direction the metrics took (absent in results measured before
+    /// there was a cap: `samples_per_triangle` for every triangle).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_samples: Option<usize>,
     /// Codec-specific counts: bits per syntax element, operation counts.
     #[serde(default, skip_serializing_if = "Stats::is_empty")]
     pub codec_stats: Stats,

@@ -119,7 +119,7 @@ fn the_harness_codes_appearance_when_asked_and_measures_it_at_the_level_that_car
     let path = resolve("spot").unwrap();
     let options = RunOptions {
         quant_bits: Some(12),
-        samples_per_triangle: 2,
+        samples: meshcodec::metrics::SampleBudget::per_triangle(2),
         appearance: Some(AttributeBits::default()),
         ..RunOptions::default()
     };

@@ -114,9 +114,15 @@ fn unknown_names_list_what_is_known() {
     let outcome = run(EXPERIMENT, &["raw", "no-such-mesh"], dir.path());
     assert_clean_failure(&outcome, "known names");
     assert!(outcome.stderr.contains("bunny"));
-    assert_clean_failure(
-        &run(EXPERIMENT, &["nocodec", "bunny"], dir.path()),
-        "codecs: raw",
+    // An unknown codec: one error line, then the codecs a line each
+    // (encode_defaults_to_emc_and_the_binaries_list_every_codec).
+    let outcome = run(EXPERIMENT, &["nocodec", "bunny"], dir.path());
+    assert_eq!(outcome.code, Some(1));
+    let first = outcome.stderr.lines().next().unwrap_or_default();
+    assert!(
+        first.starts_with("error: ") && first.contains("codecs: raw"),
+        "{}",
+        outcome.stderr
     );
 }
 
@@ -519,4 +525,121 @@ fn pm_encodes_a_mesh_that_is_no_manifold_and_info_says_it_was_cut() {
         let out = run(MESHCODEC, &["decode", "b.mc", "full.ply"], d);
         assert_eq!(out.code, Some(0), "{}", out.stderr);
     }
+}
+
+#[test]
+fn a_mesh_name_and_a_resolved_path_work_from_any_working_directory() {
+    // No data folder beside the scratch folder and none in the environment: the name is found
+    // where the binary was built to look, and `resolve`'s path names the file from anywhere.
+    let dir = scratch();
+    let d = dir.path();
+    let out = Command::new(MESHCODEC)
+        .args(["encode", "--codec", "raw", "bunny-res4", "named.mc"])
+        .current_dir(d)
+        .env_remove("MESHCODEC_DATA")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let path = meshcodec::mesh::io::resolve("bunny-res4").unwrap();
+    assert!(path.is_absolute(), "{}", path.display());
+    let out = run(
+        MESHCODEC,
+        &[
+            "encode",
+            "--codec",
+            "raw",
+            path.to_str().unwrap(),
+            "path.mc",
+        ],
+        d,
+    );
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    assert_eq!(
+        std::fs::read(d.join("named.mc")).unwrap(),
+        std::fs::read(d.join("path.mc")).unwrap()
+    );
+}
+
+#[test]
+fn encode_defaults_to_emc_and_the_binaries_list_every_codec() {
+    let dir = scratch();
+    let d = dir.path();
+    let out = run(MESHCODEC, &["encode", "bunny-res4", "b.mc"], d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let info = run(MESHCODEC, &["info", "b.mc", "--json"], d);
+    let json: serde_json::Value = serde_json::from_str(&info.stdout).unwrap();
+    assert_eq!(json["codec"], "emc");
+    let listed = |text: &str| {
+        for codec in meshcodec::codecs::registry() {
+            assert!(
+                text.lines()
+                    .any(|l| l.contains(codec.name()) && l.contains(codec.summary())),
+                "{} not listed in {text}",
+                codec.name()
+            );
+        }
+    };
+    let help = run(MESHCODEC, &["encode", "--help"], d);
+    assert_eq!(help.code, Some(0));
+    listed(&help.stdout);
+    assert!(help.stdout.contains("(default)"), "{}", help.stdout);
+    let help = run(EXPERIMENT, &["--help"], d);
+    assert_eq!(help.code, Some(0));
+    listed(&help.stdout);
+    // An unknown name: the error line, then the codecs.
+    for (bin, args) in [
+        (
+            MESHCODEC,
+            vec!["encode", "--codec", "zip", "bunny-res4", "z.mc"],
+        ),
+        (EXPERIMENT, vec!["zip", "bunny-res4", "--out", "r"]),
+    ] {
+        let out = run(bin, &args, d);
+        assert_eq!(out.code, Some(1), "{}", out.stderr);
+        let first = out.stderr.lines().next().unwrap_or_default();
+        assert!(
+            first.starts_with("error: ") && first.contains("unknown codec 'zip'"),
+            "{}",
+            out.stderr
+        );
+        listed(&out.stderr);
+        assert!(!d.join("z.mc").exists() && !d.join("r").exists());
+    }
+}
+
+#[test]
+fn a_format_that_cannot_hold_the_appearance_is_refused_naming_those_that_can() {
+    let dir = scratch();
+    let d = dir.path();
+    // bunny-10k-textured has materials, which PLY cannot hold.
+    let out = run(MESHCODEC, &["encode", "bunny-10k-textured", "t.mc"], d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    for args in [
+        vec!["decode", "t.mc", "t.ply"],
+        vec!["convert", "bunny-10k-textured", "t.ply"],
+    ] {
+        let out = run(MESHCODEC, &args, d);
+        assert_clean_failure(&out, "t.ply");
+        for named in ["materials", ".obj", ".glb", ".gltf", "--drop-attributes"] {
+            assert!(out.stderr.contains(named), "{named}: {}", out.stderr);
+        }
+        assert!(!out.stderr.contains(".ply,"), "{}", out.stderr);
+        assert!(!d.join("t.ply").exists());
+        let mut dropping = args.clone();
+        dropping.push("--drop-attributes");
+        let out = run(MESHCODEC, &dropping, d);
+        assert_eq!(out.code, Some(0), "{}", out.stderr);
+        let mesh = meshcodec::mesh::io::read_attributed(&d.join("t.ply")).unwrap();
+        assert!(mesh.attributes.is_empty());
+        std::fs::remove_file(d.join("t.ply")).unwrap();
+    }
+    // The format that holds it all still takes it.
+    let out = run(MESHCODEC, &["decode", "t.mc", "t.obj"], d);
+    assert_eq!(out.code, Some(0), "{}", out.stderr);
+    let mesh = meshcodec::mesh::io::read_attributed(&d.join("t.obj")).unwrap();
+    assert!(mesh.attributes.materials.is_some());
 }

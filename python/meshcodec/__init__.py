@@ -465,29 +465,36 @@ def distance(
     b: Union[Mesh, tuple],
     samples: int = 10,
     seed: Optional[int] = None,
-) -> Dict[str, float]:
+    max_samples: int = 1_000_000,
+) -> Dict[str, Any]:
     """Distances both ways between a reference mesh ``a`` and a mesh ``b`` (a decoded level
     counts its loose edges, and may have no face yet).
 
-    Both surfaces are sampled (``samples`` random points per triangle of ``a`` plus its
-    vertices, as many on ``b``) and each sample's exact distance to the other surface is
-    taken through a BVH, as the experiment harness measures levels (docs/CONTRACT.md §5).
+    Both surfaces are sampled (``samples`` random points per triangle of ``a``, at most
+    ``max_samples``, plus its vertices; as many on ``b``) and each sample's exact distance to
+    the other surface is taken through a BVH, as the experiment harness measures levels
+    (docs/CONTRACT.md §5).
 
     Returns:
         ``hausdorff`` (symmetric), ``rms`` (over both directions) and ``hausdorff_paper``
         (largest distance of a vertex of ``a`` to ``b``, EMC's measure), each over the
         bounding-box diagonal of ``a``; the same absolute as ``hausdorff_absolute`` and
-        ``rms_absolute``; ``diagonal``.
+        ``rms_absolute``; ``diagonal``; ``samples`` taken each way (vertices included),
+        ``rms_uncertainty`` (the RMS's relative standard error) and ``hausdorff_uncertainty``
+        (what the Hausdorff distance gained from half the random samples to all of them,
+        relative to it).
     """
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise MeshcodecError(f"samples must be a positive integer, not {samples!r}")
+    if isinstance(max_samples, bool) or not isinstance(max_samples, (int, np.integer)) or max_samples < 1:
+        raise MeshcodecError(f"max_samples must be a positive integer, not {max_samples!r}")
     av, af = _arrays_of(a, "a")
     bv, bf = _arrays_of(b, "b")
     edges = b.loose_edges if isinstance(b, Mesh) else None
     be = np.zeros((0, 2), dtype=np.int64) if edges is None else np.ascontiguousarray(edges, dtype=np.int64)
     if seed is None:
-        return _core.distance(av, af, bv, bf, be, int(samples))
-    return _core.distance(av, af, bv, bf, be, int(samples), int(seed))
+        return _core.distance(av, af, bv, bf, be, int(samples), max_samples=int(max_samples))
+    return _core.distance(av, af, bv, bf, be, int(samples), int(seed), int(max_samples))
 
 
 def codecs() -> List[Dict[str, Any]]:

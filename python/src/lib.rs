@@ -15,7 +15,9 @@ use meshcodec::mesh::attributes::{AttributedMesh, Attributes, Materials};
 use meshcodec::mesh::io;
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::TriMesh;
-use meshcodec::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
+use meshcodec::metrics::{
+    Reference, SampleBudget, DEFAULT_MAX_SAMPLES, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED,
+};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::create_exception;
@@ -707,7 +709,7 @@ fn save<'py>(
 /// Distances both ways between mesh `a` (the reference) and mesh `b` — a decoded level, which
 /// may have loose edges and even no face yet — over samples of both (docs/CONTRACT.md §5).
 #[pyfunction]
-#[pyo3(signature = (a_vertices, a_faces, b_vertices, b_faces, b_edges, samples=DEFAULT_SAMPLES_PER_TRIANGLE, seed=DEFAULT_SEED))]
+#[pyo3(signature = (a_vertices, a_faces, b_vertices, b_faces, b_edges, samples=DEFAULT_SAMPLES_PER_TRIANGLE, seed=DEFAULT_SEED, max_samples=DEFAULT_MAX_SAMPLES))]
 #[allow(clippy::too_many_arguments)]
 fn distance<'py>(
     py: Python<'py>,
@@ -718,10 +720,18 @@ fn distance<'py>(
     b_edges: PyReadonlyArray2<'py, i64>,
     samples: usize,
     seed: u64,
+    max_samples: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     if samples == 0 {
         return Err(refuse("samples must be at least 1 a triangle"));
     }
+    if max_samples == 0 {
+        return Err(refuse("max_samples must be at least 1"));
+    }
+    let budget = SampleBudget {
+        per_triangle: samples,
+        max: max_samples,
+    };
     let a = mesh_of(&a_vertices, &a_faces)?;
     let mesh = level_of(&b_vertices, &b_faces)?;
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
@@ -736,7 +746,7 @@ fn distance<'py>(
         attributes: None,
     };
     let (measured, diagonal) = py.detach(|| {
-        let reference = Reference::new(&a, samples, seed);
+        let reference = Reference::new(&a, budget, seed);
         let diagonal = a.referenced_bounds().map_or(0.0, |b| b.diagonal());
         (reference.measure(&b), diagonal)
     });
@@ -750,6 +760,11 @@ fn distance<'py>(
     d.set_item("rms_absolute", m.rms())?;
     d.set_item("diagonal", diagonal)?;
     d.set_item("samples_per_triangle", samples)?;
+    d.set_item("max_samples", max_samples)?;
+    let uncertainty = m.uncertainty();
+    d.set_item("samples", uncertainty.samples.to_vec())?;
+    d.set_item("rms_uncertainty", uncertainty.rms)?;
+    d.set_item("hausdorff_uncertainty", uncertainty.hausdorff)?;
     Ok(d)
 }
 

@@ -320,6 +320,22 @@ def test_distance_is_zero_to_itself_and_grows_as_levels_coarsen():
     assert d == meshcodec.distance(mesh, meshcodec.decode(stream, level=4), samples=3, seed=7)
 
 
+def test_distance_takes_a_sample_budget_and_says_how_precise_it_is():
+    mesh = shared("bunny-3k-libigl.off")
+    level = meshcodec.decode(meshcodec.encode(mesh.vertices, mesh.faces, codec="emc"), level=5)
+    full = meshcodec.distance(mesh, level)
+    assert full["samples"][0] == len(mesh.vertices) + 10 * len(mesh.faces)
+    capped = meshcodec.distance(mesh, level, max_samples=2000)
+    assert capped["samples"][0] == len(mesh.vertices) + 2000
+    assert capped["max_samples"] == 2000
+    # A capped run estimates the same figures, its uncertainty wider.
+    assert 0 < full["rms_uncertainty"] < capped["rms_uncertainty"] < 0.05
+    assert capped["rms"] == pytest.approx(full["rms"], rel=10 * capped["rms_uncertainty"])
+    assert 0 <= capped["hausdorff_uncertainty"] < 1
+    with pytest.raises(meshcodec.MeshcodecError, match="max_samples"):
+        meshcodec.distance(mesh, level, max_samples=0)
+
+
 def test_decoded_arrays_are_the_decoders_buffers_and_any_dtype_goes_in():
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=np.float32)
     f = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], dtype=np.uint8)

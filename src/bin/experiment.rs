@@ -3,12 +3,13 @@
 //! with one comparison chart per mesh.
 
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use meshcodec::codecs::{self, Codec};
 use meshcodec::harness::{self, RunOptions};
 use meshcodec::mesh::io::{mesh_name, resolve};
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::plot;
+use meshcodec::progress::Progress;
 use meshcodec::results::{self, RunResult};
 use meshcodec::sweep::{JobRecord, Shard, ShardManifest};
 use serde::Deserialize;
@@ -21,7 +22,7 @@ use std::process::ExitCode;
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
-    /// Codec name (raw, …).
+    /// Codec name (the list below).
     codec: Option<String>,
     /// Mesh file, or a name looked up in $MESHCODEC_DATA and ../shared/meshes.
     mesh: Option<String>,
@@ -40,6 +41,10 @@ struct Settings {
     /// Random samples per original triangle for the error metrics.
     #[arg(long, default_value_t = meshcodec::metrics::DEFAULT_SAMPLES_PER_TRIANGLE)]
     samples: usize,
+    /// Most random samples a direction for the error metrics, whatever the mesh's size
+    /// (docs/CONTRACT.md §5; each level's result records its samples and their uncertainty).
+    #[arg(long, default_value_t = meshcodec::metrics::DEFAULT_MAX_SAMPLES)]
+    max_samples: usize,
     /// Folder for results.
     #[arg(long, default_value = "results")]
     out: PathBuf,
@@ -74,6 +79,7 @@ impl Settings {
             quant: None,
             grid: None,
             samples: meshcodec::metrics::DEFAULT_SAMPLES_PER_TRIANGLE,
+            max_samples: meshcodec::metrics::DEFAULT_MAX_SAMPLES,
             out: out.to_path_buf(),
             keep_stream: false,
             appearance: false,
@@ -174,6 +180,8 @@ struct ExperimentSet {
     quant: Vec<u8>,
     /// Samples per triangle for the metrics.
     samples: Option<usize>,
+    /// Most random samples a direction for the metrics.
+    max_samples: Option<usize>,
     /// Grid shape ("cubic" or "per-axis"); absent: each codec's default.
     grid: Option<String>,
     /// Keep the streams beside the results.
@@ -196,7 +204,8 @@ struct ExperimentSet {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let command = Cli::command().after_help(meshcodec::cli::codec_list(None));
+    let cli = Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
     let outcome = match &cli.command {
         Some(Command::Run {
             file,
@@ -213,7 +222,7 @@ fn main() -> ExitCode {
         None => match (&cli.codec, &cli.mesh) {
             (Some(codec), Some(mesh)) => run_one(codec, mesh, &cli.settings).map(|_| ()),
             _ => Err(anyhow::anyhow!(
-                "usage: experiment <codec> <mesh> [--quant BITS] [--samples N] [--out DIR] | experiment run FILE"
+                "usage: experiment <codec> <mesh> [--quant BITS] [--samples N] [--max-samples N] [--out DIR] | experiment run FILE"
             )),
         },
     };
@@ -224,7 +233,10 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
     RunOptions {
         quant_bits: quant.or(settings.quant),
         grid: settings.grid,
-        samples_per_triangle: settings.samples,
+        samples: meshcodec::metrics::SampleBudget {
+            per_triangle: settings.samples,
+            max: settings.max_samples,
+        },
         progress: std::io::stderr().is_terminal(),
         appearance: settings.appearance.then_some(
             meshcodec::mesh::attribute_quantization::AttributeBits {
@@ -241,7 +253,7 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
 }
 
 fn run_one(codec_name: &str, mesh: &str, settings: &Settings) -> Result<(RunResult, Vec<PathBuf>)> {
-    let codec = codecs::by_name(codec_name)?;
+    let codec = meshcodec::cli::codec_by_name(codec_name)?;
     let path = resolve(mesh).with_context(|| mesh.to_string())?;
     run_codec(
         codec,
@@ -354,8 +366,8 @@ impl Set {
         let codecs = set
             .codecs
             .iter()
-            .map(|c| codecs::by_name(c))
-            .collect::<meshcodec::Result<Vec<_>>>()
+            .map(|c| meshcodec::cli::codec_by_name(c))
+            .collect::<Result<Vec<_>, meshcodec::cli::UnknownCodec>>()
             .with_context(|| file.display().to_string())?;
         let paths = set
             .meshes
@@ -373,6 +385,7 @@ impl Set {
         };
         let settings = Settings {
             samples: set.samples.unwrap_or(settings.samples),
+            max_samples: set.max_samples.unwrap_or(settings.max_samples),
             grid,
             keep_stream: settings.keep_stream || set.keep_streams,
             appearance: settings.appearance || set.appearance,
@@ -621,19 +634,37 @@ fn tables(results: &Path, out: &Path) -> Result<()> {
 }
 
 fn came_extras(out: &Path) -> Result<()> {
-    let path = meshcodec::came_extras::run(out, &mut |line| eprintln!("{line}"))?;
+    let progress = Progress::on_terminal();
+    progress.step("came-extras: reading");
+    let path = meshcodec::came_extras::run(out, &mut logged(&progress))?;
+    progress.finish();
     meshcodec::outln!("wrote {}", path.display());
     Ok(())
 }
 
+/// A log callback for a long experiment: each line printed, and a spinner timing what follows
+/// it on a terminal.
+fn logged(progress: &Progress) -> impl FnMut(String) + '_ {
+    move |line| {
+        progress.println(&line);
+        progress.step(format!("after: {line}"));
+    }
+}
+
 fn emc_scale(out: &Path) -> Result<()> {
-    let path = meshcodec::emc_scale::run(out, &mut |line| eprintln!("{line}"))?;
+    let progress = Progress::on_terminal();
+    progress.step("emc-scale: reading and subdividing");
+    let path = meshcodec::emc_scale::run(out, &mut logged(&progress))?;
+    progress.finish();
     meshcodec::outln!("wrote {}", path.display());
     Ok(())
 }
 
 fn came_fly(out: &Path) -> Result<()> {
-    let path = meshcodec::came_flythrough::run(out, &mut |line| eprintln!("{line}"))?;
+    let progress = Progress::on_terminal();
+    progress.step("came-fly: reading and encoding");
+    let path = meshcodec::came_flythrough::run(out, &mut logged(&progress))?;
+    progress.finish();
     meshcodec::outln!("wrote {}", path.display());
     Ok(())
 }
@@ -682,7 +713,9 @@ fn repair_cost(out: &Path) -> Result<()> {
         "manifold",
         "cost"
     );
+    let progress = Progress::on_terminal();
     for (path, times, all_bits) in &jobs {
+        progress.step(format!("repair-cost: {}", mesh_name(path)));
         let mut mesh = meshcodec::mesh::io::read_mesh(path)?;
         let mut name = path
             .file_stem()
@@ -710,8 +743,8 @@ fn repair_cost(out: &Path) -> Result<()> {
                 let share =
                     report.defects() as f64 / (report.edges + canonical.vertex_count()) as f64;
                 let extra = cost.repaired_bytes as f64 / cost.manifold_bytes as f64 - 1.0;
-                meshcodec::outln!(
-                    "{:<22} {:>4} {:<13} {:>7.3}% {:>7} {:>6} {:>6} {:>10} {:>10} {:>+7.2}%",
+                let line = format!(
+                    "{:<22} {:>4} {:<13} {:>7.3}% {:>7} {:>6} {:>6} {:>10} {:>10} {:>+7.2}%\n",
                     name,
                     bits,
                     codecs::Codec::name(&pm),
@@ -723,6 +756,7 @@ fn repair_cost(out: &Path) -> Result<()> {
                     cost.manifold_bytes,
                     100.0 * extra
                 );
+                progress.suspend(|| meshcodec::cli::write_stdout(&line))?;
                 rows.push(serde_json::json!({
                     "mesh": name,
                     "quant_bits": bits,
@@ -760,7 +794,9 @@ fn decimation(out: &Path) -> Result<()> {
         progressive_mesh, simplify, simplify_constrained, Placement,
     };
     let mut rows = Vec::new();
+    let progress = Progress::on_terminal();
     for (name, times) in DECIMATION_MESHES {
+        progress.step(format!("decimation: {name} x{}", 4u32.pow(times)));
         let path = resolve(name).with_context(|| name.to_string())?;
         let mut mesh =
             meshcodec::mesh::io::read_mesh(&path).with_context(|| path.display().to_string())?;
@@ -792,12 +828,13 @@ fn decimation(out: &Path) -> Result<()> {
         let pm = progressive_mesh(&input.faces, &simplified);
         let total_seconds = started.elapsed().as_secs_f64();
         let faces = canonical.face_count();
-        meshcodec::outln!(
-            "{name} x{}: {faces} faces -> base {} vertices; manifold check or cut {manifold_seconds:.2} s; simplify {simplify_seconds:.2} s, with PM construction {total_seconds:.2} s ({:.0} faces/s)",
+        let line = format!(
+            "{name} x{}: {faces} faces -> base {} vertices; manifold check or cut {manifold_seconds:.2} s; simplify {simplify_seconds:.2} s, with PM construction {total_seconds:.2} s ({:.0} faces/s)\n",
             4u32.pow(times),
             pm.base.positions.len(),
             faces as f64 / total_seconds
         );
+        progress.suspend(|| meshcodec::cli::write_stdout(&line))?;
         rows.push(serde_json::json!({
             "mesh": name,
             "cut_to_a_manifold": input.cut.is_some(),

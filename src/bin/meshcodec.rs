@@ -2,7 +2,7 @@
 //! measure the distance between two meshes (Metro-style).
 
 use anyhow::{Context, Result};
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use meshcodec::codecs::{self, Capability, LevelMesh, Stop};
 use meshcodec::container::StreamReader;
 use meshcodec::harness::{encode_options, RunOptions};
@@ -12,7 +12,7 @@ use meshcodec::mesh::io::{
     read_attributed, read_mesh, resolve, write_atomically, write_attributed, write_mesh,
 };
 use meshcodec::mesh::quantize::GridShape;
-use meshcodec::metrics::{Reference, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
+use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -31,8 +31,8 @@ struct Cli {
 enum Command {
     /// Encode a mesh file into a stream.
     Encode {
-        /// Codec name.
-        #[arg(long)]
+        /// Codec name (the list below).
+        #[arg(long, default_value = DEFAULT_CODEC)]
         codec: String,
         /// Quantization bits per axis (default: the codec's).
         #[arg(long)]
@@ -66,12 +66,18 @@ enum Command {
         /// Stream file to write.
         output: PathBuf,
     },
-    /// Decode a stream (or a prefix of it) into a PLY or OBJ file.
+    /// Decode a stream (or a prefix of it) into a mesh file, with the normals, texture
+    /// coordinates, colours and materials the stream carries.
     Decode {
         /// Stream file.
         input: PathBuf,
-        /// Mesh file to write (.ply, .obj, .glb or .gltf).
+        /// Mesh file to write (.ply, .obj, .glb or .gltf; a format that cannot hold what the
+        /// stream carries is refused, naming those that can).
         output: PathBuf,
+        /// Write the geometry alone, dropping the normals, texture coordinates, colours and
+        /// materials the stream carries.
+        #[arg(long)]
+        drop_attributes: bool,
         /// Stop after this many levels.
         #[arg(long, conflicts_with = "bytes")]
         level: Option<usize>,
@@ -138,8 +144,13 @@ enum Command {
     Convert {
         /// Mesh file to read.
         input: String,
-        /// Mesh file to write.
+        /// Mesh file to write (a format that cannot hold what the input holds is refused,
+        /// naming those that can).
         output: PathBuf,
+        /// Write the geometry alone, dropping the input's normals, texture coordinates, colours
+        /// and materials.
+        #[arg(long)]
+        drop_attributes: bool,
     },
     /// Distance between two meshes' surfaces: one-sided both ways, Hausdorff, RMS; and, when
     /// both have appearance, its error (uv texels, normal degrees, colour steps, materials).
@@ -151,6 +162,9 @@ enum Command {
         /// Random samples per triangle of A (taken on each mesh).
         #[arg(long, default_value_t = DEFAULT_SAMPLES_PER_TRIANGLE)]
         samples: usize,
+        /// Most random samples on each mesh, whatever A's size.
+        #[arg(long, default_value_t = meshcodec::metrics::DEFAULT_MAX_SAMPLES)]
+        max_samples: usize,
         /// Sampler seed.
         #[arg(long, default_value_t = DEFAULT_SEED)]
         seed: u64,
@@ -163,8 +177,15 @@ enum Command {
     },
 }
 
+/// The codec `encode` uses when given none.
+const DEFAULT_CODEC: &str = "emc";
+
 fn main() -> ExitCode {
-    let outcome = match Cli::parse().command {
+    let command = Cli::command().mut_subcommand("encode", |encode| {
+        encode.after_help(meshcodec::cli::codec_list(Some(DEFAULT_CODEC)))
+    });
+    let cli = Cli::from_arg_matches(&command.get_matches()).unwrap_or_else(|e| e.exit());
+    let outcome = match cli.command {
         Command::Encode {
             codec,
             quant,
@@ -200,10 +221,11 @@ fn main() -> ExitCode {
         Command::Decode {
             input,
             output,
+            drop_attributes,
             level,
             bytes,
             passes,
-        } => decode(&input, &output, level, bytes, passes),
+        } => decode(&input, &output, drop_attributes, level, bytes, passes),
         Command::Info { input, json } => info(&input, json),
         Command::View {
             input,
@@ -242,25 +264,45 @@ fn main() -> ExitCode {
                 Err(e) => Err(e.into()),
             }
         }
-        Command::Convert { input, output } => convert(&input, &output),
+        Command::Convert {
+            input,
+            output,
+            drop_attributes,
+        } => convert(&input, &output, drop_attributes),
         Command::Distance {
             a,
             b,
             samples,
+            max_samples,
             seed,
             json,
             write_samples,
-        } => distance(&a, &b, samples, seed, json, write_samples.as_deref()),
+        } => distance(
+            &a,
+            &b,
+            SampleBudget {
+                per_triangle: samples,
+                max: max_samples,
+            },
+            seed,
+            json,
+            write_samples.as_deref(),
+        ),
     };
     meshcodec::cli::exit_code(outcome)
 }
 
-fn convert(input: &str, output: &Path) -> Result<()> {
+fn convert(input: &str, output: &Path, drop_attributes: bool) -> Result<()> {
     let path = resolve(input).with_context(|| input.to_string())?;
-    let mesh =
-        meshcodec::mesh::io::read_attributed(&path).with_context(|| path.display().to_string())?;
-    meshcodec::mesh::io::write_attributed(&mesh, output)
-        .with_context(|| output.display().to_string())?;
+    let mesh = if drop_attributes {
+        AttributedMesh {
+            mesh: read_mesh(&path).with_context(|| path.display().to_string())?,
+            attributes: Default::default(),
+        }
+    } else {
+        read_attributed(&path).with_context(|| path.display().to_string())?
+    };
+    write_carried(&mesh, output, "the input holds")?;
     meshcodec::outln!(
         "wrote {}: {} vertices, {} triangles, {} wedges",
         output.display(),
@@ -269,6 +311,28 @@ fn convert(input: &str, output: &Path) -> Result<()> {
         mesh.attributes.wedge_vertex.len()
     );
     Ok(())
+}
+
+/// Writes `mesh` with all it carries; a format that cannot hold it is refused in one line that
+/// names the formats that can and `--drop-attributes`. `carrier` says whose appearance it is.
+fn write_carried(mesh: &AttributedMesh, output: &Path, carrier: &str) -> Result<()> {
+    let context = || output.display().to_string();
+    match write_attributed(mesh, output) {
+        Err(meshcodec::Error::Unsupported(why)) if !mesh.attributes.is_empty() => {
+            let holding = meshcodec::mesh::io::formats_holding(mesh);
+            let formats = if holding.is_empty() {
+                "no format written here holds it all".to_string()
+            } else {
+                let listed: Vec<String> = holding.iter().map(|f| format!(".{f}")).collect();
+                format!("formats that hold what {carrier}: {}", listed.join(", "))
+            };
+            Err(meshcodec::Error::Unsupported(format!(
+                "{why}; {formats}; --drop-attributes writes the geometry alone"
+            )))
+            .with_context(context)
+        }
+        other => other.with_context(context),
+    }
 }
 
 /// A mesh file with its appearance, or without it where the reader cannot keep what the file
@@ -307,7 +371,7 @@ fn encode(
     input: &str,
     output: &Path,
 ) -> Result<()> {
-    let codec = codecs::by_name(codec)?;
+    let codec = meshcodec::cli::codec_by_name(codec)?;
     let path = resolve(input).with_context(|| input.to_string())?;
     let context = || path.display().to_string();
     let options = encode_options(
@@ -391,6 +455,7 @@ fn read_stream(input: &Path) -> Result<Vec<u8>> {
 fn decode(
     input: &Path,
     output: &Path,
+    drop_attributes: bool,
     level: Option<usize>,
     bytes: Option<usize>,
     passes: Option<usize>,
@@ -412,16 +477,16 @@ fn decode(
         );
     }
     match decoded.attributes {
-        Some(attributes) => write_attributed(
+        Some(attributes) if !drop_attributes => write_carried(
             &AttributedMesh {
                 mesh: decoded.mesh.clone(),
                 attributes,
             },
             output,
-        ),
-        None => write_mesh(&decoded.mesh, output),
+            "the stream carries",
+        )?,
+        _ => write_mesh(&decoded.mesh, output).with_context(|| output.display().to_string())?,
     }
-    .with_context(|| output.display().to_string())?;
     meshcodec::outln!(
         "{}: level {levels}, {} vertices, {} triangles from {} bytes",
         output.display(),
@@ -775,7 +840,7 @@ fn info(input: &Path, json: bool) -> Result<()> {
 fn distance(
     a: &str,
     b: &str,
-    samples: usize,
+    samples: SampleBudget,
     seed: u64,
     json: bool,
     dump: Option<&Path>,
@@ -786,7 +851,7 @@ fn distance(
     let reference = Reference::new(mesh_a, samples, seed);
     let appearance = meshcodec::metrics::appearance::AppearanceReference::new(
         &attributed_a,
-        samples * mesh_a.face_count(),
+        samples.count(mesh_a.face_count()),
         seed ^ 2,
     )
     .map(|r| r.compare(&attributed_b.mesh, Some(&attributed_b.attributes)))
@@ -817,7 +882,9 @@ fn distance(
         "a": path_a.display().to_string(),
         "b": path_b.display().to_string(),
         "diagonal": diag,
-        "samples_per_triangle": samples,
+        "samples_per_triangle": samples.per_triangle,
+        "max_samples": samples.max,
+        "uncertainty": m.uncertainty(),
         "seed": seed,
         "a_to_b": m.forward,
         "b_to_a": m.backward,
@@ -855,10 +922,13 @@ fn distance(
             s.rms
         );
     }
+    let uncertainty = m.uncertainty();
     meshcodec::outln!(
-        "Hausdorff {hausdorff:.6e} ({:.6e} of diagonal), RMS {rms:.6e} ({:.6e} of diagonal)",
+        "Hausdorff {hausdorff:.6e} ({:.6e} of diagonal, +{:.2}% from half the samples), RMS {rms:.6e} ({:.6e} of diagonal, ±{:.2}%)",
         hausdorff / diag,
-        rms / diag
+        uncertainty.hausdorff * 100.0,
+        rms / diag,
+        uncertainty.rms * 100.0
     );
     if let Some(e) = appearance {
         let show =

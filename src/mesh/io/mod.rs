@@ -156,6 +156,16 @@ pub fn write_attributed_bytes(mesh: &AttributedMesh, format: &str) -> Result<Vec
     Ok(bytes)
 }
 
+/// The formats, of those [`write_attributed`] writes, that can hold `mesh` with all it carries
+/// (PLY holds no materials and normals or colours per vertex only, OBJ colours per vertex
+/// without alpha): what to suggest when one refuses it.
+pub fn formats_holding(mesh: &AttributedMesh) -> Vec<&'static str> {
+    ["ply", "obj", "glb", "gltf"]
+        .into_iter()
+        .filter(|format| write_attributed_bytes(mesh, format).is_ok())
+        .collect()
+}
+
 /// Reads a mesh from bytes in the given format (an extension such as "ply").
 pub fn read_mesh_bytes(bytes: &[u8], format: &str) -> Result<TriMesh> {
     read_by_extension(bytes, format)
@@ -276,11 +286,13 @@ pub fn known_names() -> Vec<String> {
 }
 
 /// Turns a path or a bare name into a mesh file: a path that exists is used as it is; a name is
-/// looked up as `<name>.*` in [`data_dirs`] (extensions in the order of [`EXTENSIONS`]).
+/// looked up as `<name>.*` in [`data_dirs`] (extensions in the order of [`EXTENSIONS`]). The path
+/// returned is absolute, so that it still names the file from another working directory (a
+/// program run in a scratch folder, a test's temporary directory).
 pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
     let as_path = Path::new(name_or_path);
     if as_path.is_file() {
-        return Ok(as_path.to_path_buf());
+        return Ok(std::path::absolute(as_path)?);
     }
     let looks_like_path = name_or_path.contains('/') || !extension(as_path).is_empty();
     if looks_like_path {
@@ -293,7 +305,7 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
         for ext in EXTENSIONS {
             let candidate = dir.join(format!("{name_or_path}.{ext}"));
             if candidate.is_file() {
-                return Ok(candidate);
+                return Ok(std::fs::canonicalize(&candidate)?);
             }
         }
     }
@@ -303,6 +315,31 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
     } else {
         format!("unknown mesh name; known names: {}", known.join(", "))
     }))
+}
+
+/// How results name the file a mesh was read from, the same on every machine: a file of a data
+/// folder as `../shared/meshes/<file>` or `$MESHCODEC_DATA/<file>`, a file under the working
+/// directory relative to it, any other by its absolute path.
+pub fn portable_source(path: &Path) -> String {
+    let file = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+    let (Some(folder), Some(name)) = (file.parent(), file.file_name()) else {
+        return path.display().to_string();
+    };
+    let name = name.to_string_lossy();
+    let same_folder = |dir: &Path| std::fs::canonicalize(dir).is_ok_and(|d| d == folder);
+    if std::env::var_os("MESHCODEC_DATA").is_some_and(|d| same_folder(Path::new(&d))) {
+        return format!("$MESHCODEC_DATA/{name}");
+    }
+    if data_dirs().iter().any(|d| same_folder(d)) {
+        return format!("../shared/meshes/{name}");
+    }
+    std::env::current_dir()
+        .ok()
+        .and_then(|cwd| std::fs::canonicalize(cwd).ok())
+        .and_then(|cwd| file.strip_prefix(cwd).ok().map(Path::to_path_buf))
+        .unwrap_or(file)
+        .display()
+        .to_string()
 }
 
 /// The short name of a mesh path: its file stem.
