@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The test suite, from a clean clone: installs what it needs, then runs the Rust tests (unit,
-# integration, property, doc), the Python package's suite and examples, and the Open3D and Dask
-# checks.
+# integration, property, doc), the WebAssembly package's tests in Node, the Python package's
+# suite and examples, and the Open3D and Dask checks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,6 +22,11 @@ python_env=$!
 # unify other features). Examples are left to clippy's check (.ci/run): the tests do not run them.
 cargo test --release --lib --bins --tests
 cargo test --release --doc
+
+# The WebAssembly package, built as a user builds it (installing its toolchain), decodes every
+# golden stream in Node exactly as the native decoder just built does.
+bash web/build.sh
+node --test web/test/
 
 if ! wait "$python_env"; then
   cat "$python_log" >&2

@@ -19,8 +19,12 @@
 //! --release --example emc_placement`; BENCHMARKS.md, "Intermediate levels").
 
 use super::walk::{estimate, Walker};
+// The same exponential on every platform (the `libm` crate's, not the C library's, whose last
+// bit differs between glibc and the WebAssembly build): a level shows the same positions
+// wherever it is decoded (web/test/decode.test.mjs compares them bit for bit).
 use crate::mesh::Grid;
 use glam::DVec3;
+use libm::exp;
 use rayon::prelude::*;
 
 /// How much the prediction's expected squared error is trusted, per half-width that the
@@ -121,7 +125,7 @@ fn wide_truncated_mean(m: f64, s: f64) -> f64 {
         0.101_228_536_290_376_3,
     ];
     let peak = m.clamp(-1.0, 1.0);
-    let density = |t: f64| (((peak - m).powi(2) - (t - m).powi(2)) / (2.0 * s * s)).exp();
+    let density = |t: f64| exp(((peak - m).powi(2) - (t - m).powi(2)) / (2.0 * s * s));
     let (mut mass, mut moment) = (0.0, 0.0);
     for (x, weight) in NODES.into_iter().zip(WEIGHTS) {
         for t in [-x, x] {
@@ -134,7 +138,7 @@ fn wide_truncated_mean(m: f64, s: f64) -> f64 {
 }
 
 fn normal_pdf(x: f64) -> f64 {
-    (-0.5 * x * x).exp() * 0.398_942_280_401_432_7
+    exp(-0.5 * x * x) * 0.398_942_280_401_432_7
 }
 
 fn normal_cdf(x: f64) -> f64 {
@@ -148,7 +152,7 @@ fn erf(x: f64) -> f64 {
         * (0.254_829_592
             + t * (-0.284_496_736
                 + t * (1.421_413_741 + t * (-1.453_152_027 + t * 1.061_405_429))));
-    let y = 1.0 - poly * (-x * x).exp();
+    let y = 1.0 - poly * exp(-x * x);
     y.copysign(x)
 }
 

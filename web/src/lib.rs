@@ -1,0 +1,213 @@
+//! meshcodec in JavaScript: the codec core's decoders compiled to WebAssembly, with
+//! wasm-bindgen bindings shaped like the ecosystem's mesh decoders (Draco's `DecoderModule`,
+//! meshoptimizer's `MeshoptDecoder`): bytes in, typed arrays out.
+//!
+//! `bash web/build.sh` writes `web/pkg/meshcodec.js` (an ES module: `await init({module_or_path})`,
+//! then the functions), its `.wasm` and TypeScript types; Node 20 and browsers load the same
+//! files. Errors are JavaScript `Error`s carrying the library's one-line message
+//! (docs/CONTRACT.md §7); a corrupt or cut stream ends in one, never in a trap.
+
+use js_sys::{Array, Float64Array, Object, Reflect, Uint32Array};
+use meshcodec::codecs::{self, LevelMesh, Stop};
+use meshcodec::container::StreamReader;
+use wasm_bindgen::prelude::*;
+
+/// A library error as a JavaScript `Error` with its one-line message.
+fn to_js(e: meshcodec::Error) -> JsError {
+    JsError::new(&e.to_string().replace(['\n', '\t'], " "))
+}
+
+fn set(object: &Object, key: &str, value: impl Into<JsValue>) -> Result<(), JsError> {
+    Reflect::set(object, &JsValue::from_str(key), &value.into())
+        .map(|_| ())
+        .map_err(|_| JsError::new(&format!("cannot set {key}")))
+}
+
+/// A decoded level as a plain object: `positions` (Float64Array of x, y, z), `indices`
+/// (Uint32Array of triangle corners), `level`, `levels`, `codec`, `vertices`, `triangles`,
+/// `appearance` (whether the level carries normals, uvs, colours or materials).
+fn level_object(
+    mesh: &LevelMesh,
+    level: usize,
+    levels: usize,
+    codec: &str,
+) -> Result<Object, JsError> {
+    let positions: Vec<f64> = mesh
+        .mesh
+        .positions
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .collect();
+    let indices: Vec<u32> = mesh.mesh.faces.iter().flatten().copied().collect();
+    let object = Object::new();
+    set(
+        &object,
+        "positions",
+        Float64Array::from(positions.as_slice()),
+    )?;
+    set(&object, "indices", Uint32Array::from(indices.as_slice()))?;
+    set(&object, "level", level as u32)?;
+    set(&object, "levels", levels as u32)?;
+    set(&object, "codec", codec)?;
+    set(&object, "vertices", mesh.mesh.positions.len() as u32)?;
+    set(&object, "triangles", mesh.mesh.faces.len() as u32)?;
+    set(&object, "appearance", mesh.attributes.is_some())?;
+    Ok(object)
+}
+
+/// The codec name of a stream's header.
+fn codec_name(bytes: &[u8]) -> Result<&'static str, JsError> {
+    let reader = StreamReader::open(bytes).map_err(to_js)?;
+    Ok(codecs::by_id(reader.header().codec_id)
+        .map_err(to_js)?
+        .name())
+}
+
+/// Decodes a stream, or the levels a prefix of it holds: every level, or the first `level`
+/// levels, of the first `nbytes` bytes (all when absent).
+#[wasm_bindgen]
+pub fn decode(bytes: &[u8], level: Option<u32>, nbytes: Option<u32>) -> Result<Object, JsError> {
+    let prefix = &bytes[..nbytes.map_or(bytes.len(), |n| (n as usize).min(bytes.len()))];
+    let codec = codec_name(prefix)?;
+    let stop = level.map_or(Stop::All, |l| Stop::Levels(l as usize));
+    let mut decoder = codecs::open(prefix).map_err(to_js)?;
+    let levels = decoder.levels();
+    let (mesh, decoded) = codecs::decode_with(decoder.as_mut(), stop).map_err(to_js)?;
+    if mesh.mesh.positions.is_empty() {
+        return Err(JsError::new(&format!(
+            "the first {} bytes hold no complete level",
+            prefix.len()
+        )));
+    }
+    level_object(&mesh, decoded, levels, codec)
+}
+
+/// The byte each level of a stream ends at, from a prefix holding its header and index.
+#[wasm_bindgen(js_name = levelEnds)]
+pub fn level_ends(bytes: &[u8]) -> Result<Vec<f64>, JsError> {
+    Ok(codecs::level_ends(bytes)
+        .map_err(to_js)?
+        .into_iter()
+        .map(|end| end as f64)
+        .collect())
+}
+
+/// What a stream's header and index say, without decoding it: `codec`, `formatVersion`,
+/// `quantBits`, `origin`, `cell`, `vertices`, `triangles`, `levels`, `levelEnds`,
+/// `payloadStart`, `truncated`, `appearance`, and `units` with each one's byte range.
+#[wasm_bindgen]
+pub fn info(bytes: &[u8]) -> Result<Object, JsError> {
+    let reader = StreamReader::open(bytes).map_err(to_js)?;
+    let header = reader.header();
+    let codec = codecs::by_id(header.codec_id).map_err(to_js)?;
+    let index = reader.index();
+    let start = reader.payload_start() as u64;
+    let units = Array::new();
+    for (i, u) in index.units.iter().enumerate() {
+        let unit = Object::new();
+        set(&unit, "unit", i as u32)?;
+        set(&unit, "parent", u.parent.map(|p| p as f64))?;
+        set(&unit, "firstByte", (start + u.offset) as f64)?;
+        set(&unit, "endByte", (start + u.end()) as f64)?;
+        set(&unit, "bytes", u.length as f64)?;
+        set(&unit, "present", reader.unit(i).is_some())?;
+        units.push(&unit);
+    }
+    // As `levelEnds` says them: the full level of a stream with appearance ends with its unit.
+    let ends = codecs::level_ends(bytes).map_err(to_js)?;
+    let object = Object::new();
+    set(&object, "codec", codec.name())?;
+    set(&object, "formatVersion", header.version())?;
+    set(&object, "bytes", bytes.len() as f64)?;
+    set(&object, "streamBytes", (start + index.payload_bytes) as f64)?;
+    set(&object, "truncated", reader.truncated())?;
+    set(&object, "quantBits", header.grid.bits)?;
+    set(
+        &object,
+        "origin",
+        Float64Array::from(&header.grid.origin[..]),
+    )?;
+    set(&object, "cell", Float64Array::from(&header.grid.cell[..]))?;
+    set(&object, "vertices", header.vertices as f64)?;
+    set(&object, "triangles", header.triangles as f64)?;
+    set(&object, "levels", ends.len() as u32)?;
+    let ends: Vec<f64> = ends.into_iter().map(|e| e as f64).collect();
+    set(&object, "levelEnds", Float64Array::from(ends.as_slice()))?;
+    set(&object, "payloadStart", start as f64)?;
+    set(&object, "units", units)?;
+    set(&object, "appearance", header.appearance.is_some())?;
+    Ok(object)
+}
+
+/// A decoder fed a stream's bytes as they arrive (the chunks of `fetch()`'s `ReadableStream`):
+/// each `push` returns the newest level its bytes completed, if any.
+#[wasm_bindgen]
+pub struct ProgressiveDecoder {
+    bytes: Vec<u8>,
+    /// Where each level ends, once the header and index are in.
+    ends: Option<Vec<u64>>,
+    /// Levels handed over so far.
+    handed: usize,
+}
+
+impl Default for ProgressiveDecoder {
+    fn default() -> Self {
+        ProgressiveDecoder::new()
+    }
+}
+
+#[wasm_bindgen]
+impl ProgressiveDecoder {
+    /// A decoder with no bytes yet.
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> ProgressiveDecoder {
+        ProgressiveDecoder {
+            bytes: Vec::new(),
+            ends: None,
+            handed: 0,
+        }
+    }
+
+    /// Takes the next chunk; returns the newest level now complete (a level object as
+    /// `decode` returns), or `undefined` when the chunk completed none. Levels completed by
+    /// the same chunk are handed over as one, the newest.
+    pub fn push(&mut self, chunk: &[u8]) -> Result<JsValue, JsError> {
+        self.bytes.extend_from_slice(chunk);
+        if self.ends.is_none() {
+            match codecs::level_ends(&self.bytes) {
+                Ok(ends) => self.ends = Some(ends),
+                Err(meshcodec::Error::Truncated(_)) => return Ok(JsValue::UNDEFINED),
+                Err(e) => return Err(to_js(e)),
+            }
+        }
+        let ends = self.ends.as_deref().unwrap_or_default();
+        let complete = ends
+            .iter()
+            .take_while(|&&end| end <= self.bytes.len() as u64)
+            .count();
+        if complete <= self.handed {
+            return Ok(JsValue::UNDEFINED);
+        }
+        self.handed = complete;
+        let level = decode(&self.bytes, Some(complete as u32), None)?;
+        Ok(level.into())
+    }
+
+    /// Bytes taken so far.
+    #[wasm_bindgen(getter)]
+    pub fn received(&self) -> f64 {
+        self.bytes.len() as f64
+    }
+
+    /// Levels the stream holds (0 until its header and index are in).
+    #[wasm_bindgen(getter)]
+    pub fn levels(&self) -> u32 {
+        self.ends.as_ref().map_or(0, |e| e.len() as u32)
+    }
+
+    /// Levels handed over so far.
+    #[wasm_bindgen(getter)]
+    pub fn level(&self) -> u32 {
+        self.handed as u32
+    }
+}

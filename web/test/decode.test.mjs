@@ -1,0 +1,142 @@
+// The WebAssembly package against the native decoder: every golden stream decodes in Node exactly
+// as `meshcodec decode` decodes it (positions to the last bit, faces, level counts), level by
+// level and fed in chunks; cut and corrupted streams end in an Error with the library's message,
+// never in a trap. Run by tests/run.sh after `bash web/build.sh` and the release build:
+//   node --test web/test/
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import { execFileSync } from "node:child_process";
+import { mkdtempSync, readdirSync, readFileSync, rmSync, statSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { join } from "node:path";
+import { fileURLToPath } from "node:url";
+
+import init, { decode, info, levelEnds, ProgressiveDecoder } from "../pkg/meshcodec.js";
+
+const root = fileURLToPath(new URL("../../", import.meta.url));
+const native = process.env.MESHCODEC_BIN ?? join(root, "target/release/meshcodec");
+await init({ module_or_path: readFileSync(join(root, "web/pkg/meshcodec_bg.wasm")) });
+
+/** Every golden stream of tests/golden/ (all format versions). */
+function goldenStreams() {
+  const dir = join(root, "tests/golden");
+  return readdirSync(dir)
+    .filter((d) => statSync(join(dir, d)).isDirectory())
+    .flatMap((d) => readdirSync(join(dir, d)).filter((f) => f.endsWith(".mc")).map((f) => join(dir, d, f)))
+    .sort();
+}
+
+/** The native decoder's mesh of `stream` after `level` levels, from the binary PLY it writes. */
+function nativeLevel(stream, level, scratch) {
+  const out = join(scratch, `level-${level}.ply`);
+  execFileSync(native, ["decode", stream, out, "--level", String(level), "--drop-attributes"]);
+  const bytes = readFileSync(out);
+  const headerEnd = bytes.indexOf("end_header\n") + "end_header\n".length;
+  const header = bytes.subarray(0, headerEnd).toString("latin1");
+  const vertices = Number(/element vertex (\d+)/.exec(header)[1]);
+  const faces = Number(/element face (\d+)/.exec(header)[1]);
+  const view = new DataView(bytes.buffer, bytes.byteOffset + headerEnd);
+  const positions = new Float64Array(vertices * 3);
+  for (let i = 0; i < positions.length; i++) positions[i] = view.getFloat64(i * 8, true);
+  const indices = new Uint32Array(faces * 3);
+  let at = vertices * 24;
+  for (let f = 0; f < faces; f++) {
+    assert.equal(view.getUint8(at), 3);
+    for (let c = 0; c < 3; c++) indices[f * 3 + c] = view.getInt32(at + 1 + 4 * c, true);
+    at += 13;
+  }
+  return { positions, indices };
+}
+
+/** Positions compared bit for bit (NaN-safe, -0 apart from +0). */
+function assertSameBits(actual, expected, what) {
+  assert.equal(actual.length, expected.length, `${what}: lengths`);
+  const a = new BigUint64Array(actual.buffer, actual.byteOffset, actual.length);
+  const e = new BigUint64Array(expected.buffer, expected.byteOffset, expected.length);
+  for (let i = 0; i < a.length; i++) {
+    if (a[i] !== e[i]) assert.fail(`${what}: coordinate ${i} is ${actual[i]}, natively ${expected[i]}`);
+  }
+}
+
+const streams = goldenStreams();
+
+test("there are golden streams of every codec", () => {
+  const codecs = new Set(streams.map((s) => info(readFileSync(s)).codec));
+  for (const codec of ["raw", "emc-paper", "emc", "pm", "pm-reordered", "came-paper", "came"]) {
+    assert.ok(codecs.has(codec), `no golden stream of ${codec}`);
+  }
+});
+
+for (const stream of streams) {
+  const name = stream.slice(join(root, "tests/golden/").length);
+  test(`${name} decodes as natively, every level`, () => {
+    const bytes = new Uint8Array(readFileSync(stream));
+    const described = info(bytes);
+    assert.deepEqual(Array.from(levelEnds(bytes)), Array.from(described.levelEnds));
+    const scratch = mkdtempSync(join(tmpdir(), "meshcodec-web-"));
+    try {
+      for (let level = 1; level <= described.levels; level++) {
+        const ours = decode(bytes, level);
+        assert.equal(ours.level, level);
+        assert.equal(ours.levels, described.levels);
+        assert.equal(ours.codec, described.codec);
+        const theirs = nativeLevel(stream, level, scratch);
+        assertSameBits(ours.positions, theirs.positions, `${name} level ${level}`);
+        assert.deepEqual(ours.indices, theirs.indices, `${name} level ${level}: faces`);
+      }
+      const full = decode(bytes);
+      assert.equal(full.level, described.levels);
+    } finally {
+      rmSync(scratch, { recursive: true, force: true });
+    }
+  });
+
+  test(`${name} fed in chunks hands over each level as its bytes arrive`, () => {
+    const bytes = new Uint8Array(readFileSync(stream));
+    const ends = Array.from(levelEnds(bytes));
+    const decoder = new ProgressiveDecoder();
+    const chunk = Math.max(1, Math.ceil(bytes.length / 37));
+    let last = 0;
+    for (let at = 0; at < bytes.length; at += chunk) {
+      const end = Math.min(bytes.length, at + chunk);
+      const level = decoder.push(bytes.subarray(at, end));
+      const complete = ends.filter((e) => e <= end).length;
+      if (level === undefined) {
+        assert.equal(complete, last, `${name}: a level completed at byte ${end} was not handed over`);
+        continue;
+      }
+      assert.equal(level.level, complete);
+      const whole = decode(bytes, complete);
+      assertSameBits(level.positions, whole.positions, `${name} level ${complete} from chunks`);
+      last = complete;
+    }
+    assert.equal(last, ends.length);
+    decoder.free();
+  });
+}
+
+test("cut and corrupted streams end in an Error with the library's message", () => {
+  let refused = 0;
+  for (const stream of streams) {
+    const bytes = new Uint8Array(readFileSync(stream));
+    const cuts = [0, 1, 5, 17, 40, bytes.length >> 3, bytes.length >> 1, bytes.length - 1];
+    const variants = cuts.filter((n) => n < bytes.length).map((n) => bytes.slice(0, n));
+    for (let k = 0; k < 24; k++) {
+      const broken = bytes.slice();
+      const at = (k * 7919 + 13) % broken.length;
+      broken[at] ^= 1 << (k % 8);
+      variants.push(broken);
+    }
+    for (const variant of variants) {
+      try {
+        decode(variant);
+      } catch (e) {
+        assert.ok(e instanceof Error, `${stream}: threw ${e}`);
+        assert.ok(!(e instanceof WebAssembly.RuntimeError), `${stream}: the module trapped: ${e}`);
+        assert.ok(e.message.length > 0 && !e.message.includes("\n"), e.message);
+        refused++;
+      }
+    }
+  }
+  assert.ok(refused > streams.length * 4, `only ${refused} refused`);
+});
