@@ -26,6 +26,7 @@ cargo test --release --doc
 # The WebAssembly package, built as a user builds it (installing its toolchain), decodes every
 # golden stream in Node exactly as the native decoder just built does.
 bash web/build.sh
+bash tests/chromium.sh
 node --test web/test/
 
 if ! wait "$python_env"; then

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Builds the WebAssembly package into web/pkg/: meshcodec.js (an ES module, wasm-bindgen's web
 # target), meshcodec_bg.wasm and the TypeScript types; Node 20 and browsers load the same files.
+# Also installs web/node_modules (three.js for web/loader.js and the viewer).
 # Installs what it needs on a fresh machine: Debian's rustc-web (a compiler whose standard
 # library builds for wasm32: -Zbuild-std) and wasm-ld, and the wasm-bindgen command of the
 # version Cargo.lock pins.
@@ -33,6 +34,10 @@ RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 \
   RUSTFLAGS='--cfg getrandom_backend="wasm_js"' \
   /usr/bin/cargo build -q --release -p meshcodec-web --target wasm32-unknown-unknown \
   -Zbuild-std=std,panic_abort --target-dir target/web
+
+# three.js for the loader and the viewer, playwright-core for the browser test: the versions
+# web/package-lock.json pins.
+(cd web && npm ci --no-audit --no-fund --loglevel=error)
 
 rm -rf web/pkg
 wasm-bindgen --target web --out-dir web/pkg --out-name meshcodec --remove-name-section \

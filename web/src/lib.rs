@@ -9,7 +9,7 @@
 
 use js_sys::{Array, Float64Array, Object, Reflect, Uint32Array};
 use meshcodec::codecs::{self, LevelMesh, Stop};
-use meshcodec::container::StreamReader;
+use meshcodec::container::{Header, StreamReader};
 use wasm_bindgen::prelude::*;
 
 /// A library error as a JavaScript `Error` with its one-line message.
@@ -25,13 +25,15 @@ fn set(object: &Object, key: &str, value: impl Into<JsValue>) -> Result<(), JsEr
 
 /// A decoded level as a plain object: `positions` (Float64Array of x, y, z), `indices`
 /// (Uint32Array of triangle corners), `level`, `levels`, `codec`, `vertices`, `triangles`,
-/// `appearance` (whether the level carries normals, uvs, colours or materials).
+/// `meshVertices` (of the full mesh), `appearance` (whether the level carries normals, uvs,
+/// colours or materials).
 fn level_object(
     mesh: &LevelMesh,
     level: usize,
     levels: usize,
-    codec: &str,
+    header: &Header,
 ) -> Result<Object, JsError> {
+    let codec = codecs::by_id(header.codec_id).map_err(to_js)?.name();
     let positions: Vec<f64> = mesh
         .mesh
         .positions
@@ -51,16 +53,9 @@ fn level_object(
     set(&object, "codec", codec)?;
     set(&object, "vertices", mesh.mesh.positions.len() as u32)?;
     set(&object, "triangles", mesh.mesh.faces.len() as u32)?;
+    set(&object, "meshVertices", header.vertices as f64)?;
     set(&object, "appearance", mesh.attributes.is_some())?;
     Ok(object)
-}
-
-/// The codec name of a stream's header.
-fn codec_name(bytes: &[u8]) -> Result<&'static str, JsError> {
-    let reader = StreamReader::open(bytes).map_err(to_js)?;
-    Ok(codecs::by_id(reader.header().codec_id)
-        .map_err(to_js)?
-        .name())
 }
 
 /// Decodes a stream, or the levels a prefix of it holds: every level, or the first `level`
@@ -68,7 +63,6 @@ fn codec_name(bytes: &[u8]) -> Result<&'static str, JsError> {
 #[wasm_bindgen]
 pub fn decode(bytes: &[u8], level: Option<u32>, nbytes: Option<u32>) -> Result<Object, JsError> {
     let prefix = &bytes[..nbytes.map_or(bytes.len(), |n| (n as usize).min(bytes.len()))];
-    let codec = codec_name(prefix)?;
     let stop = level.map_or(Stop::All, |l| Stop::Levels(l as usize));
     let mut decoder = codecs::open(prefix).map_err(to_js)?;
     let levels = decoder.levels();
@@ -79,7 +73,8 @@ pub fn decode(bytes: &[u8], level: Option<u32>, nbytes: Option<u32>) -> Result<O
             prefix.len()
         )));
     }
-    level_object(&mesh, decoded, levels, codec)
+    let header = decoder.header().clone();
+    level_object(&mesh, decoded, levels, &header)
 }
 
 /// The byte each level of a stream ends at, from a prefix holding its header and index.

@@ -5,16 +5,15 @@
 //   node --test web/test/
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { execFileSync } from "node:child_process";
 import { mkdtempSync, readdirSync, readFileSync, rmSync, statSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { fileURLToPath } from "node:url";
 
 import init, { decode, info, levelEnds, ProgressiveDecoder } from "../pkg/meshcodec.js";
+import { assertSameBits, nativeLevel } from "./native.mjs";
 
 const root = fileURLToPath(new URL("../../", import.meta.url));
-const native = process.env.MESHCODEC_BIN ?? join(root, "target/release/meshcodec");
 await init({ module_or_path: readFileSync(join(root, "web/pkg/meshcodec_bg.wasm")) });
 
 /** Every golden stream of tests/golden/ (all format versions). */
@@ -24,38 +23,6 @@ function goldenStreams() {
     .filter((d) => statSync(join(dir, d)).isDirectory())
     .flatMap((d) => readdirSync(join(dir, d)).filter((f) => f.endsWith(".mc")).map((f) => join(dir, d, f)))
     .sort();
-}
-
-/** The native decoder's mesh of `stream` after `level` levels, from the binary PLY it writes. */
-function nativeLevel(stream, level, scratch) {
-  const out = join(scratch, `level-${level}.ply`);
-  execFileSync(native, ["decode", stream, out, "--level", String(level), "--drop-attributes"]);
-  const bytes = readFileSync(out);
-  const headerEnd = bytes.indexOf("end_header\n") + "end_header\n".length;
-  const header = bytes.subarray(0, headerEnd).toString("latin1");
-  const vertices = Number(/element vertex (\d+)/.exec(header)[1]);
-  const faces = Number(/element face (\d+)/.exec(header)[1]);
-  const view = new DataView(bytes.buffer, bytes.byteOffset + headerEnd);
-  const positions = new Float64Array(vertices * 3);
-  for (let i = 0; i < positions.length; i++) positions[i] = view.getFloat64(i * 8, true);
-  const indices = new Uint32Array(faces * 3);
-  let at = vertices * 24;
-  for (let f = 0; f < faces; f++) {
-    assert.equal(view.getUint8(at), 3);
-    for (let c = 0; c < 3; c++) indices[f * 3 + c] = view.getInt32(at + 1 + 4 * c, true);
-    at += 13;
-  }
-  return { positions, indices };
-}
-
-/** Positions compared bit for bit (NaN-safe, -0 apart from +0). */
-function assertSameBits(actual, expected, what) {
-  assert.equal(actual.length, expected.length, `${what}: lengths`);
-  const a = new BigUint64Array(actual.buffer, actual.byteOffset, actual.length);
-  const e = new BigUint64Array(expected.buffer, expected.byteOffset, expected.length);
-  for (let i = 0; i < a.length; i++) {
-    if (a[i] !== e[i]) assert.fail(`${what}: coordinate ${i} is ${actual[i]}, natively ${expected[i]}`);
-  }
 }
 
 const streams = goldenStreams();

@@ -1,0 +1,111 @@
+// MeshcodecLoader: meshcodec streams into three.js, as DRACOLoader brings Draco's. `load` hands
+// over a BufferGeometry at once and refines it in place level by level as the stream arrives,
+// decoded in a Web Worker (worker.js) so that the page never waits on the decoder:
+//
+//   const loader = new MeshcodecLoader();
+//   loader.load("bunny.mc", (geometry) => {...}, onProgress, onError, (geometry, level) => {...});
+//
+// `onLoad` runs once the last level is in; `onLevel` after each level (geometry.userData.meshcodec
+// holds its figures and its positions in double precision). Errors arrive at `onError` as
+// `Error`s with the library's one-line message.
+import { BufferAttribute, BufferGeometry, Loader } from "three";
+
+let nextId = 1;
+
+export class MeshcodecLoader extends Loader {
+  constructor(manager) {
+    super(manager);
+    this.worker = null;
+    this.pending = new Map();
+  }
+
+  /** The worker, started on first use. */
+  start() {
+    if (!this.worker) {
+      this.worker = new Worker(new URL("./worker.js", import.meta.url), { type: "module" });
+      this.worker.onmessage = ({ data }) => this.pending.get(data.id)?.(data);
+      this.worker.onerror = (event) => {
+        for (const handle of this.pending.values()) handle({ type: "error", message: event.message });
+      };
+    }
+    return this.worker;
+  }
+
+  /** Streams `url` into a BufferGeometry, returned at once and refined as levels arrive. */
+  load(url, onLoad, onProgress, onError, onLevel) {
+    const resolved = this.manager.resolveURL(this.path + url);
+    return this.decode({ url: new URL(resolved, globalThis.location?.href).href }, onLoad, onProgress, onError, onLevel);
+  }
+
+  /** The same for bytes already read (an ArrayBuffer, handed over to the worker). */
+  parse(buffer, onLoad, onError, onLevel) {
+    return this.decode({ bytes: buffer }, onLoad, undefined, onError, onLevel, [buffer]);
+  }
+
+  /** A Promise of the geometry once its last level is in. */
+  loadAsync(url, onProgress) {
+    return new Promise((resolve, reject) => this.load(url, resolve, onProgress, reject));
+  }
+
+  decode(request, onLoad, onProgress, onError, onLevel, transfer = []) {
+    const geometry = new BufferGeometry();
+    const id = nextId++;
+    this.manager.itemStart(id);
+    const end = () => {
+      this.pending.delete(id);
+      this.manager.itemEnd(id);
+    };
+    this.pending.set(id, (message) => {
+      switch (message.type) {
+        case "progress":
+          onProgress?.({ loaded: message.received, total: message.total, lengthComputable: message.total > 0 });
+          break;
+        case "level":
+          setLevel(geometry, message);
+          onLevel?.(geometry, geometry.userData.meshcodec);
+          break;
+        case "done":
+          end();
+          onLoad?.(geometry);
+          break;
+        case "error": {
+          end();
+          const error = new Error(message.message);
+          this.manager.itemError(id);
+          if (onError) onError(error);
+          else console.error(error);
+          break;
+        }
+      }
+    });
+    this.start().postMessage({ ...request, id }, transfer);
+    return geometry;
+  }
+
+  dispose() {
+    this.worker?.terminate();
+    this.worker = null;
+    this.pending.clear();
+    return this;
+  }
+}
+
+/** Puts a decoded level into `geometry`: single-precision positions for drawing, the level's
+ * own double-precision positions and figures in `userData.meshcodec`. */
+function setLevel(geometry, level) {
+  geometry.setAttribute("position", new BufferAttribute(Float32Array.from(level.positions), 3));
+  geometry.setIndex(new BufferAttribute(level.indices, 1));
+  geometry.computeVertexNormals();
+  geometry.computeBoundingBox();
+  geometry.computeBoundingSphere();
+  geometry.userData.meshcodec = {
+    codec: level.codec,
+    level: level.level,
+    levels: level.levels,
+    vertices: level.vertices,
+    triangles: level.triangles,
+    meshVertices: level.meshVertices,
+    received: level.received,
+    positions: level.positions,
+  };
+}

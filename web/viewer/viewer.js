@@ -1,0 +1,129 @@
+// The viewer: opens the stream named by ?src= (or a file dropped on the page), shows each level
+// as it arrives with a progress bar and a line of figures, and orbits around the mesh. Its state
+// is window.viewer.state (for people and for tests: the level shown, its figures, errors).
+import * as THREE from "three";
+import { OrbitControls } from "three/addons/controls/OrbitControls.js";
+import { MeshcodecLoader } from "../loader.js";
+
+const canvas = document.getElementById("view");
+const fill = document.getElementById("fill");
+const figures = document.getElementById("figures");
+const errorLine = document.getElementById("error");
+const source = document.getElementById("source");
+
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0x1d2127);
+const camera = new THREE.PerspectiveCamera(40, 1, 0.001, 1000);
+const controls = new OrbitControls(camera, canvas);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x44474f, 1.6));
+const light = new THREE.DirectionalLight(0xffffff, 1.8);
+camera.add(light);
+light.position.set(0.5, 0.8, 1);
+scene.add(camera);
+const material = new THREE.MeshStandardMaterial({ color: 0xc9c2b6, roughness: 0.75, flatShading: false });
+
+const state = { status: "idle", level: 0, levels: 0, levelsSeen: [], received: 0, total: 0, faces: 0, vertices: 0, error: null, frames: 0 };
+window.viewer = { state, scene, camera, mesh: null };
+
+const loader = new MeshcodecLoader();
+let mesh = null;
+let framed = false;
+
+function resize() {
+  const { clientWidth: w, clientHeight: h } = canvas;
+  renderer.setSize(w, h, false);
+  camera.aspect = w / Math.max(1, h);
+  camera.updateProjectionMatrix();
+}
+
+/** Looks at the whole mesh from the front, a little above, once its first level is in. */
+function frame(geometry) {
+  const { center, radius } = geometry.boundingSphere;
+  const distance = radius / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2)) * 1.1;
+  camera.position.copy(center).add(new THREE.Vector3(0, 0.25, 1).normalize().multiplyScalar(distance));
+  camera.near = distance / 100;
+  camera.far = distance * 10;
+  camera.updateProjectionMatrix();
+  controls.target.copy(center);
+  controls.update();
+}
+
+function showFigures() {
+  const bytes = state.total ? `${state.received.toLocaleString()} of ${state.total.toLocaleString()} bytes` : `${state.received.toLocaleString()} bytes`;
+  const rate = state.meshVertices ? ` · ${((state.received * 8) / state.meshVertices).toFixed(2)} bits a vertex` : "";
+  figures.textContent = `${bytes} · level ${state.level} of ${state.levels} · ${state.faces.toLocaleString()} faces${rate}`;
+  fill.style.width = `${state.total ? (100 * state.received) / state.total : 0}%`;
+}
+
+function open(request, name) {
+  source.textContent = name;
+  Object.assign(state, { status: "loading", level: 0, levels: 0, levelsSeen: [], received: 0, total: 0, faces: 0, vertices: 0, error: null });
+  errorLine.textContent = "";
+  framed = false;
+  if (mesh) {
+    scene.remove(mesh);
+    mesh.geometry.dispose();
+  }
+  const onProgress = ({ loaded, total }) => {
+    state.received = loaded;
+    state.total = total;
+    showFigures();
+  };
+  const onLevel = (geometry, level) => {
+    Object.assign(state, {
+      level: level.level,
+      levels: level.levels,
+      faces: level.triangles,
+      vertices: level.vertices,
+      meshVertices: level.meshVertices,
+      codec: level.codec,
+    });
+    state.levelsSeen.push(level.level);
+    if (!framed) {
+      frame(geometry);
+      framed = true;
+    }
+    showFigures();
+  };
+  const onLoad = () => {
+    state.status = "done";
+    fill.style.width = "100%";
+    showFigures();
+  };
+  const onError = (error) => {
+    state.status = "error";
+    state.error = error.message;
+    errorLine.textContent = error.message;
+  };
+  const geometry = request.url
+    ? loader.load(request.url, onLoad, onProgress, onError, onLevel)
+    : loader.parse(request.bytes, onLoad, onError, onLevel);
+  mesh = new THREE.Mesh(geometry, material);
+  window.viewer.mesh = mesh;
+  scene.add(mesh);
+}
+
+addEventListener("resize", resize);
+addEventListener("dragover", (e) => {
+  e.preventDefault();
+  document.body.classList.add("dragging");
+});
+addEventListener("dragleave", () => document.body.classList.remove("dragging"));
+addEventListener("drop", async (e) => {
+  e.preventDefault();
+  document.body.classList.remove("dragging");
+  const file = e.dataTransfer.files[0];
+  if (file) open({ bytes: await file.arrayBuffer() }, file.name);
+});
+
+resize();
+renderer.setAnimationLoop(() => {
+  controls.update();
+  renderer.render(scene, camera);
+  state.frames++;
+});
+
+const src = new URLSearchParams(location.search).get("src");
+if (src) open({ url: src }, src);
