@@ -90,12 +90,19 @@ export class MeshcodecLoader extends Loader {
   }
 }
 
-/** Puts a decoded level into `geometry`: single-precision positions for drawing, the level's
- * own double-precision positions and figures in `userData.meshcodec`. */
+/** Puts a decoded level into `geometry`: single-precision positions for drawing (a vertex a
+ * wedge where the level carries appearance: normals, uvs and colours as attributes, a group a
+ * material), the level's own double-precision positions and figures in `userData.meshcodec`. */
 function setLevel(geometry, level) {
-  geometry.setAttribute("position", new BufferAttribute(Float32Array.from(level.positions), 3));
-  geometry.setIndex(new BufferAttribute(level.indices, 1));
-  geometry.computeVertexNormals();
+  for (const name of ["normal", "uv", "color"]) geometry.deleteAttribute(name);
+  geometry.clearGroups();
+  if (level.appearance) {
+    setAppearance(geometry, level);
+  } else {
+    geometry.setAttribute("position", new BufferAttribute(Float32Array.from(level.positions), 3));
+    geometry.setIndex(new BufferAttribute(level.indices, 1));
+  }
+  if (!geometry.getAttribute("normal")) geometry.computeVertexNormals();
   geometry.computeBoundingBox();
   geometry.computeBoundingSphere();
   geometry.userData.meshcodec = {
@@ -107,5 +114,47 @@ function setLevel(geometry, level) {
     meshVertices: level.meshVertices,
     received: level.received,
     positions: level.positions,
+    indices: level.indices,
+    appearance: level.appearance,
+    materials: level.appearance?.materials?.names ?? [],
   };
+}
+
+/** A vertex a wedge, as three.js draws seams: its vertex's position, its own normal, uv and
+ * colour; faces ordered by material, a group each. */
+function setAppearance(geometry, level) {
+  const { corners, wedgeVertex, normals, uvs, colours, materials } = level.appearance;
+  const wedges = wedgeVertex.length;
+  const positions = new Float32Array(wedges * 3);
+  for (let w = 0; w < wedges; w++) {
+    const v = wedgeVertex[w] * 3;
+    positions.set([level.positions[v], level.positions[v + 1], level.positions[v + 2]], w * 3);
+  }
+  geometry.setAttribute("position", new BufferAttribute(positions, 3));
+  if (normals) {
+    const unit = new Float32Array(normals.length);
+    for (let i = 0; i < normals.length; i += 3) {
+      const length = Math.hypot(normals[i], normals[i + 1], normals[i + 2]) || 1;
+      unit.set([normals[i] / length, normals[i + 1] / length, normals[i + 2] / length], i);
+    }
+    geometry.setAttribute("normal", new BufferAttribute(unit, 3));
+  }
+  if (uvs) geometry.setAttribute("uv", new BufferAttribute(Float32Array.from(uvs), 2));
+  if (colours) geometry.setAttribute("color", new BufferAttribute(Float32Array.from(colours), 4));
+  const faces = corners.length / 3;
+  if (!materials) {
+    geometry.setIndex(new BufferAttribute(corners, 1));
+    return;
+  }
+  const order = Array.from({ length: faces }, (_, f) => f).sort((a, b) => materials.face[a] - materials.face[b] || a - b);
+  const index = new Uint32Array(corners.length);
+  order.forEach((f, k) => index.set(corners.subarray(f * 3, f * 3 + 3), k * 3));
+  geometry.setIndex(new BufferAttribute(index, 1));
+  let start = 0;
+  for (let k = 1; k <= faces; k++) {
+    if (k === faces || materials.face[order[k]] !== materials.face[order[start]]) {
+      geometry.addGroup(start * 3, (k - start) * 3, materials.face[order[start]]);
+      start = k;
+    }
+  }
 }

@@ -10,6 +10,7 @@
 use js_sys::{Array, Float64Array, Object, Reflect, Uint32Array};
 use meshcodec::codecs::{self, LevelMesh, Stop};
 use meshcodec::container::{Header, StreamReader};
+use meshcodec::mesh::attributes::Attributes;
 use wasm_bindgen::prelude::*;
 
 /// A library error as a JavaScript `Error` with its one-line message.
@@ -23,10 +24,49 @@ fn set(object: &Object, key: &str, value: impl Into<JsValue>) -> Result<(), JsEr
         .map_err(|_| JsError::new(&format!("cannot set {key}")))
 }
 
+/// A level's appearance as Hoppe's wedges, the library's own values: `corners` (Uint32Array, the
+/// wedge of each face corner, face by face), `wedgeVertex` (Uint32Array, each wedge's vertex),
+/// and where the stream carries them `normals` (Float64Array, x, y, z a wedge), `uvs` (u, v a
+/// wedge), `colours` (r, g, b, a in [0, 1] a wedge), `materials` ({`face`: Uint32Array of each
+/// face's material, `names`: an Array of strings}).
+fn appearance_object(a: &Attributes) -> Result<Object, JsError> {
+    let object = Object::new();
+    let corners: Vec<u32> = a.corners.iter().flatten().copied().collect();
+    set(&object, "corners", Uint32Array::from(corners.as_slice()))?;
+    set(
+        &object,
+        "wedgeVertex",
+        Uint32Array::from(a.wedge_vertex.as_slice()),
+    )?;
+    if let Some(normals) = &a.normals {
+        let flat: Vec<f64> = normals.iter().flat_map(|n| [n.x, n.y, n.z]).collect();
+        set(&object, "normals", Float64Array::from(flat.as_slice()))?;
+    }
+    if let Some(uvs) = &a.uvs {
+        let flat: Vec<f64> = uvs.iter().flat_map(|t| [t.x, t.y]).collect();
+        set(&object, "uvs", Float64Array::from(flat.as_slice()))?;
+    }
+    if let Some(colours) = &a.colours {
+        let flat: Vec<f64> = colours.iter().flatten().copied().collect();
+        set(&object, "colours", Float64Array::from(flat.as_slice()))?;
+    }
+    if let Some(materials) = &a.materials {
+        let m = Object::new();
+        set(&m, "face", Uint32Array::from(materials.face.as_slice()))?;
+        let names = Array::new();
+        for name in &materials.names {
+            names.push(&JsValue::from_str(name));
+        }
+        set(&m, "names", names)?;
+        set(&object, "materials", m)?;
+    }
+    Ok(object)
+}
+
 /// A decoded level as a plain object: `positions` (Float64Array of x, y, z), `indices`
 /// (Uint32Array of triangle corners), `level`, `levels`, `codec`, `vertices`, `triangles`,
-/// `meshVertices` (of the full mesh), `appearance` (whether the level carries normals, uvs,
-/// colours or materials).
+/// `meshVertices` (of the full mesh), and `appearance` where the level carries normals, uvs,
+/// colours or materials ([`appearance_object`]; `null` otherwise).
 fn level_object(
     mesh: &LevelMesh,
     level: usize,
@@ -54,7 +94,11 @@ fn level_object(
     set(&object, "vertices", mesh.mesh.positions.len() as u32)?;
     set(&object, "triangles", mesh.mesh.faces.len() as u32)?;
     set(&object, "meshVertices", header.vertices as f64)?;
-    set(&object, "appearance", mesh.attributes.is_some())?;
+    let appearance = match &mesh.attributes {
+        Some(a) if !a.is_empty() => appearance_object(a)?.into(),
+        _ => JsValue::NULL,
+    };
+    set(&object, "appearance", appearance)?;
     Ok(object)
 }
 

@@ -11,7 +11,7 @@ import { join } from "node:path";
 import { fileURLToPath } from "node:url";
 
 import init, { decode, info, levelEnds, ProgressiveDecoder } from "../pkg/meshcodec.js";
-import { assertSameBits, nativeLevel } from "./native.mjs";
+import { assertSameBits, nativeAppearance, nativeLevel } from "./native.mjs";
 
 const root = fileURLToPath(new URL("../../", import.meta.url));
 await init({ module_or_path: readFileSync(join(root, "web/pkg/meshcodec_bg.wasm")) });
@@ -53,6 +53,28 @@ for (const stream of streams) {
       }
       const full = decode(bytes);
       assert.equal(full.level, described.levels);
+      assert.equal(full.appearance !== null, described.appearance, `${name}: appearance`);
+      if (full.appearance) {
+        const a = full.appearance;
+        const theirs = nativeAppearance(stream, scratch);
+        assert.deepEqual(Array.from(a.corners), theirs.corners, `${name}: corner wedges`);
+        if (a.uvs) assertSameBits(a.uvs, Float64Array.from(theirs.uvs), `${name}: uvs`);
+        else assert.equal(theirs.uvs.length, 0);
+        if (a.normals) assertSameBits(a.normals, Float64Array.from(theirs.normals), `${name}: normals`);
+        else assert.equal(theirs.normals.length, 0);
+        if (a.materials) {
+          const names = Array.from(a.materials.face, (m) => a.materials.names[m]);
+          assert.deepEqual(names, theirs.faceMaterial, `${name}: materials`);
+        }
+        if (a.colours) {
+          for (let w = 0; w < a.wedgeVertex.length; w++) {
+            const rgb = Array.from(a.colours.subarray(w * 4, w * 4 + 3));
+            assert.deepEqual(rgb, theirs.colours[a.wedgeVertex[w]], `${name}: colour of wedge ${w}`);
+          }
+        }
+        // Each corner's wedge belongs to the corner's vertex.
+        for (let c = 0; c < a.corners.length; c++) assert.equal(a.wedgeVertex[a.corners[c]], full.indices[c]);
+      }
     } finally {
       rmSync(scratch, { recursive: true, force: true });
     }

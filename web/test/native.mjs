@@ -40,3 +40,32 @@ export function assertSameBits(actual, expected, what) {
   }
 }
 
+
+/** The native decoder's full level of `stream` with its appearance, from the OBJ it writes:
+ * each wedge's uv and normal (as written: Rust's shortest round-trip digits, so they parse back
+ * to the same doubles), each corner's wedge, each face's material name, each vertex's colour. */
+export function nativeAppearance(stream, scratch) {
+  const out = join(scratch, "full.obj");
+  execFileSync(native, ["decode", stream, out]);
+  const uvs = [];
+  const normals = [];
+  const colours = [];
+  const corners = [];
+  const faceMaterial = [];
+  let material = "";
+  for (const line of readFileSync(out, "latin1").split("\n")) {
+    const [tag, ...rest] = line.trim().split(/\s+/);
+    if (tag === "v" && rest.length === 6) colours.push(rest.slice(3).map(Number));
+    else if (tag === "vt") uvs.push(...rest.map(Number));
+    else if (tag === "vn") normals.push(...rest.map(Number));
+    else if (tag === "usemtl") material = rest.join(" ");
+    else if (tag === "f") {
+      for (const corner of rest) {
+        const wedge = corner.split("/")[1] || corner.split("/")[2];
+        corners.push(Number(wedge) - 1);
+      }
+      faceMaterial.push(material);
+    }
+  }
+  return { uvs, normals, colours, corners, faceMaterial };
+}

@@ -97,6 +97,29 @@ test("the viewer streams bunny's emc levels one by one and ends on the native de
   await page.close();
 });
 
+test("a stream with appearance is drawn with its uvs through the checker, a vertex a wedge", async () => {
+  const { page, problems } = await openViewer("../../tests/golden/v4/emc-spot-appearance.mc");
+  const state = await page.evaluate(() => window.viewer.state);
+  assert.equal(state.status, "done", state.error ?? "");
+  assert.ok(state.appearance.includes("uvs"), `appearance: ${state.appearance}`);
+  const drawn = await page.evaluate(() => {
+    const { geometry, material } = window.viewer.mesh;
+    const data = geometry.userData.meshcodec;
+    return {
+      vertices: geometry.getAttribute("position").count,
+      uvs: geometry.getAttribute("uv")?.count ?? 0,
+      wedges: data.appearance.wedgeVertex.length,
+      textured: [material].flat().every((m) => m.map !== null),
+    };
+  });
+  assert.equal(drawn.vertices, drawn.wedges);
+  assert.equal(drawn.uvs, drawn.wedges);
+  assert.ok(drawn.textured);
+  await page.screenshot({ path: join(scratch, "viewer-spot.png") });
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test("a cut stream ends in the viewer's error line", async () => {
   const { page, problems } = await openViewer("bunny-emc-cut.mc");
   const state = await page.evaluate(() => window.viewer.state);

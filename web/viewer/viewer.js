@@ -24,6 +24,44 @@ light.position.set(0.5, 0.8, 1);
 scene.add(camera);
 const material = new THREE.MeshStandardMaterial({ color: 0xc9c2b6, roughness: 0.75, flatShading: false });
 
+/** A checker texture, 16 squares a side of the uv square: shows the uvs, their seams and their
+ * stretch. */
+function checker() {
+  const canvas = document.createElement("canvas");
+  canvas.width = canvas.height = 512;
+  const context = canvas.getContext("2d");
+  for (let i = 0; i < 16; i++) {
+    for (let j = 0; j < 16; j++) {
+      context.fillStyle = (i + j) % 2 ? "#e9e4da" : "#5f6f86";
+      context.fillRect(i * 32, j * 32, 32, 32);
+    }
+  }
+  const texture = new THREE.CanvasTexture(canvas);
+  texture.colorSpace = THREE.SRGBColorSpace;
+  texture.wrapS = texture.wrapT = THREE.RepeatWrapping;
+  texture.anisotropy = 4;
+  return texture;
+}
+const checkerTexture = checker();
+
+/** The materials for a level: the checker through its uvs, its colours, one material a group
+ * (a hue each) where it has several. */
+function materialsFor(geometry, level) {
+  const appearance = level.appearance;
+  if (!appearance) return material;
+  const make = (hue) =>
+    new THREE.MeshStandardMaterial({
+      color: hue === undefined ? 0xffffff : new THREE.Color().setHSL(hue, 0.35, 0.75),
+      roughness: 0.75,
+      map: geometry.getAttribute("uv") ? checkerTexture : null,
+      vertexColors: Boolean(geometry.getAttribute("color")),
+      side: THREE.DoubleSide,
+    });
+  const names = level.materials;
+  if (names.length > 1) return names.map((_, i) => make(i / names.length));
+  return make();
+}
+
 const state = { status: "idle", level: 0, levels: 0, levelsSeen: [], received: 0, total: 0, faces: 0, vertices: 0, error: null, frames: 0 };
 window.viewer = { state, scene, camera, mesh: null };
 
@@ -53,13 +91,26 @@ function frame(geometry) {
 function showFigures() {
   const bytes = state.total ? `${state.received.toLocaleString()} of ${state.total.toLocaleString()} bytes` : `${state.received.toLocaleString()} bytes`;
   const rate = state.meshVertices ? ` · ${((state.received * 8) / state.meshVertices).toFixed(2)} bits a vertex` : "";
-  figures.textContent = `${bytes} · level ${state.level} of ${state.levels} · ${state.faces.toLocaleString()} faces${rate}`;
+  const carried = state.appearance?.length ? ` · ${state.appearance.join(", ")}` : "";
+  figures.textContent = `${bytes} · level ${state.level} of ${state.levels} · ${state.faces.toLocaleString()} faces${rate}${carried}`;
   fill.style.width = `${state.total ? (100 * state.received) / state.total : 0}%`;
 }
 
 function open(request, name) {
   source.textContent = name;
-  Object.assign(state, { status: "loading", level: 0, levels: 0, levelsSeen: [], received: 0, total: 0, faces: 0, vertices: 0, error: null });
+  Object.assign(state, {
+    status: "loading",
+    level: 0,
+    levels: 0,
+    levelsSeen: [],
+    received: 0,
+    total: 0,
+    faces: 0,
+    vertices: 0,
+    error: null,
+    appearance: [],
+    appearanceShown: false,
+  });
   errorLine.textContent = "";
   framed = false;
   if (mesh) {
@@ -81,6 +132,13 @@ function open(request, name) {
       codec: level.codec,
     });
     state.levelsSeen.push(level.level);
+    state.appearance = level.appearance
+      ? Object.keys(level.appearance).filter((k) => ["normals", "uvs", "colours", "materials"].includes(k))
+      : [];
+    if (level.appearance && !state.appearanceShown) {
+      mesh.material = materialsFor(geometry, level);
+      state.appearanceShown = true;
+    }
     if (!framed) {
       frame(geometry);
       framed = true;
