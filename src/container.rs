@@ -87,10 +87,10 @@ pub struct AppearanceSpec {
     /// them (`pm`), rather than in an appearance unit after the last.
     pub in_levels: bool,
     /// Whether the levels carry only which corners share a normal, each level's normals being
-    /// derived from its positions (docs/FORMAT.md §5.2; with normals and `in_levels` only).
+    /// derived from its positions (docs/FORMAT.md §6.3; with normals and `in_levels` only).
     pub derived_normals: bool,
     /// Whether the levels' new normals are predicted from the geometry of their vertex's faces
-    /// (docs/FORMAT.md §6.1; with normals coded in the levels only).
+    /// (docs/FORMAT.md §6.3; with normals coded in the levels only).
     pub geometric_normals: bool,
 }
 

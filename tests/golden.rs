@@ -309,7 +309,7 @@ fn the_golden_stream_with_appearance_in_pm_splits_is_reproduced_and_decodes_exac
     );
 }
 
-/// Normals in pm's splits, both ways (docs/FORMAT.md §6.1): predicted from the geometry of
+/// Normals in pm's splits, both ways (docs/FORMAT.md §6.3): predicted from the geometry of
 /// their vertex's faces (flag 64) on vw-beetle.obj, a mesh pm cuts to a manifold; and derived
 /// from the positions over their groups (flag 32) on spot with creased normals.
 #[test]

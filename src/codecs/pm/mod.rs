@@ -38,7 +38,7 @@
 //! the full level is lossless. Appearance (wedges: normals, texture coordinates, colours; face
 //! materials) travels in an appearance unit after the last level, as for every codec, or, with
 //! [`AttributeFit`] (`--attributes fit|keep`), inside the splits so that every level carries it
-//! ([`wedges`], docs/FORMAT.md §6.1): Hoppe's `corners` / wedge-delta / `matid` fields as
+//! ([`wedges`], docs/FORMAT.md §6.3): Hoppe's `corners` / wedge-delta / `matid` fields as
 //! candidate choices and predicted residuals, the simplifier keeping seams
 //! ([`simplify::Constraints::seams`]) and the encoder valuing collapsed wedges by the rule
 //! ([`wedge_levels`]).

@@ -1,6 +1,6 @@
 //! The wedges of a progressive mesh, level by level: the base mesh's corners, and what each
 //! vertex split changes (Hoppe 1998 §3's `corners`, wedge deltas and `matid` fields, with our
-//! predictions), written once for both directions over [`Symbols`] (docs/FORMAT.md §5.2).
+//! predictions), written once for both directions over [`Symbols`] (docs/FORMAT.md §6.3).
 //!
 //! Every mesh of the sequence carries a value (a [`CornerCode`]) at every face corner; wedges
 //! are the distinct values at a vertex, as in the canonical mesh. A split of vs changes only the
