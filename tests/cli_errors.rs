@@ -643,3 +643,46 @@ fn a_format_that_cannot_hold_the_appearance_is_refused_naming_those_that_can() {
     let mesh = meshcodec::mesh::io::read_attributed(&d.join("t.obj")).unwrap();
     assert!(mesh.attributes.materials.is_some());
 }
+
+#[test]
+fn render_draws_a_mesh_or_a_stream_and_refuses_bad_cameras() {
+    let dir = scratch();
+    let d = dir.path();
+    let camera = [
+        "--eye",
+        "0,0.1,0.4",
+        "--target",
+        "0,0.1,0",
+        "--size",
+        "64x48",
+    ];
+    let ok = |args: &[&str]| {
+        let out = run(MESHCODEC, args, d);
+        assert_eq!(out.code, Some(0), "{args:?}: {}", out.stderr);
+    };
+    ok(&[&["render", "bunny-res4", "mesh.png"][..], &camera].concat());
+    ok(&["encode", "bunny-res4", "b.mc"]);
+    ok(&[
+        &["render", "b.mc", "level.png", "--level", "3"][..],
+        &camera,
+    ]
+    .concat());
+    for png in ["mesh.png", "level.png"] {
+        let bytes = std::fs::read(d.join(png)).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG"), "{png}");
+    }
+    let out = run(
+        MESHCODEC,
+        &[&["render", "b.mc", "x.png", "--fov", "0"][..], &camera].concat(),
+        d,
+    );
+    assert_clean_failure(&out, "--fov 0");
+    write(d, "junk.mc", b"MshC\x02\x04 not a stream");
+    let out = run(
+        MESHCODEC,
+        &[&["render", "junk.mc", "x.png"][..], &camera].concat(),
+        d,
+    );
+    assert_clean_failure(&out, "junk.mc");
+    assert!(!d.join("x.png").exists());
+}

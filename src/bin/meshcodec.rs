@@ -139,6 +139,32 @@ enum Command {
         #[arg(long)]
         allow_fold_overs: bool,
     },
+    /// Render a mesh file, or a stream's full level (or `--level`), flat-shaded from a camera
+    /// into a PNG: the project's own rasterizer, which the browser viewer's test compares with.
+    Render {
+        /// Mesh file or name, or a stream (.mc).
+        input: String,
+        /// PNG to write.
+        output: PathBuf,
+        /// Eye position, x,y,z (the mesh's units).
+        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
+        eye: glam::DVec3,
+        /// Point looked at, x,y,z.
+        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
+        target: glam::DVec3,
+        /// Up direction, x,y,z.
+        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true, default_value = "0,1,0")]
+        up: glam::DVec3,
+        /// Vertical field of view, degrees.
+        #[arg(long, default_value_t = 50.0)]
+        fov: f64,
+        /// Picture, WIDTHxHEIGHT pixels.
+        #[arg(long, value_parser = meshcodec::cli::parse_size, default_value = "1280x720")]
+        size: (u32, u32),
+        /// A stream's level to draw (default: its last).
+        #[arg(long)]
+        level: Option<usize>,
+    },
     /// Convert a mesh file to another format (.ply, .obj, .glb or .gltf), keeping its normals,
     /// texture coordinates, colours and materials where the output format holds them.
     Convert {
@@ -269,6 +295,27 @@ fn main() -> ExitCode {
             output,
             drop_attributes,
         } => convert(&input, &output, drop_attributes),
+        Command::Render {
+            input,
+            output,
+            eye,
+            target,
+            up,
+            fov,
+            size,
+            level,
+        } => render(
+            &input,
+            &output,
+            &meshcodec::render::Perspective {
+                eye,
+                target,
+                up,
+                fov_degrees: fov,
+            },
+            size,
+            level,
+        ),
         Command::Distance {
             a,
             b,
@@ -290,6 +337,44 @@ fn main() -> ExitCode {
         ),
     };
     meshcodec::cli::exit_code(outcome)
+}
+
+fn render(
+    input: &str,
+    output: &Path,
+    camera: &meshcodec::render::Perspective,
+    (width, height): (u32, u32),
+    level: Option<usize>,
+) -> Result<()> {
+    if !(camera.fov_degrees > 0.0 && camera.fov_degrees < 180.0) {
+        anyhow::bail!(
+            "--fov {}: a field of view is between 0 and 180 degrees",
+            camera.fov_degrees
+        );
+    }
+    let mesh = if input.ends_with(".mc") {
+        let stream = read_stream(Path::new(input))?;
+        let stop = level.map_or(Stop::All, Stop::Levels);
+        codecs::decode(&stream, stop)
+            .with_context(|| input.to_string())?
+            .0
+            .mesh
+    } else {
+        if level.is_some() {
+            anyhow::bail!("{input}: --level is for a stream (.mc)");
+        }
+        let path = resolve(input).with_context(|| input.to_string())?;
+        read_mesh(&path).with_context(|| path.display().to_string())?
+    };
+    // save_png names the file in its errors.
+    meshcodec::render::render_perspective(&mesh, camera, width, height).save_png(output)?;
+    meshcodec::outln!(
+        "wrote {}: {} faces from {}",
+        output.display(),
+        mesh.face_count(),
+        input
+    );
+    Ok(())
 }
 
 fn convert(input: &str, output: &Path, drop_attributes: bool) -> Result<()> {

@@ -97,6 +97,66 @@ test("the viewer streams bunny's emc levels one by one and ends on the native de
   await page.close();
 });
 
+test("the viewer draws the outline the project's rasterizer draws from the same camera", async (t) => {
+  const stream = join(scratch, "bunny-emc.mc");
+  const { positions } = nativeLevel(stream, 12, scratch);
+  const low = [Infinity, Infinity, Infinity];
+  const high = [-Infinity, -Infinity, -Infinity];
+  positions.forEach((x, i) => {
+    low[i % 3] = Math.min(low[i % 3], x);
+    high[i % 3] = Math.max(high[i % 3], x);
+  });
+  const target = low.map((l, k) => (l + high[k]) / 2);
+  const diagonal = Math.hypot(...high.map((h, k) => h - low[k]));
+  const eye = [target[0] + 0.4 * diagonal, target[1] + 0.3 * diagonal, target[2] + 1.4 * diagonal];
+  const camera = ["--eye", eye.join(","), "--target", target.join(","), "--fov", "40", "--size", "800x600"];
+  execFileSync(native, ["render", stream, join(scratch, "reference.png"), ...camera]);
+  const { page, problems } = await openViewer(`bunny-emc.mc&eye=${eye.join(",")}&target=${target.join(",")}&fov=40`);
+  const frames = await page.evaluate(() => window.viewer.state.frames);
+  await page.waitForFunction((n) => window.viewer.state.frames > n + 2, frames);
+  const masks = await page.evaluate(async () => {
+    const image = new Image();
+    image.src = "/target/web-test/reference.png";
+    await image.decode();
+    const canvas = document.createElement("canvas");
+    canvas.width = image.width;
+    canvas.height = image.height;
+    const context = canvas.getContext("2d");
+    context.drawImage(image, 0, 0);
+    const reference = context.getImageData(0, 0, image.width, image.height).data;
+    const gl = document.getElementById("view").getContext("webgl2");
+    const [w, h] = [gl.drawingBufferWidth, gl.drawingBufferHeight];
+    const drawn = new Uint8Array(w * h * 4);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, drawn);
+    let both = 0;
+    let either = 0;
+    let ours = 0;
+    let theirs = 0;
+    for (let y = 0; y < h; y++) {
+      for (let x = 0; x < w; x++) {
+        const r = (y * w + x) * 4;
+        // The rasterizer's background is white; the viewer's #1d2127, its rows bottom-up.
+        const inReference = reference[r] + reference[r + 1] + reference[r + 2] < 3 * 250;
+        const d = ((h - 1 - y) * w + x) * 4;
+        const inViewer = Math.abs(drawn[d] - 0x1d) + Math.abs(drawn[d + 1] - 0x21) + Math.abs(drawn[d + 2] - 0x27) > 24;
+        both += inReference && inViewer;
+        either += inReference || inViewer;
+        ours += inViewer;
+        theirs += inReference;
+      }
+    }
+    return { size: [w, h, image.width, image.height], both, either, ours, theirs };
+  });
+  assert.deepEqual(masks.size, [800, 600, 800, 600]);
+  const overlap = masks.both / masks.either;
+  assert.ok(masks.theirs > 0.05 * 800 * 600, `the reference covers ${masks.theirs} pixels`);
+  t.diagnostic(`outlines overlap ${overlap.toFixed(4)} (viewer ${masks.ours}, rasterizer ${masks.theirs} pixels)`);
+  await page.screenshot({ path: join(scratch, "viewer-camera.png") });
+  assert.ok(overlap > 0.97, `outlines overlap ${overlap.toFixed(4)} (viewer ${masks.ours}, rasterizer ${masks.theirs} pixels)`);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
 test("a stream with appearance is drawn with its uvs through the checker, a vertex a wedge", async () => {
   const { page, problems } = await openViewer("../../tests/golden/v4/emc-spot-appearance.mc");
   const state = await page.evaluate(() => window.viewer.state);

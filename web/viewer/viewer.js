@@ -76,6 +76,32 @@ function resize() {
   camera.updateProjectionMatrix();
 }
 
+/** The camera the address asks for (`eye`, `target`, `up` as x,y,z; `fov` in degrees), if any:
+ * the view `meshcodec render` draws with the same numbers. */
+function cameraFromAddress(params) {
+  const vector = (name) => {
+    const parts = params.get(name)?.split(",").map(Number);
+    return parts?.length === 3 && parts.every(Number.isFinite) ? new THREE.Vector3(...parts) : null;
+  };
+  const eye = vector("eye");
+  const target = vector("target");
+  if (!eye || !target) return null;
+  return { eye, target, up: vector("up") ?? new THREE.Vector3(0, 1, 0), fov: Number(params.get("fov")) || 50 };
+}
+
+function placeCamera({ eye, target, up, fov }) {
+  const distance = eye.distanceTo(target);
+  camera.fov = fov;
+  camera.up.copy(up);
+  camera.position.copy(eye);
+  camera.near = distance / 1000;
+  camera.far = distance * 100;
+  camera.lookAt(target);
+  camera.updateProjectionMatrix();
+  controls.target.copy(target);
+  controls.update();
+}
+
 /** Looks at the whole mesh from the front, a little above, once its first level is in. */
 function frame(geometry) {
   const { center, radius } = geometry.boundingSphere;
@@ -140,7 +166,8 @@ function open(request, name) {
       state.appearanceShown = true;
     }
     if (!framed) {
-      frame(geometry);
+      if (fixedCamera) placeCamera(fixedCamera);
+      else frame(geometry);
       framed = true;
     }
     showFigures();
@@ -183,5 +210,7 @@ renderer.setAnimationLoop(() => {
   state.frames++;
 });
 
-const src = new URLSearchParams(location.search).get("src");
+const params = new URLSearchParams(location.search);
+const fixedCamera = cameraFromAddress(params);
+const src = params.get("src");
 if (src) open({ url: src }, src);
