@@ -7,6 +7,11 @@
 //! | codec | what it is | when to use it |
 //! |---|---|---|
 //! | `raw` | the uncompressed indexed face set, 3·Q bits a vertex | the baseline row of every table |
+//! | `emc` | Magnor & Girod's embedded mesh coding, context-modelled: octree splits of positions and connectivity together, any topology, lossless | the smallest progressive stream; levels as the bytes arrive |
+//! | `emc-paper` | the same as published (Table 1) | reproducing the paper |
+//! | `pm`, `pm-reordered` | Hoppe's progressive meshes: QEM collapses, coded vertex splits, wedges in the splits | intermediate levels of the best quality for their bits |
+//! | `came` | Grabner's compressed vertex hierarchy, context-modelled and lossless, meta-nodes read on demand | view-dependent refinement ([`codecs::came::refine`]) |
+//! | `came-paper` | the same as published (lossy) | reproducing the paper |
 //!
 //! Layers (see ARCHITECTURE.md): [`mesh`] knows no bits, [`coding`] knows no meshes, [`codecs`]
 //! joins them through the stream [`container`]. With the default `lab` feature, `metrics`,

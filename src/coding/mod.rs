@@ -1,5 +1,7 @@
 //! Bits without meshes: a bit ledger that classes every syntax element as connectivity or
-//! geometry, bit-level writers and readers over it, and LEB128 variable-length integers.
+//! geometry, bit-level writers and readers over it (`bits`), adaptive binary arithmetic coding
+//! (`arith`), canonical Huffman codes (`huffman`) and LEB128 variable-length integers
+//! (`varint`).
 
 pub mod arith;
 pub mod bits;
