@@ -103,21 +103,8 @@ enum Command {
         input: PathBuf,
         /// Mesh file to write (.ply or .obj).
         output: PathBuf,
-        /// Eye position, x,y,z (the mesh's units).
-        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
-        eye: glam::DVec3,
-        /// Point looked at, x,y,z.
-        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
-        target: glam::DVec3,
-        /// Up direction, x,y,z.
-        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true, default_value = "0,1,0")]
-        up: glam::DVec3,
-        /// Vertical field of view, degrees.
-        #[arg(long, default_value_t = 50.0)]
-        fov: f64,
-        /// Viewport, WIDTHxHEIGHT pixels.
-        #[arg(long, value_parser = meshcodec::cli::parse_size, default_value = "1280x720")]
-        size: (u32, u32),
+        #[command(flatten)]
+        camera: CameraArgs,
         /// Screen-space tolerance, pixels: nodes are refined while their error sphere spans
         /// this many pixels or more.
         #[arg(long, default_value_t = 1.0)]
@@ -146,21 +133,8 @@ enum Command {
         input: String,
         /// PNG to write.
         output: PathBuf,
-        /// Eye position, x,y,z (the mesh's units).
-        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
-        eye: glam::DVec3,
-        /// Point looked at, x,y,z.
-        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
-        target: glam::DVec3,
-        /// Up direction, x,y,z.
-        #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true, default_value = "0,1,0")]
-        up: glam::DVec3,
-        /// Vertical field of view, degrees.
-        #[arg(long, default_value_t = 50.0)]
-        fov: f64,
-        /// Picture, WIDTHxHEIGHT pixels.
-        #[arg(long, value_parser = meshcodec::cli::parse_size, default_value = "1280x720")]
-        size: (u32, u32),
+        #[command(flatten)]
+        camera: CameraArgs,
         /// A stream's level to draw (default: its last).
         #[arg(long)]
         level: Option<usize>,
@@ -201,6 +175,50 @@ enum Command {
         #[arg(long)]
         write_samples: Option<PathBuf>,
     },
+}
+
+/// A camera on the command line (`view`, `render`).
+#[derive(clap::Args)]
+struct CameraArgs {
+    /// Eye position, x,y,z (the mesh's units).
+    #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
+    eye: glam::DVec3,
+    /// Point looked at, x,y,z.
+    #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true)]
+    target: glam::DVec3,
+    /// Up direction, x,y,z.
+    #[arg(long, value_parser = meshcodec::cli::parse_vector, allow_hyphen_values = true, default_value = "0,1,0")]
+    up: glam::DVec3,
+    /// Vertical field of view, degrees.
+    #[arg(long, default_value_t = 50.0)]
+    fov: f64,
+    /// Viewport, WIDTHxHEIGHT pixels.
+    #[arg(long, value_parser = meshcodec::cli::parse_size, default_value = "1280x720")]
+    size: (u32, u32),
+}
+
+impl CameraArgs {
+    /// The camera as the view-dependent front takes it.
+    fn view_camera(&self) -> meshcodec::codecs::came::refine::Camera {
+        meshcodec::codecs::came::refine::Camera {
+            eye: self.eye,
+            target: self.target,
+            up: self.up,
+            fov_degrees: self.fov,
+            width: self.size.0,
+            height: self.size.1,
+        }
+    }
+
+    /// The camera as the rasterizer takes it.
+    fn perspective(&self) -> meshcodec::render::Perspective {
+        meshcodec::render::Perspective {
+            eye: self.eye,
+            target: self.target,
+            up: self.up,
+            fov_degrees: self.fov,
+        }
+    }
 }
 
 /// The codec `encode` uses when given none.
@@ -256,25 +274,14 @@ fn main() -> ExitCode {
         Command::View {
             input,
             output,
-            eye,
-            target,
-            up,
-            fov,
-            size,
+            camera,
             tolerance,
             faces,
             png,
             two_sided,
             allow_fold_overs,
         } => {
-            let camera = meshcodec::codecs::came::refine::Camera {
-                eye,
-                target,
-                up,
-                fov_degrees: fov,
-                width: size.0,
-                height: size.1,
-            };
+            let camera = camera.view_camera();
             let chosen = meshcodec::codecs::came::refine::View::new(&camera, tolerance)
                 .map(|v| v.two_sided(two_sided).keep_orientation(!allow_fold_overs));
             match chosen {
@@ -298,24 +305,9 @@ fn main() -> ExitCode {
         Command::Render {
             input,
             output,
-            eye,
-            target,
-            up,
-            fov,
-            size,
+            camera,
             level,
-        } => render(
-            &input,
-            &output,
-            &meshcodec::render::Perspective {
-                eye,
-                target,
-                up,
-                fov_degrees: fov,
-            },
-            size,
-            level,
-        ),
+        } => render(&input, &output, &camera.perspective(), camera.size, level),
         Command::Distance {
             a,
             b,
