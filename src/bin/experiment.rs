@@ -634,36 +634,35 @@ fn tables(results: &Path, out: &Path) -> Result<()> {
 }
 
 fn came_extras(out: &Path) -> Result<()> {
-    let progress = Progress::on_terminal();
-    progress.step("came-extras: reading");
-    let path = meshcodec::came_extras::run(out, &mut logged(&progress))?;
-    progress.finish();
-    meshcodec::outln!("wrote {}", path.display());
-    Ok(())
-}
-
-/// A log callback for a long experiment: each line printed, and a spinner timing what follows
-/// it on a terminal.
-fn logged(progress: &Progress) -> impl FnMut(String) + '_ {
-    move |line| {
-        progress.println(&line);
-        progress.step(format!("after: {line}"));
-    }
+    logged("came-extras: reading", |log| {
+        meshcodec::came_extras::run(out, log)
+    })
 }
 
 fn emc_scale(out: &Path) -> Result<()> {
-    let progress = Progress::on_terminal();
-    progress.step("emc-scale: reading and subdividing");
-    let path = meshcodec::emc_scale::run(out, &mut logged(&progress))?;
-    progress.finish();
-    meshcodec::outln!("wrote {}", path.display());
-    Ok(())
+    logged("emc-scale: reading and subdividing", |log| {
+        meshcodec::emc_scale::run(out, log)
+    })
 }
 
 fn came_fly(out: &Path) -> Result<()> {
+    logged("came-fly: reading and encoding", |log| {
+        meshcodec::came_flythrough::run(out, log)
+    })
+}
+
+/// Runs a long experiment that logs its steps: each line printed, a spinner on a terminal
+/// timing what follows it (`first` until the first line), and the file it wrote said at the end.
+fn logged(
+    first: &str,
+    run: impl FnOnce(&mut dyn FnMut(String)) -> meshcodec::Result<PathBuf>,
+) -> Result<()> {
     let progress = Progress::on_terminal();
-    progress.step("came-fly: reading and encoding");
-    let path = meshcodec::came_flythrough::run(out, &mut logged(&progress))?;
+    progress.step(first);
+    let path = run(&mut |line| {
+        progress.println(&line);
+        progress.step(format!("after: {line}"));
+    })?;
     progress.finish();
     meshcodec::outln!("wrote {}", path.display());
     Ok(())

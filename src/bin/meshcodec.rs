@@ -281,9 +281,9 @@ fn main() -> ExitCode {
             two_sided,
             allow_fold_overs,
         } => {
-            let camera = camera.view_camera();
-            let chosen = meshcodec::codecs::came::refine::View::new(&camera, tolerance)
-                .map(|v| v.two_sided(two_sided).keep_orientation(!allow_fold_overs));
+            let chosen =
+                meshcodec::codecs::came::refine::View::new(&camera.view_camera(), tolerance)
+                    .map(|v| v.two_sided(two_sided).keep_orientation(!allow_fold_overs));
             match chosen {
                 Ok(chosen) => view(
                     &input,
@@ -577,7 +577,7 @@ fn decode(
 fn view(
     input: &Path,
     output: &Path,
-    camera: &meshcodec::codecs::came::refine::Camera,
+    camera: &CameraArgs,
     view: &meshcodec::codecs::came::refine::View,
     tolerance: f64,
     faces: Option<usize>,
@@ -642,13 +642,8 @@ fn view(
         eprintln!("warning: meta-node {unit} refused, its branch stays coarse: {why}");
     }
     if let Some(png) = png {
-        let perspective = meshcodec::render::Perspective {
-            eye: camera.eye,
-            target: camera.target,
-            up: camera.up,
-            fov_degrees: camera.fov_degrees,
-        };
-        meshcodec::render::render_perspective(&mesh, &perspective, camera.width, camera.height)
+        let (width, height) = camera.size;
+        meshcodec::render::render_perspective(&mesh, &camera.perspective(), width, height)
             .save_png(png)?;
         meshcodec::outln!("wrote {}", png.display());
     }
