@@ -62,6 +62,8 @@ pub mod render;
 #[cfg(feature = "lab")]
 pub mod results;
 #[cfg(feature = "lab")]
+pub mod screen_error;
+#[cfg(feature = "lab")]
 pub mod sweep;
 #[cfg(feature = "lab")]
 pub mod tables;

@@ -208,6 +208,52 @@ fn came_streams_without_normal_cones_still_decode_and_refine() {
     assert!(new_faces < two_sided, "{new_faces} of {two_sided}");
 }
 
+/// `came` streams written before deviations (5 bytes of parameters) still decode exactly, and
+/// refine by their spheres, the paper's test: `came-eight-before-deviations.mc` is the golden
+/// stream of that build, kept. The deviations leave a view's front coarser.
+#[test]
+fn came_streams_without_deviations_still_decode_and_refine_by_their_spheres() {
+    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    let old = std::fs::read(golden_dir().join("came-eight-before-deviations.mc")).unwrap();
+    let codec = codecs::by_name("came").unwrap();
+    let [(_, eight)] = read_all(["eight"]);
+    let canonical = canonical(codec, &eight);
+    let (decoded, _) = codecs::decode(&old, Stop::All).unwrap();
+    canonical.check_lossless(&decoded.mesh).unwrap();
+    let new = codec.encode(&canonical).unwrap().bytes;
+    let params = |bytes: &[u8]| {
+        meshcodec::container::StreamReader::open(bytes)
+            .unwrap()
+            .header()
+            .params
+            .len()
+    };
+    assert_eq!((params(&old), params(&new)), (5, 6));
+    let camera = Camera {
+        eye: glam::DVec3::new(0.0, 0.0, 25.0),
+        target: glam::DVec3::ZERO,
+        up: glam::DVec3::Y,
+        fov_degrees: 40.0,
+        width: 640,
+        height: 480,
+    };
+    let view = View::new(&camera, 1.0)
+        .unwrap()
+        .two_sided(true)
+        .keep_orientation(false);
+    let faces = |bytes: &[u8]| {
+        let mut front = ViewMesh::from_stream(bytes).unwrap();
+        front.settle(&view, Budget::UNLIMITED, 64);
+        front.check_invariants().unwrap();
+        front.face_count()
+    };
+    let (old_faces, new_faces) = (faces(&old), faces(&new));
+    assert!(
+        new_faces * 3 < old_faces * 2,
+        "{new_faces} against {old_faces}"
+    );
+}
+
 #[test]
 fn streams_of_another_format_version_are_refused_in_one_line() {
     let codec = codecs::by_name("raw").unwrap();

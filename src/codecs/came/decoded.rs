@@ -28,6 +28,9 @@ pub struct Node {
     pub position: [f64; 3],
     /// Its error sphere's radius (grid units).
     pub radius: f64,
+    /// Its deviation (grid units, `hierarchy::came::deviation`): the error refinement
+    /// projects; the sphere's radius in streams without deviations.
+    pub deviation: f32,
     /// Its normal cone as coded ([`CodedCone::NONE`] where the stream has none).
     pub cone: CodedCone,
     /// Root of the unit that decoded the split creating it.
@@ -126,7 +129,7 @@ impl DecodedTree {
     }
 
     /// Adds the root (an inner node: the meshes CAME codes have triangles).
-    pub fn add_root(&mut self, position: [f64; 3], radius: f64, cone: CodedCone) {
+    pub fn add_root(&mut self, position: [f64; 3], radius: f64, deviation: f32, cone: CodedCone) {
         self.nodes.push(Node {
             id: NodeId::ROOT,
             leaf: false,
@@ -134,6 +137,7 @@ impl DecodedTree {
             parent: u32::MAX,
             position,
             radius,
+            deviation,
             cone,
             created_unit: NodeId::ROOT,
             split_unit: None,
@@ -152,15 +156,15 @@ impl DecodedTree {
         status(n.leaf, n.split_unit, n.created_unit, unit)
     }
 
-    /// Splits node `s` into children with the given leaf flags, positions, radii and cones,
-    /// decoded by the unit rooted at `unit`.
+    /// Splits node `s` into children with the given leaf flags, positions, (radius,
+    /// deviation) pairs and cones, decoded by the unit rooted at `unit`.
     #[allow(clippy::too_many_arguments)]
     pub fn split(
         &mut self,
         s: u32,
         leaf: [bool; 2],
         positions: [[f64; 3]; 2],
-        radii: [f64; 2],
+        spheres: [(f64, f32); 2],
         cones: [CodedCone; 2],
         unit: NodeId,
         at: usize,
@@ -191,7 +195,8 @@ impl DecodedTree {
                 children: None,
                 parent: s,
                 position: positions[side],
-                radius: radii[side],
+                radius: spheres[side].0,
+                deviation: spheres[side].1,
                 cone: cones[side],
                 created_unit: unit,
                 split_unit: None,

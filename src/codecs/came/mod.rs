@@ -124,10 +124,14 @@ pub struct Params {
     pub radius_bits: u8,
     /// Bits a coordinate of a normal cone's axis (0: the stream codes no cones).
     pub cone_bits: u8,
+    /// Bits of a deviation code (0: the stream codes no deviations, and refinement projects
+    /// the spheres).
+    pub deviation_bits: u8,
 }
 
 impl Params {
-    /// The header bytes: four, and a fifth with the cones' bits when there are cones.
+    /// The header bytes: four, a fifth with the cones' bits when there are cones or
+    /// deviations, and a sixth with the deviations' bits when there are deviations.
     pub fn to_bytes(self) -> Vec<u8> {
         let mut bytes = vec![
             self.meta_levels,
@@ -135,8 +139,11 @@ impl Params {
             self.component_bits,
             self.radius_bits,
         ];
-        if self.cone_bits > 0 {
+        if self.cone_bits > 0 || self.deviation_bits > 0 {
             bytes.push(self.cone_bits);
+        }
+        if self.deviation_bits > 0 {
+            bytes.push(self.deviation_bits);
         }
         bytes
     }
@@ -144,10 +151,15 @@ impl Params {
     /// Parameters from header bytes; `components`: the range bits per component may take.
     pub fn from_bytes(bytes: &[u8], components: std::ops::RangeInclusive<u8>) -> Result<Params> {
         let bad = |what: &str| Error::malformed(0, 0, format!("CAME parameters: {what}"));
-        let cone_bits = match bytes.len() {
-            4 => 0,
-            5 if bytes[4] > 0 => bytes[4],
-            _ => return Err(bad("4 bytes, or 5 with normal cones, expected")),
+        let (cone_bits, deviation_bits) = match bytes.len() {
+            4 => (0, 0),
+            5 if bytes[4] > 0 => (bytes[4], 0),
+            6 if bytes[5] > 0 => (bytes[4], bytes[5]),
+            _ => {
+                return Err(bad(
+                    "4 bytes, 5 with normal cones or 6 with deviations expected",
+                ))
+            }
         };
         let [meta_levels, depth, component_bits, radius_bits] =
             [bytes[0], bytes[1], bytes[2], bytes[3]];
@@ -169,6 +181,7 @@ impl Params {
             component_bits,
             radius_bits,
             cone_bits,
+            deviation_bits,
         })
     }
 }
@@ -280,6 +293,8 @@ pub struct Layout {
     pub radius_bits: u8,
     /// Bits a coordinate of a normal cone's axis (0: no cones).
     pub cone_bits: u8,
+    /// Bits of a deviation code (0: no deviations).
+    pub deviation_bits: u8,
 }
 
 /// Encodes `mesh` as a CAME stream: builds the hierarchy, partitions it into meta-nodes, has
@@ -300,6 +315,7 @@ pub fn encode_stream(
         component_bits: layout.component_bits,
         radius_bits: layout.radius_bits,
         cone_bits: layout.cone_bits,
+        deviation_bits: layout.deviation_bits,
     };
     let mut fields = std::collections::BTreeMap::<&'static str, f64>::new();
     let units: Vec<(Vec<u8>, LevelCost)> = code_units(&tree, &part)

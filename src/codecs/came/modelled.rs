@@ -18,6 +18,9 @@ use crate::coding::SyntaxClass;
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self, coded_cones, CodedCone, ANGLE_BITS, NO_CONE};
+use crate::hierarchy::came::deviation::{
+    decoded_deviation, deviation_code, deviations, round_up, DEVIATION_BITS,
+};
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
 use crate::hierarchy::came::{NodeId, VertexTree};
 use crate::mesh::attribute_quantization::octahedral_max;
@@ -51,6 +54,9 @@ struct Contexts {
     /// classes, and each is 3 KB of contexts to set up.
     coordinate: Vec<Option<Box<[IntContext; 3]>>>,
     ratio: [Vec<BitContext>; 2],
+    /// One tree for both children (two by side, or by the left child's code, cost more:
+    /// units are too small to learn them).
+    deviation: Vec<BitContext>,
     triangles: [UintContext; 4],
     up: UintContext,
     towards: [BitContext; 4],
@@ -78,6 +84,7 @@ impl Contexts {
                 vec![BitContext::default(); 1 << RADIUS_BITS],
                 vec![BitContext::default(); 1 << RADIUS_BITS],
             ],
+            deviation: vec![BitContext::default(); 1 << DEVIATION_BITS],
             triangles: Default::default(),
             up: UintContext::default(),
             towards: [BitContext::default(); 4],
@@ -189,6 +196,7 @@ impl Codec for Came {
             component_bits: 0,
             radius_bits: RADIUS_BITS,
             cone_bits: cones::AXIS_BITS,
+            deviation_bits: DEVIATION_BITS,
         };
         encode_stream(mesh, layout, |tree, part| {
             let encoder = Encoder::new(tree, mesh, part);
@@ -216,6 +224,13 @@ pub fn params(header: &Header) -> Result<Params> {
             "came streams use 4-bit radius ratios",
         ));
     }
+    if ![0, DEVIATION_BITS].contains(&params.deviation_bits) {
+        return Err(Error::malformed(
+            0,
+            0,
+            format!("came streams code deviations on {DEVIATION_BITS} bits"),
+        ));
+    }
     if ![0, cones::AXIS_BITS].contains(&params.cone_bits) {
         return Err(Error::malformed(
             0,
@@ -239,6 +254,9 @@ struct Encoder<'a> {
     /// The decoder's (rounded-up) sphere radii, and each inner non-root node's ratio code.
     radii: Vec<f64>,
     ratio_codes: Vec<u32>,
+    /// The decoder's (rounded-up) deviations, and each inner non-root node's deviation code.
+    deviations: Vec<f32>,
+    deviation_codes: Vec<u32>,
     /// Each node's normal cone as coded.
     cones: Vec<CodedCone>,
     born: Vec<Vec<BornTriangle>>,
@@ -270,6 +288,21 @@ impl<'a> Encoder<'a> {
                 }
             }
         }
+        let measured = deviations(tree, &leaf, &mesh.faces, &positions);
+        let mut deviations = vec![0.0f32; tree.node_count()];
+        let mut deviation_codes = vec![0; tree.node_count()];
+        deviations[tree.root as usize] = round_up(measured[tree.root as usize].ceil());
+        for s in tree.breadth_first() {
+            let [t, u] = tree.children_of(s).expect("inner");
+            for c in [t, u] {
+                if (c as usize) >= n {
+                    let parent = deviations[s as usize];
+                    let code = deviation_code(measured[c as usize], parent);
+                    deviations[c as usize] = decoded_deviation(code, parent);
+                    deviation_codes[c as usize] = code;
+                }
+            }
+        }
         let cones = coded_cones(tree, &mesh.cells, &mesh.faces, mesh.grid.cell);
         Encoder {
             tree,
@@ -278,6 +311,8 @@ impl<'a> Encoder<'a> {
             positions,
             radii,
             ratio_codes,
+            deviations,
+            deviation_codes,
             cones,
             born: born_triangles(tree, mesh),
         }
@@ -310,6 +345,8 @@ impl<'a> Encoder<'a> {
             }
             let r = self.radii[tree.root as usize] as u64;
             enc.uint(&mut UintContext::default(), r, G, "spheres");
+            let e = self.deviations[tree.root as usize] as u64;
+            enc.uint(&mut UintContext::default(), e, G, "deviations");
             let cone = self.cones[tree.root as usize];
             put_cone(&mut enc, &mut ctx, CodedCone::NONE, cone);
         }
@@ -335,6 +372,7 @@ impl<'a> Encoder<'a> {
                 if tree.is_leaf(c) {
                     continue;
                 }
+                let deviation = self.deviation_codes[c as usize];
                 put_symbol(
                     &mut enc,
                     &mut ctx.ratio[side],
@@ -342,6 +380,14 @@ impl<'a> Encoder<'a> {
                     RADIUS_BITS,
                     G,
                     "spheres",
+                );
+                put_symbol(
+                    &mut enc,
+                    &mut ctx.deviation,
+                    deviation,
+                    DEVIATION_BITS,
+                    G,
+                    "deviations",
                 );
                 let (parent, cone) = (self.cones[s as usize], self.cones[c as usize]);
                 put_cone(&mut enc, &mut ctx, parent, cone);
@@ -791,6 +837,7 @@ impl UnitDecoder for ModelledUnits {
         };
         let whole = r.bit(|c| &mut c.whole)?;
         let with_cones = params.cone_bits > 0;
+        let with_deviations = params.deviation_bits > 0;
         if first {
             let mut p = [0.0; 3];
             for x in &mut p {
@@ -802,12 +849,23 @@ impl UnitDecoder for ModelledUnits {
                 .filter(|&v| v <= 1 << 40)
                 .ok_or_else(|| Error::malformed(0, at, "the root's radius is cut or too large"))?
                 as f64;
+            // Streams without deviations refine by their spheres.
+            let deviation = if with_deviations {
+                r.dec
+                    .uint(&mut UintContext::default())
+                    .filter(|&v| v <= 1 << 40)
+                    .ok_or_else(|| {
+                        Error::malformed(0, at, "the root's deviation is cut or too large")
+                    })? as f32
+            } else {
+                round_up(radius)
+            };
             let cone = if with_cones {
                 r.cone(CodedCone::NONE)?
             } else {
                 CodedCone::NONE
             };
-            r.tree.add_root(p, radius, cone);
+            r.tree.add_root(p, radius, deviation, cone);
         }
         let top = r.tree.nodes[root as usize].id.len();
         let mut queue = vec![root];
@@ -819,6 +877,7 @@ impl UnitDecoder for ModelledUnits {
             at_node += 1;
             let node = &r.tree.nodes[s as usize];
             let (sid, ps, rs, parent_cone) = (node.id, node.position, node.radius, node.cone);
+            let parent_deviation = node.deviation;
             let depth = sid.len() as usize + 1;
             let mut leaf = [false; 2];
             for (side, l) in leaf.iter_mut().enumerate() {
@@ -842,6 +901,7 @@ impl UnitDecoder for ModelledUnits {
             }
             let positions = [ps, pu];
             let mut radii = [0.0; 2];
+            let mut deviations = [0.0f32; 2];
             let mut cones = [CodedCone::NONE; 2];
             for side in 0..2 {
                 if leaf[side] {
@@ -851,11 +911,19 @@ impl UnitDecoder for ModelledUnits {
                 let code = get_symbol(&mut r.dec, &mut r.ctx.ratio[side], RADIUS_BITS)
                     .ok_or_else(|| r.cut())?;
                 radii[side] = decoded_radius(code, base, RADIUS_BITS);
+                deviations[side] = if with_deviations {
+                    let code = get_symbol(&mut r.dec, &mut r.ctx.deviation, DEVIATION_BITS)
+                        .ok_or_else(|| r.cut())?;
+                    decoded_deviation(code, parent_deviation)
+                } else {
+                    round_up(radii[side])
+                };
                 if with_cones {
                     cones[side] = r.cone(parent_cone)?;
                 }
             }
-            let children = r.tree.split(s, leaf, positions, radii, cones, unit, at)?;
+            let spheres = [0, 1].map(|side| (radii[side], deviations[side]));
+            let children = r.tree.split(s, leaf, positions, spheres, cones, unit, at)?;
             for side in 0..2 {
                 if leaf[side] {
                     continue;

@@ -23,6 +23,7 @@ use crate::coding::{BitSink, BitSource, SyntaxClass};
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::CodedCone;
+use crate::hierarchy::came::deviation::round_up;
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
 use crate::hierarchy::came::{NodeId, VertexTree, MAX_DEPTH};
 use crate::mesh::quantize::GridShape;
@@ -199,6 +200,7 @@ impl Codec for CamePaper {
             component_bits: self.component_bits,
             radius_bits: RADIUS_BITS,
             cone_bits: 0,
+            deviation_bits: 0,
         };
         let bits = self.component_bits;
         encode_stream(mesh, layout, |tree, part| {
@@ -253,11 +255,11 @@ impl Codec for CamePaper {
 /// A `came-paper` stream's parameters, checked.
 pub fn params(header: &Header) -> Result<Params> {
     let params = Params::from_bytes(&header.params, 1..=16)?;
-    if params.cone_bits != 0 {
+    if params.cone_bits != 0 || params.deviation_bits != 0 {
         return Err(Error::malformed(
             0,
             0,
-            "came-paper streams code no normal cones",
+            "came-paper streams code no normal cones and no deviations",
         ));
     }
     Ok(params)
@@ -564,6 +566,8 @@ impl UnitDecoder for PaperUnits {
             tree.add_root(
                 clamp_to_grid(DVec3::from_array(p), cells),
                 radius as f64,
+                // The paper refines by its spheres.
+                round_up(radius as f64),
                 CodedCone::NONE,
             );
         }
@@ -602,7 +606,9 @@ impl UnitDecoder for PaperUnits {
                     radii[side] = decoded_radius(code, base, params.radius_bits);
                 }
             }
-            let children = tree.split(s, leaf, positions, radii, [CodedCone::NONE; 2], unit, at)?;
+            let spheres = radii.map(|r| (r, round_up(r)));
+            let children =
+                tree.split(s, leaf, positions, spheres, [CodedCone::NONE; 2], unit, at)?;
             for side in 0..2 {
                 if leaf[side] {
                     continue;

@@ -22,6 +22,7 @@
 
 mod build;
 pub mod cones;
+pub mod deviation;
 mod grid;
 pub mod node_id;
 mod regions;

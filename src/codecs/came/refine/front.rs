@@ -25,8 +25,9 @@
 //! even between a loaded meta-node and one still on its way (tested against the projection
 //! computed from the whole stream).
 //!
-//! No fold-overs in view: every present face that meets the view frustum turns the way of the
-//! full mesh's triangle it stands for (its *counterpart*: the same triangle with each corner at
+//! No fold-overs in view: every present face that shows in the view — meets its frustum and
+//! spans the tolerance on the screen ([`View::shows_triangle`]; a smaller face shows within the
+//! tolerance whichever way it turns) — turns the way of the full mesh's triangle it stands for (its *counterpart*: the same triangle with each corner at
 //! its leaf), the normals of the two making an angle under 90°. The hierarchy's build does not test Hoppe's fold-over conditions
 //! (the stored dependencies make a split's neighbourhood the one the encoder saw, but nothing
 //! checked that neighbourhood for flips), and the counterpart's corners are not known where
@@ -202,6 +203,8 @@ pub struct ViewMesh {
     /// Position and error-sphere radius, in world units.
     /// (One array: the view test of every active node, every pass, reads both.)
     spheres: Vec<(DVec3, f64)>,
+    /// Deviation, in world units: the error the view test projects.
+    deviations: Vec<f64>,
     /// Normal cone, for back-face culling.
     cones: Vec<NormalCone>,
     state: Vec<State>,
@@ -283,6 +286,7 @@ impl ViewMesh {
             children: Vec::new(),
             opens: Vec::new(),
             spheres: Vec::new(),
+            deviations: Vec::new(),
             cones: Vec::new(),
             state: Vec::new(),
             born: Vec::new(),
@@ -412,6 +416,7 @@ impl ViewMesh {
             self.children.push([NONE; 2]);
             self.opens.push(NONE);
             self.spheres.push((n.center, n.radius));
+            self.deviations.push(n.deviation);
             self.cones.push(n.cone);
             self.state.push(State::Below);
             self.born.push(SmallVec::new());
@@ -645,9 +650,10 @@ impl ViewMesh {
         }
     }
 
-    /// Whether the face on active nodes `corners` meets the view's frustum.
+    /// Whether the face on active nodes `corners` shows in the view: it meets the frustum and
+    /// spans the tolerance on the screen ([`View::shows_triangle`]).
     fn in_view(&self, view: &View, corners: [u32; 3]) -> bool {
-        view.sees_triangle(corners.map(|v| self.spheres[v as usize].0))
+        view.shows_triangle(corners.map(|v| self.spheres[v as usize].0))
     }
 
     /// Whether node `v` is a leaf of the hierarchy (not a node whose split is still to load).
@@ -1031,7 +1037,14 @@ impl ViewMesh {
 
     fn wants(&self, view: &View, v: u32) -> bool {
         let (center, radius) = self.spheres[v as usize];
-        view.wants_split(center, radius, &self.cones[v as usize], self.scale)
+        let deviation = self.deviations[v as usize];
+        view.wants_split(
+            center,
+            radius,
+            deviation,
+            &self.cones[v as usize],
+            self.scale,
+        )
     }
 
     /// Returns whether it passed over the front (rather than revisiting the splits that

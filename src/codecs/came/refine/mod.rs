@@ -11,12 +11,17 @@
 //!   are split first ("forced split").
 //! - ecol(v_s): the inverse (one path bit dropped); legal when v_t and v_u are active and no
 //!   split node depends on v_s.
-//! - r_v: the error sphere's radius at v (every vertex of v's subtree lies within r_v of v).
+//! - r_v: the error sphere's radius at v (every vertex of v's subtree lies within r_v of v);
+//!   the spheres cull and place the test.
+//! - e_v: the deviation at v (`came` streams, `hierarchy::came::deviation`): how far the
+//!   surface under v lies from the simplified surface around v, measured at encoding, monotone
+//!   up the hierarchy; where a stream has none (`came-paper`, and `came` streams written
+//!   before deviations) e_v = r_v, the paper's test.
 //! - τ: the screen-space tolerance in pixels; φ: the vertical field of view; H: the viewport's
 //!   height in pixels; κ = 2·τ·tan(φ/2) / H. A node is refined while its sphere meets the view
-//!   frustum and a vertex of its subtree could land τ pixels or more from it on the screen:
-//!   r_v·√(1 + t²) ≥ κ·z, z the sphere's least depth and t its largest tangent off the axis
-//!   ([`View::wants_split`]) — Hoppe's r_v ≥ κ·|v − e|, made an upper bound.
+//!   frustum and its deviation could span τ pixels or more on the screen somewhere in the
+//!   sphere: e_v·√(1 + t²) ≥ κ·z, z the sphere's least depth and t its largest tangent off the
+//!   axis ([`View::wants_split`]) — Hoppe's δ_v ≥ κ·|v − e|, made an upper bound.
 //!
 //! - n̂_v, α_v: the node's normal cone (axis, half-angle), holding the normal of every face with
 //!   a corner under v; `came` streams code one per inner node (docs/FORMAT.md §8.2, about 2
@@ -35,5 +40,5 @@ mod loader;
 mod view;
 
 pub use front::{Adapted, Budget, Fetched, Pick, ViewMesh};
-pub use loader::{ByteSource, Fetch, SeekSource};
+pub use loader::{ByteSource, Fetch, SeekSource, DEVIATION_MARGIN};
 pub use view::{Camera, View};

@@ -185,23 +185,39 @@ impl View {
         self.sees(centre, radius * (1.0 + 1e-9))
     }
 
-    /// Whether a node with this error sphere and normal cone is to be refined, κ scaled by
-    /// `scale` (the face budget's regulation): in the frustum, not facing away
-    /// ([`View::faces_away`]) and spanning the tolerance or more.
-    ///
-    /// "Spanning" is bounded from above, so that no vertex of the node's subtree lands τ
-    /// pixels or more from the node on the screen while the node stands for it: over the
-    /// sphere, the projection (x/z, y/z) stretches lengths by at most √(1 + t²) / z, with z
-    /// the least depth and t the largest tangent off the axis, so the node is refined while
-    /// r·√(1 + t²) ≥ κ·z_min (z_min = depth of the centre − r; t = (lateral distance + r) /
-    /// z_min). A sphere reaching the eye's plane is always refined.
-    pub fn wants_split(&self, center: DVec3, radius: f64, cone: &NormalCone, scale: f64) -> bool {
-        self.spans_tolerance(center, radius, scale) && !self.faces_away(center, radius, cone)
+    /// Whether triangle `p` meets the frustum and spans the tolerance on the screen (its
+    /// bounding sphere's diameter, projected as [`View::wants_split`] projects a deviation): a
+    /// face smaller than that shows within the tolerance whichever way it turns.
+    pub fn shows_triangle(&self, p: [DVec3; 3]) -> bool {
+        let centre = (p[0] + p[1] + p[2]) / 3.0;
+        let radius = p.iter().map(|&q| q.distance(centre)).fold(0.0, f64::max) * (1.0 + 1e-9);
+        self.sees(centre, radius) && self.deviates(centre, radius, 2.0 * radius, 1.0)
     }
 
-    fn spans_tolerance(&self, center: DVec3, radius: f64, scale: f64) -> bool {
+    /// Whether a node with this error sphere, deviation and normal cone is to be refined, κ
+    /// scaled by `scale` (the face budget's regulation): in the frustum, not facing away
+    /// ([`View::faces_away`]) and deviating by the tolerance or more on the screen.
+    ///
+    /// The projected deviation is bounded from above wherever in the sphere the error lies:
+    /// over the sphere, the projection (x/z, y/z) stretches lengths by at most √(1 + t²) / z,
+    /// with z the least depth and t the largest tangent off the axis, so the node is refined
+    /// while e·√(1 + t²) ≥ κ·z_min (z_min = depth of the centre − r; t = (lateral distance +
+    /// r) / z_min). A sphere reaching the eye's plane is always refined (unless its deviation
+    /// is 0: its surface is exact). With e = r, this is the paper's test on the spheres.
+    pub fn wants_split(
+        &self,
+        center: DVec3,
+        radius: f64,
+        deviation: f64,
+        cone: &NormalCone,
+        scale: f64,
+    ) -> bool {
+        self.deviates(center, radius, deviation, scale) && !self.faces_away(center, radius, cone)
+    }
+
+    fn deviates(&self, center: DVec3, radius: f64, deviation: f64, scale: f64) -> bool {
         let k = self.kappa * scale;
-        if radius <= 0.0 || !k.is_finite() || !self.sees(center, radius) {
+        if deviation <= 0.0 || !k.is_finite() || !self.sees(center, radius) {
             return false;
         }
         if k == 0.0 {
@@ -215,7 +231,7 @@ impl View {
         }
         let lateral = (d - self.forward * depth).length() + radius;
         let tangent = lateral / nearest;
-        radius * (1.0 + tangent * tangent).sqrt() >= k * nearest
+        deviation * (1.0 + tangent * tangent).sqrt() >= k * nearest
     }
 }
 
@@ -254,17 +270,28 @@ mod tests {
         let v = View::new(&camera(), 2.0).unwrap();
         // At distance 10 a pixel is 2·tan 30°·10 / 600 ≈ 0.0192 units.
         let pixel = 2.0 * (30f64).to_radians().tan() * 10.0 / 600.0;
-        assert!(v.wants_split(DVec3::ZERO, 2.1 * pixel, &NONE, 1.0));
-        assert!(!v.wants_split(DVec3::ZERO, 1.9 * pixel, &NONE, 1.0));
-        assert!(!v.wants_split(DVec3::ZERO, 2.1 * pixel, &NONE, 1.2));
-        assert!(!v.wants_split(DVec3::new(0.0, 0.0, 30.0), 10.0, &NONE, 1.0));
+        assert!(v.wants_split(DVec3::ZERO, 2.1 * pixel, 2.1 * pixel, &NONE, 1.0));
+        assert!(!v.wants_split(DVec3::ZERO, 1.9 * pixel, 1.9 * pixel, &NONE, 1.0));
+        assert!(!v.wants_split(DVec3::ZERO, 2.1 * pixel, 2.1 * pixel, &NONE, 1.2));
+        assert!(!v.wants_split(DVec3::new(0.0, 0.0, 30.0), 10.0, 10.0, &NONE, 1.0));
         // Off the axis a sphere's subtree can spread further on the screen: at the edge of
         // the view (tangent ≈ 0.5 here) 1.9 pixels' radius is refined.
-        assert!(v.wants_split(DVec3::new(5.0, 0.0, 0.0), 1.9 * pixel, &NONE, 1.0));
+        assert!(v.wants_split(
+            DVec3::new(5.0, 0.0, 0.0),
+            1.9 * pixel,
+            1.9 * pixel,
+            &NONE,
+            1.0
+        ));
         // A sphere reaching the eye's plane is.
-        assert!(v.wants_split(DVec3::new(0.0, 0.5, 9.5), 0.6, &NONE, 1.0));
-        assert!(View::everything().wants_split(DVec3::ZERO, 1e-9, &NONE, 1.0));
-        assert!(!View::nothing().wants_split(DVec3::ZERO, 1e9, &NONE, 1.0));
+        assert!(v.wants_split(DVec3::new(0.0, 0.5, 9.5), 0.6, 0.6, &NONE, 1.0));
+        assert!(View::everything().wants_split(DVec3::ZERO, 1e-9, 1e-9, &NONE, 1.0));
+        assert!(!View::nothing().wants_split(DVec3::ZERO, 1e9, 1e9, &NONE, 1.0));
+        // A large sphere whose surface deviates little is left coarse; one that is exact
+        // (deviation 0) is never refined, not even reaching the eye's plane.
+        assert!(!v.wants_split(DVec3::ZERO, 10.0 * pixel, 1.9 * pixel, &NONE, 1.0));
+        assert!(v.wants_split(DVec3::ZERO, 10.0 * pixel, 2.2 * pixel, &NONE, 1.0));
+        assert!(!v.wants_split(DVec3::new(0.0, 0.5, 9.5), 0.6, 0.0, &NONE, 1.0));
     }
 
     #[test]
@@ -275,9 +302,9 @@ mod tests {
         let big = 0.5;
         // Normals along -z face away (the eye sees their backs); along +z they face the eye.
         assert!(v.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0)));
-        assert!(!v.wants_split(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0), 1.0));
+        assert!(!v.wants_split(DVec3::ZERO, big, big, &cone([0.0, 0.0, -1.0], 30.0), 1.0));
         assert!(!v.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, 1.0], 30.0)));
-        assert!(v.wants_split(DVec3::ZERO, big, &cone([0.0, 0.0, 1.0], 30.0), 1.0));
+        assert!(v.wants_split(DVec3::ZERO, big, big, &cone([0.0, 0.0, 1.0], 30.0), 1.0));
         // Sideways: a face seen edge-on is not culled; nor is a cone reaching past 90°.
         assert!(!v.faces_away(DVec3::ZERO, big, &cone([1.0, 0.0, 0.0], 5.0)));
         assert!(!v.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 88.0)));
@@ -290,7 +317,7 @@ mod tests {
         assert!(!v.faces_away(DVec3::ZERO, big, &NONE));
         let two = v.clone().two_sided(true);
         assert!(!two.faces_away(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0)));
-        assert!(two.wants_split(DVec3::ZERO, big, &cone([0.0, 0.0, -1.0], 30.0), 1.0));
+        assert!(two.wants_split(DVec3::ZERO, big, big, &cone([0.0, 0.0, -1.0], 30.0), 1.0));
     }
 
     #[test]
