@@ -4,14 +4,11 @@
 //! faces, splits and collapses, adaptation time, bytes fetched so far, the share of the surface
 //! in view, and the measured screen-space error against the tolerance.
 //!
-//! The measured error of a frame: every vertex of the full mesh inside the view frustum with a
-//! face turned towards the eye, and the vertex standing for it in the adapted mesh (the active
-//! node on its leaf path), are projected to the screen; the largest distance between the two,
-//! in pixels (no occlusion test: hidden vertices count too). A vertex all of whose faces turn
-//! away is drawn by none of them on a one-sided surface, and back-face culling leaves it coarse.
-//!
 //! Beside the path's front, a second front follows the same views two-sided (no back-face
-//! culling), for its faces and bytes.
+//! culling), for its faces and bytes, and for the measured error of a frame: the two-sided
+//! front against the full mesh on the screen, both ways, over every sample in the frustum
+//! (`crate::screen_error`, docs/CONTRACT.md §8). Fold-overs "in view" are those spanning the
+//! tolerance in the frustum, what the orientation guard promises to leave none of.
 //!
 //! Writes results/came/flythrough.{json,csv}, the series as a chart (flythrough.{png,svg}), and
 //! renders of the farthest and nearest frames, adapted and full.
@@ -25,6 +22,7 @@ use crate::mesh::quantize::GridShape;
 use crate::mesh::{generate, TriMesh};
 use crate::plot::{Chart, Mark, Series};
 use crate::render::{render_perspective, Perspective};
+use crate::screen_error::FullMesh;
 use glam::DVec3;
 use plotters::prelude::SeriesLabelPosition;
 use serde::{Deserialize, Serialize};
@@ -90,9 +88,10 @@ pub struct Frame {
     pub operations_unguarded: usize,
     pub fold_overs_in_view_unguarded: usize,
     pub fold_overs_in_view_facing_unguarded: usize,
-    /// Full-mesh vertices inside the frustum with a face towards the eye, and the measured
-    /// screen-space error over them.
-    pub visible_vertices: usize,
+    /// Samples in the frustum (both ways: the full mesh's vertices and face centroids, the
+    /// two-sided front's face centroids and edge midpoints), and the measured screen-space
+    /// error of the two-sided front over them (`crate::screen_error`).
+    pub error_samples: usize,
     pub max_error_px: f64,
     pub mean_error_px: f64,
 }
@@ -164,41 +163,6 @@ fn camera_at(i: usize, centre: DVec3, radius: f64, spot: DVec3) -> Camera {
     }
 }
 
-/// A camera's projection to pixels (from the centre of the screen), set up once a frame.
-struct Projection {
-    eye: DVec3,
-    forward: DVec3,
-    right: DVec3,
-    up: DVec3,
-    focal: f64,
-}
-
-impl Projection {
-    fn new(camera: &Camera) -> Projection {
-        let forward = (camera.target - camera.eye).normalize();
-        let right = forward.cross(camera.up).normalize();
-        Projection {
-            eye: camera.eye,
-            forward,
-            right,
-            up: right.cross(forward),
-            focal: 0.5 * camera.height as f64 / (camera.fov_degrees.to_radians() / 2.0).tan(),
-        }
-    }
-
-    /// Pixel position of `p` (`None` behind the eye).
-    fn project(&self, p: DVec3) -> Option<(f64, f64)> {
-        let d = p - self.eye;
-        let z = d.dot(self.forward);
-        (z > 1e-12).then(|| {
-            (
-                d.dot(self.right) / z * self.focal,
-                d.dot(self.up) / z * self.focal,
-            )
-        })
-    }
-}
-
 /// The full mesh's triangles as centroid and area, once for every frame's share in view.
 fn centroids_and_areas(mesh: &TriMesh) -> Vec<(DVec3, f64)> {
     mesh.faces
@@ -226,55 +190,8 @@ fn surface_in_view(triangles: &[(DVec3, f64)], view: &View) -> f64 {
     }
 }
 
-/// The largest and mean screen distance between each vertex in view and where it stands in
-/// the adapted mesh, and how many vertices are in view.
-fn measured_error(
-    front: &ViewMesh,
-    leaves: &[Leaf],
-    facing: &[bool],
-    camera: &Camera,
-    view: &View,
-) -> Result<(f64, f64, usize)> {
-    let projection = Projection::new(camera);
-    let (mut max, mut sum, mut count) = (0.0f64, 0.0, 0usize);
-    for &(id, p, vertex) in leaves {
-        if !view.sees(p, 0.0) || !facing[vertex as usize] {
-            continue;
-        }
-        let q = front
-            .position_of(id)
-            .ok_or_else(|| Error::mesh("a vertex has no place in the adapted mesh"))?;
-        let error = match (projection.project(p), projection.project(q)) {
-            (Some(a), Some(b)) => ((a.0 - b.0).powi(2) + (a.1 - b.1).powi(2)).sqrt(),
-            // Its stand-in behind the eye: off the screen altogether.
-            _ => f64::INFINITY,
-        };
-        max = max.max(error);
-        sum += error;
-        count += 1;
-    }
-    Ok((max, sum / count.max(1) as f64, count))
-}
-
 /// A vertex of the full mesh: its leaf path, position and number in the full mesh.
 type Leaf = (crate::hierarchy::came::NodeId, DVec3, u32);
-
-/// Per vertex of `mesh`, whether a face of it turns towards `eye` (every vertex, if `two_sided`).
-fn facing_the_eye(mesh: &TriMesh, eye: DVec3, two_sided: bool, out: &mut Vec<bool>) {
-    out.clear();
-    out.resize(mesh.vertex_count(), two_sided);
-    if two_sided {
-        return;
-    }
-    for face in &mesh.faces {
-        let [a, b, c] = mesh.corners(*face);
-        if (a - eye).dot((b - a).cross(c - a)) < 0.0 {
-            for &v in face {
-                out[v as usize] = true;
-            }
-        }
-    }
-}
 
 /// Fold-overs of a front.
 #[derive(Clone, Copy, Default)]
@@ -301,7 +218,8 @@ fn fold_overs(
         let n = normal(full);
         if normal(adapted).dot(n) <= 0.0 && n != DVec3::ZERO {
             let facing = (full[0] - view.eye()).dot(n) < 0.0;
-            let in_view = view.sees_triangle(adapted);
+            // In view: spanning the tolerance in the frustum (what the guard promises).
+            let in_view = view.shows_triangle(adapted);
             out.all += 1;
             out.facing += facing as usize;
             out.in_view += in_view as usize;
@@ -412,7 +330,7 @@ fn fly(
     let at: std::collections::HashMap<u64, DVec3> =
         leaves.iter().map(|&(id, p, _)| (id.packed(), p)).collect();
     let triangles = centroids_and_areas(full);
-    let mut facing = Vec::new();
+    let reference = FullMesh::new(full);
     let mut front = ViewMesh::open_file(path)?;
     let mut two_sided = ViewMesh::open_file(path)?;
     let mut unguarded = ViewMesh::open_file(path)?;
@@ -463,11 +381,11 @@ fn fly(
         }
         operations_unguarded += ops_unguarded;
         adapting_unguarded += ms_unguarded / 1e3;
-        facing_the_eye(full, camera.eye, view.is_two_sided(), &mut facing);
         let folds = fold_overs(&front, &at, &view);
         let folds_unguarded = fold_overs(&unguarded, &at, &view);
-        let (max_error_px, mean_error_px, visible_vertices) =
-            measured_error(&front, leaves, &facing, &camera, &view)?;
+        let error = reference.screen_error(&two_sided.mesh(), &camera, &view);
+        let (max_error_px, mean_error_px, error_samples) =
+            (error.max_px, error.mean_px, error.samples);
         let fetched = front.fetched();
         let frame = Frame {
             frame: i,
@@ -496,13 +414,13 @@ fn fly(
             operations_unguarded: ops_unguarded,
             fold_overs_in_view_unguarded: folds_unguarded.in_view,
             fold_overs_in_view_facing_unguarded: folds_unguarded.in_view_facing,
-            visible_vertices,
+            error_samples,
             max_error_px,
             mean_error_px,
         };
         if i % 10 == 0 || i + 1 == FRAMES {
             log(format!(
-                "frame {i}: {} faces ({} two-sided, {} without the orientation guard), {} folded over ({} in view; unguarded {} in view, {} of them facing the eye), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} vertices",
+                "frame {i}: {} faces ({} two-sided, {} without the orientation guard), {} folded over ({} in view; unguarded {} in view, {} of them facing the eye), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} samples",
                 frame.faces,
                 frame.faces_two_sided,
                 frame.faces_unguarded,
@@ -516,7 +434,7 @@ fn fly(
                 100.0 * fetched.bytes_read as f64 / stream_bytes as f64,
                 max_error_px,
                 mean_error_px,
-                visible_vertices
+                error_samples
             ));
         }
         if i == 0 || i + 1 == FRAMES {
@@ -595,7 +513,7 @@ fn fly(
 
 fn csv(report: &Flythrough) -> String {
     let mut out = String::from(
-        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,fold_overs_facing,fold_overs_in_view,unsure,faces_unguarded,adapt_ms_unguarded,operations_unguarded,fold_overs_in_view_unguarded,fold_overs_in_view_facing_unguarded,visible_vertices,max_error_px,mean_error_px\n",
+        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,fold_overs_facing,fold_overs_in_view,unsure,faces_unguarded,adapt_ms_unguarded,operations_unguarded,fold_overs_in_view_unguarded,fold_overs_in_view_facing_unguarded,error_samples,max_error_px,mean_error_px\n",
     );
     for f in &report.frames {
         out += &format!(
@@ -623,7 +541,7 @@ fn csv(report: &Flythrough) -> String {
             f.operations_unguarded,
             f.fold_overs_in_view_unguarded,
             f.fold_overs_in_view_facing_unguarded,
-            f.visible_vertices,
+            f.error_samples,
             f.max_error_px,
             f.mean_error_px
         );

@@ -102,6 +102,8 @@ pub enum CameField {
     MrData,
     /// Normal cones (`came`; not in the paper).
     Cones,
+    /// Deviations (`came`; not in the paper).
+    Deviations,
 }
 
 impl CameField {
@@ -113,16 +115,18 @@ impl CameField {
             CameField::Coordinates => "coordinates",
             CameField::MrData => "spheres",
             CameField::Cones => "cones",
+            CameField::Deviations => "deviations",
         }
     }
 
     /// Every field.
-    pub const ALL: [CameField; 5] = [
+    pub const ALL: [CameField; 6] = [
         CameField::Connectivity,
         CameField::Dependencies,
         CameField::Coordinates,
         CameField::MrData,
         CameField::Cones,
+        CameField::Deviations,
     ];
 }
 
