@@ -308,9 +308,13 @@ pub fn encode_stream(
     let started = std::time::Instant::now();
     let tree = hierarchy(mesh)?;
     let seconds = started.elapsed().as_secs_f64();
-    let part = partition::partition(&tree, META_LEVELS, layout.tails);
+    let levels: u8 = std::env::var("PROBE_L")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(META_LEVELS);
+    let part = partition::partition(&tree, levels, layout.tails);
     let params = Params {
-        meta_levels: META_LEVELS,
+        meta_levels: levels,
         depth: tree.depth(),
         component_bits: layout.component_bits,
         radius_bits: layout.radius_bits,
