@@ -308,13 +308,9 @@ pub fn encode_stream(
     let started = std::time::Instant::now();
     let tree = hierarchy(mesh)?;
     let seconds = started.elapsed().as_secs_f64();
-    let levels: u8 = std::env::var("PROBE_L")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(META_LEVELS);
-    let part = partition::partition(&tree, levels, layout.tails);
+    let part = partition::partition(&tree, META_LEVELS, layout.tails);
     let params = Params {
-        meta_levels: levels,
+        meta_levels: META_LEVELS,
         depth: tree.depth(),
         component_bits: layout.component_bits,
         radius_bits: layout.radius_bits,
