@@ -171,19 +171,26 @@ fn emc_streams_with_the_corrections_after_the_last_level_still_decode() {
     assert!(!new_levels.advance().unwrap());
 }
 
-/// `came` streams written before normal cones (4 bytes of parameters) still decode exactly, and
-/// refine view-dependently without culling: `came-eight-before-cones.mc` is the golden stream of
-/// that build, kept.
-#[test]
-fn came_streams_without_normal_cones_still_decode_and_refine() {
-    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
-    let old = std::fs::read(golden_dir().join("came-eight-before-cones.mc")).unwrap();
+/// A kept `came` golden stream of eight, checked to decode exactly to today's canonical mesh,
+/// and today's `came` stream of the same mesh.
+fn kept_came_stream_and_todays(file: &str) -> (Vec<u8>, Vec<u8>) {
+    let old = std::fs::read(golden_dir().join(file)).unwrap();
     let codec = codecs::by_name("came").unwrap();
     let [(_, eight)] = read_all(["eight"]);
     let canonical = canonical(codec, &eight);
     let (decoded, _) = codecs::decode(&old, Stop::All).unwrap();
     canonical.check_lossless(&decoded.mesh).unwrap();
     let new = codec.encode(&canonical).unwrap().bytes;
+    (old, new)
+}
+
+/// `came` streams written before normal cones (4 bytes of parameters) still decode exactly, and
+/// refine view-dependently without culling: `came-eight-before-cones.mc` is the golden stream of
+/// that build, kept.
+#[test]
+fn came_streams_without_normal_cones_still_decode_and_refine() {
+    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    let (old, new) = kept_came_stream_and_todays("came-eight-before-cones.mc");
     let camera = Camera {
         eye: glam::DVec3::new(0.0, 0.0, 3.0),
         target: glam::DVec3::ZERO,
@@ -214,13 +221,7 @@ fn came_streams_without_normal_cones_still_decode_and_refine() {
 #[test]
 fn came_streams_without_deviations_still_decode_and_refine_by_their_spheres() {
     use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
-    let old = std::fs::read(golden_dir().join("came-eight-before-deviations.mc")).unwrap();
-    let codec = codecs::by_name("came").unwrap();
-    let [(_, eight)] = read_all(["eight"]);
-    let canonical = canonical(codec, &eight);
-    let (decoded, _) = codecs::decode(&old, Stop::All).unwrap();
-    canonical.check_lossless(&decoded.mesh).unwrap();
-    let new = codec.encode(&canonical).unwrap().bytes;
+    let (old, new) = kept_came_stream_and_todays("came-eight-before-deviations.mc");
     let params = |bytes: &[u8]| {
         meshcodec::container::StreamReader::open(bytes)
             .unwrap()
