@@ -105,8 +105,8 @@ enum Command {
         output: PathBuf,
         #[command(flatten)]
         camera: CameraArgs,
-        /// Screen-space tolerance, pixels: nodes are refined while their error sphere spans
-        /// this many pixels or more.
+        /// Screen-space tolerance, pixels: nodes are refined while their deviation (came; the
+        /// error sphere in came-paper and older came streams) spans this many pixels or more.
         #[arg(long, default_value_t = 1.0)]
         tolerance: f64,
         /// Face budget: the tolerance is raised until the mesh holds at most this many faces.
