@@ -426,6 +426,14 @@ impl ViewMesh {
             Ok(delta) => {
                 self.units[loaded.unit] = UnitState::Loaded;
                 self.grow(delta);
+                // The orientation certificates read the deepest loaded nodes: a collapse
+                // refused before may be allowed now.
+                for p in std::mem::take(&mut self.refused) {
+                    if !self.in_retry[p as usize] {
+                        self.in_retry[p as usize] = true;
+                        self.retry.push(p);
+                    }
+                }
             }
             Err(e) => {
                 self.units[loaded.unit] = UnitState::Refused;
@@ -1235,8 +1243,8 @@ impl ViewMesh {
     /// After the passes: the collapses a face's orientation may have refused tried again, and
     /// the guard ([`Self::guard`]), until neither does anything. Tried again: those near a face
     /// that moved, appeared or went since they were last tried (`retry`: the parents of its
-    /// corners), as nothing else changes what the orientation allows under one view; and after
-    /// whole passes (a view that may be new), every refused one.
+    /// corners), and every refused one after a meta-node arrives (the certificates read the
+    /// deepest loaded nodes) or after whole passes (a view that may be new).
     fn settle_orientation(
         &mut self,
         view: &View,
