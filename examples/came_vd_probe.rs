@@ -52,7 +52,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (mut folded, mut shown) = (0, 0);
         for (leaves, at) in front.present_triangles() {
             let counterpart = leaves.map(|l| leaf[&l.packed()]);
-            if view.sees_triangle(at) && normal(at).dot(normal(counterpart)) <= 0.0 {
+            let full_normal = normal(counterpart);
+            // A zero-area triangle of the full mesh turns no way.
+            if full_normal != DVec3::ZERO
+                && view.sees_triangle(at)
+                && normal(at).dot(full_normal) <= 0.0
+            {
                 folded += 1;
                 shown += view.shows_triangle(at) as usize;
             }
@@ -68,6 +73,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             fetched.units,
             error.max_px,
             error.mean_px,
+        );
+        println!(
+            "  largest error at {:?}, a sample of the {} mesh",
+            error.worst_at,
+            if error.worst_on_full {
+                "full"
+            } else {
+                "adapted"
+            }
         );
     }
     Ok(())

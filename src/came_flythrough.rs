@@ -10,10 +10,12 @@
 //! (`crate::screen_error`, docs/CONTRACT.md §8). Fold-overs "in view" are those spanning the
 //! tolerance in the frustum, what the orientation guard promises to leave none of.
 //!
-//! Writes results/came/flythrough.{json,csv}, the series as a chart (flythrough.{png,svg}), and
+//! Writes results/came/flythrough.{json,csv}, the series as a chart (flythrough.{png,svg}: faces,
+//! fold-overs, work, the stream fetched so far and the bytes each frame read, the error), and
 //! renders of the farthest and nearest frames, adapted and full.
 
 use crate::came_extras::{QUANT_BITS, TABLE_MESHES};
+use crate::came_vd::{nearest_depth, pixel_size};
 use crate::codecs::came::refine::{Budget, Camera, View, ViewMesh};
 use crate::codecs::{self, EncodeOptions};
 use crate::error::{Error, Result};
@@ -94,6 +96,10 @@ pub struct Frame {
     pub error_samples: usize,
     pub max_error_px: f64,
     pub mean_error_px: f64,
+    /// A pixel's size at the least depth of the full mesh's vertices in view
+    /// ([`crate::came_vd::nearest_depth`]): the tolerance a view-independent mesh keeps.
+    #[serde(default)]
+    pub pixel_at_nearest: f64,
 }
 
 /// One view from a cold start: what it alone fetches.
@@ -387,6 +393,8 @@ fn fly(
         let (max_error_px, mean_error_px, error_samples) =
             (error.max_px, error.mean_px, error.samples);
         let fetched = front.fetched();
+        let pixel_at_nearest = nearest_depth(full, &camera, &view)
+            .map_or(0.0, |z| pixel_size(&camera, z) * TOLERANCE_PX);
         let frame = Frame {
             frame: i,
             eye: camera.eye.to_array(),
@@ -417,6 +425,7 @@ fn fly(
             error_samples,
             max_error_px,
             mean_error_px,
+            pixel_at_nearest,
         };
         if i % 10 == 0 || i + 1 == FRAMES {
             log(format!(
@@ -513,11 +522,11 @@ fn fly(
 
 fn csv(report: &Flythrough) -> String {
     let mut out = String::from(
-        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,fold_overs_facing,fold_overs_in_view,unsure,faces_unguarded,adapt_ms_unguarded,operations_unguarded,fold_overs_in_view_unguarded,fold_overs_in_view_facing_unguarded,error_samples,max_error_px,mean_error_px\n",
+        "frame,faces,vertices,faces_two_sided,splits,collapses,passes,adaptations,adapt_ms,wait_ms,bytes_fetched,units_loaded,bytes_fetched_two_sided,surface_in_view,fold_overs,fold_overs_facing,fold_overs_in_view,unsure,faces_unguarded,adapt_ms_unguarded,operations_unguarded,fold_overs_in_view_unguarded,fold_overs_in_view_facing_unguarded,error_samples,max_error_px,mean_error_px,pixel_at_nearest\n",
     );
     for f in &report.frames {
         out += &format!(
-            "{},{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{:.5},{},{},{},{},{},{:.3},{},{},{},{},{:.4},{:.4}\n",
+            "{},{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{:.5},{},{},{},{},{},{:.3},{},{},{},{},{:.4},{:.4},{:.6e}\n",
             f.frame,
             f.faces,
             f.vertices,
@@ -543,7 +552,8 @@ fn csv(report: &Flythrough) -> String {
             f.fold_overs_in_view_facing_unguarded,
             f.error_samples,
             f.max_error_px,
-            f.mean_error_px
+            f.mean_error_px,
+            f.pixel_at_nearest
         );
     }
     out
@@ -558,6 +568,22 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
             .frames
             .iter()
             .map(|f| (f.frame as f64, y(f)))
+            .collect(),
+        mark: Mark::Line,
+    };
+    // What a frame read beyond the frames before it, in kB (a frame that read nothing sits at
+    // the floor of the log axis, 0.01 kB).
+    let per_frame = |label: &str, total: &dyn Fn(&Frame) -> u64| Series {
+        label: label.to_string(),
+        points: report
+            .frames
+            .iter()
+            .scan(0u64, |before, f| {
+                let now = total(f);
+                let read = now.saturating_sub(*before);
+                *before = now;
+                Some((f.frame as f64, (read as f64 / 1e3).max(0.01)))
+            })
             .collect(),
         mark: Mark::Line,
     };
@@ -624,6 +650,15 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
                     100.0 * f.bytes_fetched_two_sided as f64 / report.stream_bytes as f64
                 }),
                 series("surface in view", &|f| 100.0 * f.surface_in_view),
+            ],
+        ),
+        panel(
+            "Bytes read per frame",
+            "kB (log)",
+            true,
+            vec![
+                per_frame("one-sided", &|f| f.bytes_fetched),
+                per_frame("two-sided", &|f| f.bytes_fetched_two_sided),
             ],
         ),
         panel(

@@ -46,6 +46,8 @@ pub mod came_extras;
 #[cfg(feature = "lab")]
 pub mod came_flythrough;
 #[cfg(feature = "lab")]
+pub mod came_vd;
+#[cfg(feature = "lab")]
 pub mod cli;
 #[cfg(feature = "lab")]
 pub mod emc_scale;

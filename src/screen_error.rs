@@ -22,6 +22,10 @@ pub struct ScreenError {
     pub mean_px: f64,
     /// Samples in the frustum.
     pub samples: usize,
+    /// Where the largest error was measured, and whether that sample lies on the full mesh
+    /// (else on the adapted one).
+    pub worst_at: DVec3,
+    pub worst_on_full: bool,
 }
 
 /// The full mesh, prepared once for every view measured against it.
@@ -74,20 +78,22 @@ impl<'a> FullMesh<'a> {
             ]);
         }
         back.retain(in_view);
-        let (mut max, mut sum) = (0.0f64, 0.0);
-        for (points, surface) in [(&there, &index), (&back, &self.index)] {
+        let mut error = ScreenError::default();
+        let mut sum = 0.0;
+        for (points, surface, on_full) in [(&there, &index, true), (&back, &self.index, false)] {
             for (&p, d) in points.iter().zip(surface.distances(points)) {
                 let px = pixels(p, d);
-                max = max.max(px);
+                if px > error.max_px {
+                    error.max_px = px;
+                    error.worst_at = p;
+                    error.worst_on_full = on_full;
+                }
                 sum += px;
             }
         }
-        let samples = there.len() + back.len();
-        ScreenError {
-            max_px: max,
-            mean_px: sum / samples.max(1) as f64,
-            samples,
-        }
+        error.samples = there.len() + back.len();
+        error.mean_px = sum / error.samples.max(1) as f64;
+        error
     }
 }
 

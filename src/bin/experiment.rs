@@ -147,6 +147,18 @@ enum Command {
         #[arg(long, default_value = "results")]
         out: PathBuf,
     },
+    /// CAME's view-dependent table: far, middle and near views of bunny.ply, dragon-50k and the
+    /// million-triangle mesh from a cold start, two-sided: faces, bytes read, adaptation time,
+    /// measured screen-space error; writes results/came/vd.json and renders under
+    /// results/came/vd/, and the full decodes (for experiments/meshopt_vd.py) under `work`.
+    CameVd {
+        /// Folder for results.
+        #[arg(long, default_value = "results")]
+        out: PathBuf,
+        /// Folder for the full decodes (large; not results).
+        #[arg(long, default_value = "target/came-vd")]
+        work: PathBuf,
+    },
     /// `emc` on bunny-closed-35k as shared and subdivided two and three times (35k → 557k →
     /// 2.2 M vertices) and on bunny.ply, the anchor: encode and decode times and peak memory;
     /// writes results/emc/scale.json.
@@ -218,6 +230,7 @@ fn main() -> ExitCode {
         Some(Command::RepairCost { out }) => repair_cost(out),
         Some(Command::CameExtras { out }) => came_extras(out),
         Some(Command::CameFly { out }) => came_fly(out),
+        Some(Command::CameVd { out, work }) => came_vd(out, work),
         Some(Command::EmcScale { out }) => emc_scale(out),
         None => match (&cli.codec, &cli.mesh) {
             (Some(codec), Some(mesh)) => run_one(codec, mesh, &cli.settings).map(|_| ()),
@@ -642,6 +655,12 @@ fn came_extras(out: &Path) -> Result<()> {
 fn emc_scale(out: &Path) -> Result<()> {
     logged("emc-scale: reading and subdividing", |log| {
         meshcodec::emc_scale::run(out, log)
+    })
+}
+
+fn came_vd(out: &Path, work: &Path) -> Result<()> {
+    logged("came-vd: reading and encoding", |log| {
+        meshcodec::came_vd::run(out, work, log)
     })
 }
 

@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 
 mod attributes;
 mod came;
+mod came_vd;
 
 pub use attributes::{ATTRIBUTES_COMMAND, ATTRIBUTE_MESHES};
 
@@ -352,6 +353,10 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
     match came::rate_distortion(results, out) {
         Ok(p) => written.extend(p),
         Err(e) => missing.push(format!("came-rate-distortion: {e}")),
+    }
+    match came_vd::table(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("came-vd: {e}")),
     }
     match attributes::attributes_table(results, out) {
         Ok(p) => written.push(p),

@@ -25,7 +25,6 @@ pub mod cones;
 pub mod deviation;
 mod grid;
 pub mod node_id;
-mod regions;
 pub mod spheres;
 
 pub use build::{build, BuildOptions};
