@@ -85,6 +85,7 @@ pub struct ScaleResults {
 /// Resets the process's peak resident size to what is allocated now; whether the system allows
 /// it. The allocator first gives back the memory it kept from earlier phases (glibc), else the
 /// peak would start from that.
+#[allow(unsafe_code)]
 fn reset_peak() -> bool {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: malloc_trim only returns free memory of the allocator to the system.

@@ -32,6 +32,12 @@
 //! # Ok::<(), meshcodec::Error>(())
 //! ```
 
+// Unsafe code is allowed only where it is needed, each block with its SAFETY reason: the raw
+// views of `emc`'s slab lanes (`codecs::emc::clusters`, `codecs::emc::modelled::walk`), the
+// prefetch hint, and the lab's allocator trim (`emc_scale`).
+#![deny(unsafe_code)]
+#![warn(clippy::undocumented_unsafe_blocks)]
+
 pub mod codecs;
 pub mod coding;
 pub mod container;

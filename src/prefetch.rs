@@ -5,6 +5,7 @@
 /// Asks the processor to bring the cache line at `at` in. Only a hint, not an access: `at`
 /// need not be valid to read (nothing is done where the processor has no such hint).
 #[inline(always)]
+#[allow(unsafe_code)]
 pub(crate) fn prefetch<T>(at: *const T) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: a prefetch reads nothing the program sees and never faults, whatever the address.

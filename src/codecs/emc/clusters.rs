@@ -204,6 +204,7 @@ pub struct ClusterLanes {
 }
 
 // SAFETY: see the type's docs: the slabs sharing the arrays touch disjoint entries.
+#[allow(unsafe_code)]
 unsafe impl Send for ClusterLanes {}
 
 /// Entry `i` of one of [`ClusterLanes`]' arrays of `len` entries, bounds-checked, as a place.
@@ -226,6 +227,8 @@ macro_rules! read {
     }};
 }
 
+// The raw views are read and written here only (`entry!`, `read!`).
+#[allow(unsafe_code)]
 impl ClusterLanes {
     fn trie(&self) -> &KeyTrie {
         // SAFETY: the trie is only read, and outlives the view (see the type's docs).

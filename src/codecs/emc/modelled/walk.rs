@@ -812,7 +812,10 @@ struct Lanes {
 }
 
 // SAFETY: see the type's docs: the runs sharing a view touch disjoint vertices.
+#[allow(unsafe_code)]
 unsafe impl Sync for Lanes {}
+// SAFETY: as for `Sync`: a run moved to another thread still touches only its own vertices.
+#[allow(unsafe_code)]
 unsafe impl Send for Lanes {}
 
 /// One vertex's entry in an array of [`Lanes`], bounds-checked, to read.
@@ -860,6 +863,8 @@ struct Run<'a> {
     created: Vec<u32>,
 }
 
+// The lanes are read and written here only (`lane!`, `lane_mut!`).
+#[allow(unsafe_code)]
 impl Run<'_> {
     fn adjacency(&self, v: usize) -> &Neighbours {
         debug_assert!(self.owns(v), "vertex {v} read outside its slab");
@@ -1172,6 +1177,8 @@ impl Run<'_> {
 /// The neighbour lists of [`Lanes`], for [`split_edges`].
 struct LaneLists<'a>(&'a Lanes);
 
+// A lane's list, through `lane_mut!`.
+#[allow(unsafe_code)]
 impl NeighbourLists for LaneLists<'_> {
     fn list(&mut self, v: usize) -> &mut Neighbours {
         lane_mut!(self.0, adjacency, v)
