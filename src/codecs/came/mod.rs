@@ -1,6 +1,6 @@
 //! CAME: Grabner's *Compressed Adaptive Multiresolution Encoding* — a binary vertex hierarchy of
 //! any mesh coded compactly enough to be a compression format and completely enough to drive
-//! view-dependent refinement (docs/FORMAT.md §8–§9).
+//! view-dependent refinement (docs/FORMAT.md §8).
 //!
 //! Based on: M. Grabner, "Compressed Adaptive Multiresolution Encoding", WSCG 2002; the
 //! dependencies follow H. Hoppe, "View-dependent refinement of progressive meshes",
@@ -43,7 +43,7 @@ use partition::Partition;
 
 /// The bytes each level (front depth) of a CAME stream needs: the front at depth k needs every
 /// unit whose root lies above depth k, and a unit's root lies L levels below its parent's.
-/// Units come in the order their roots deepen (docs/FORMAT.md §9), so level k needs the stream
+/// Units come in the order their roots deepen (docs/FORMAT.md §8.1), so level k needs the stream
 /// up to the end of the last such unit.
 pub fn level_ends(stream: &crate::container::StreamReader, params: &Params) -> Result<Vec<u64>> {
     let units = &stream.index().units;

@@ -1,5 +1,5 @@
 //! `came`: the CAME hierarchy with every syntax element arithmetic-coded, losslessly
-//! (docs/FORMAT.md §9).
+//! (docs/FORMAT.md §8.2).
 //!
 //! Inner nodes sit at their representative vertex (left children followed down), so v_t = v_s
 //! and a split codes one integer vector d_u = v_u − v_s, with contexts from the parent's sphere.
