@@ -14,14 +14,14 @@
 //! fold-overs, work, the stream fetched so far and the bytes each frame read, the error), and
 //! renders of the farthest and nearest frames, adapted and full.
 
-use crate::came_extras::{QUANT_BITS, TABLE_MESHES};
+use crate::came_extras::{table_mesh, QUANT_BITS, TABLE_MESHES};
 use crate::came_vd::{nearest_depth, pixel_size};
 use crate::codecs::came::refine::{Budget, Camera, View, ViewMesh};
 use crate::codecs::{self, EncodeOptions};
 use crate::error::{Error, Result};
-use crate::mesh::io::{read_mesh, resolve, write_atomically};
+use crate::mesh::io::write_atomically;
 use crate::mesh::quantize::GridShape;
-use crate::mesh::{generate, TriMesh};
+use crate::mesh::TriMesh;
 use crate::plot::{Chart, Mark, Series};
 use crate::render::{render_perspective, Perspective};
 use crate::screen_error::FullMesh;
@@ -245,10 +245,7 @@ fn stream_path() -> PathBuf {
 /// step and a line every ten frames.
 pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
     let (name, subdivisions) = TABLE_MESHES[3];
-    let mut mesh = read_mesh(&resolve(name)?)?;
-    for _ in 0..subdivisions {
-        mesh = generate::subdivide(&mesh);
-    }
+    let (_, mesh) = table_mesh(name, subdivisions)?;
     let options = EncodeOptions {
         quant_bits: QUANT_BITS,
         grid: GridShape::Cubic,

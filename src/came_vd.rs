@@ -14,13 +14,13 @@
 //! the middle view's eye, so that what it holds can be seen) under results/came/vd/, and each
 //! mesh's full decode as `<work>/<mesh>.ply` for the script.
 
-use crate::came_extras::{QUANT_BITS, TABLE_MESHES};
+use crate::came_extras::{table_mesh, QUANT_BITS, TABLE_MESHES};
 use crate::codecs::came::refine::{Budget, Camera, View, ViewMesh};
 use crate::codecs::{self, EncodeOptions};
 use crate::error::{Error, Result};
-use crate::mesh::io::{read_mesh, resolve, write_atomically, write_mesh};
+use crate::mesh::io::{write_atomically, write_mesh};
 use crate::mesh::quantize::GridShape;
-use crate::mesh::{generate, Aabb, TriMesh};
+use crate::mesh::{Aabb, TriMesh};
 use crate::render::{render_perspective, Perspective};
 use crate::screen_error::FullMesh;
 use glam::DVec3;
@@ -162,10 +162,7 @@ fn one_mesh(
     subdivisions: u32,
     log: &mut dyn FnMut(String),
 ) -> Result<VdMesh> {
-    let mut mesh = read_mesh(&resolve(name)?)?;
-    for _ in 0..subdivisions {
-        mesh = generate::subdivide(&mesh);
-    }
+    let (_, mesh) = table_mesh(name, subdivisions)?;
     let options = EncodeOptions {
         quant_bits: QUANT_BITS,
         grid: GridShape::Cubic,
