@@ -169,6 +169,29 @@ fn camera_at(i: usize, centre: DVec3, radius: f64, spot: DVec3) -> Camera {
     }
 }
 
+/// The path's [`FRAMES`] cameras around and into `full`: the orbit about its bounding box's
+/// centre, then the flight to the surface point farthest along the orbit's first direction.
+pub fn cameras(full: &TriMesh) -> Result<Vec<Camera>> {
+    let bounds = crate::mesh::Aabb::around(full.positions.iter().copied())
+        .ok_or_else(|| Error::mesh("an empty mesh"))?;
+    let centre = (bounds.min + bounds.max) / 2.0;
+    let radius = (bounds.max - bounds.min).length() / 2.0;
+    let towards = DVec3::new(0.0, 0.3, 1.0).normalize();
+    let spot = full
+        .positions
+        .iter()
+        .copied()
+        .max_by(|a, b| {
+            (*a - centre)
+                .dot(towards)
+                .total_cmp(&(*b - centre).dot(towards))
+        })
+        .ok_or_else(|| Error::mesh("an empty mesh"))?;
+    Ok((0..FRAMES)
+        .map(|i| camera_at(i, centre, radius, spot))
+        .collect())
+}
+
 /// The full mesh's triangles as centroid and area, once for every frame's share in view.
 fn centroids_and_areas(mesh: &TriMesh) -> Vec<(DVec3, f64)> {
     mesh.faces
@@ -314,22 +337,7 @@ fn fly(
     stream_bytes: u64,
     log: &mut dyn FnMut(String),
 ) -> Result<Flythrough> {
-    let bounds = crate::mesh::Aabb::around(full.positions.iter().copied())
-        .ok_or_else(|| Error::mesh("an empty mesh"))?;
-    let centre = (bounds.min + bounds.max) / 2.0;
-    let radius = (bounds.max - bounds.min).length() / 2.0;
-    // The spot flown to: the surface point farthest along the path's first direction.
-    let towards = DVec3::new(0.0, 0.3, 1.0).normalize();
-    let spot = full
-        .positions
-        .iter()
-        .copied()
-        .max_by(|a, b| {
-            (*a - centre)
-                .dot(towards)
-                .total_cmp(&(*b - centre).dot(towards))
-        })
-        .ok_or_else(|| Error::mesh("an empty mesh"))?;
+    let cameras = cameras(full)?;
     let at: std::collections::HashMap<u64, DVec3> =
         leaves.iter().map(|&(id, p, _)| (id.packed(), p)).collect();
     let triangles = centroids_and_areas(full);
@@ -341,8 +349,7 @@ fn fly(
     let units = front.fetched().units;
     let mut frames = Vec::with_capacity(FRAMES);
     let (mut operations, mut adapting) = (0usize, 0.0f64);
-    for i in 0..FRAMES {
-        let camera = camera_at(i, centre, radius, spot);
+    for (i, &camera) in cameras.iter().enumerate() {
         let view = View::new(&camera, TOLERANCE_PX)?;
         let (mut splits, mut collapses, mut adapt_s, mut wait_s) = (0, 0, 0.0, 0.0);
         let (mut passes, mut adaptations, mut unsure) = (0, 0, 0);
@@ -471,7 +478,7 @@ fn fly(
                 .total_cmp(&(b.surface_in_view - 0.1).abs())
         })
         .ok_or_else(|| Error::mesh("no frames"))?;
-    let camera = camera_at(tenth.frame, centre, radius, spot);
+    let camera = cameras[tenth.frame];
     let mut cold = ViewMesh::open_file(path)?;
     cold.settle(&View::new(&camera, TOLERANCE_PX)?, Budget::UNLIMITED, 256);
     let fetched = cold.fetched();
