@@ -555,7 +555,12 @@ impl ViewMesh {
 
     /// The deepest loaded node on the path to `id`, and whether it is `id`.
     fn toward(&self, id: NodeId) -> (u32, bool) {
-        let mut v = 0u32;
+        self.toward_from(0, id)
+    }
+
+    /// [`ViewMesh::toward`], walking down from `start`, an ancestor of `id` (or `id`).
+    fn toward_from(&self, start: u32, id: NodeId) -> (u32, bool) {
+        let mut v = start;
         loop {
             let len = self.ids[v as usize].len();
             if len >= id.len() {
@@ -727,16 +732,26 @@ impl ViewMesh {
             // θ + α < 90° ⇔ cos θ > sin α (α widened by the cone's margin).
             cone.is_some() && n.dot(axis) > cone.sin as f64 * area * SLACK
         });
-        cones || self.deeper_nodes_hold_orientation(n, f)
+        cones || self.deeper_nodes_hold_orientation(n, corners, f)
     }
 
     /// The counterpart's corners lie within the spheres of the deepest loaded nodes on their
     /// leaf paths (the leaves themselves, radius 0, once loaded): a proxy triangle Q on those
     /// nodes, whose normal makes an angle β with the face's n, and whose spheres bound the
     /// angle γ between Q's normal and the counterpart's; the face is certain when β + γ < 90°.
-    fn deeper_nodes_hold_orientation(&self, n: DVec3, f: u32) -> bool {
+    ///
+    /// Each leaf path is walked down from the corner above the leaf (`corners`: active nodes,
+    /// or a collapse's parent), not from the root: half the steps or fewer, in nodes near each
+    /// other.
+    fn deeper_nodes_hold_orientation(&self, n: DVec3, corners: [u32; 3], f: u32) -> bool {
         let leaves = self.leaf_corners[f as usize];
-        let deepest = leaves.map(|leaf| self.toward(leaf).0);
+        let deepest = leaves.map(|leaf| {
+            let above = corners
+                .into_iter()
+                .find(|&c| self.ids[c as usize].is_ancestor_of(leaf))
+                .unwrap_or(0);
+            self.toward_from(above, leaf).0
+        });
         let q = deepest.map(|v| self.spheres[v as usize].0);
         let r = deepest.map(|v| self.spheres[v as usize].1);
         let Some(cos_gamma) = spheres_hold_orientation(q, r) else {
