@@ -172,21 +172,8 @@ fn camera_at(i: usize, centre: DVec3, radius: f64, spot: DVec3) -> Camera {
 /// The path's [`FRAMES`] cameras around and into `full`: the orbit about its bounding box's
 /// centre, then the flight to the surface point farthest along the orbit's first direction.
 pub fn cameras(full: &TriMesh) -> Result<Vec<Camera>> {
-    let bounds = crate::mesh::Aabb::around(full.positions.iter().copied())
-        .ok_or_else(|| Error::mesh("an empty mesh"))?;
-    let centre = (bounds.min + bounds.max) / 2.0;
-    let radius = (bounds.max - bounds.min).length() / 2.0;
-    let towards = DVec3::new(0.0, 0.3, 1.0).normalize();
-    let spot = full
-        .positions
-        .iter()
-        .copied()
-        .max_by(|a, b| {
-            (*a - centre)
-                .dot(towards)
-                .total_cmp(&(*b - centre).dot(towards))
-        })
-        .ok_or_else(|| Error::mesh("an empty mesh"))?;
+    let (centre, diagonal, spot) = crate::came_vd::framing(full)?;
+    let radius = diagonal / 2.0;
     Ok((0..FRAMES)
         .map(|i| camera_at(i, centre, radius, spot))
         .collect())

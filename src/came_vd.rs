@@ -38,8 +38,26 @@ pub const WIDTH: u32 = 1280;
 pub const HEIGHT: u32 = 720;
 pub const FOV_DEGREES: f64 = 50.0;
 pub const TOLERANCE_PX: f64 = 1.0;
-/// The direction the eyes lie in from the mesh (the fly-through's first).
-const TOWARDS: DVec3 = DVec3::new(0.0, 0.3, 1.0);
+/// The direction the eyes lie in from the mesh (the fly-through's first), unit length.
+pub fn towards() -> DVec3 {
+    DVec3::new(0.0, 0.3, 1.0).normalize()
+}
+
+/// Where the views of `mesh` are set: its bounding box's centre and diagonal, and the surface
+/// point farthest [`towards`] the eyes (the near view's, and the fly-through's last).
+pub fn framing(mesh: &TriMesh) -> Result<(DVec3, f64, DVec3)> {
+    let empty = || Error::mesh("an empty mesh");
+    let bounds = Aabb::around(mesh.positions.iter().copied()).ok_or_else(empty)?;
+    let centre = (bounds.min + bounds.max) / 2.0;
+    let along = |p: DVec3| (p - centre).dot(towards());
+    let spot = mesh
+        .positions
+        .iter()
+        .copied()
+        .max_by(|a, b| along(*a).total_cmp(&along(*b)))
+        .ok_or_else(empty)?;
+    Ok((centre, (bounds.max - bounds.min).length(), spot))
+}
 /// The command that makes it.
 pub const COMMAND: &str = "cargo run --release --bin experiment -- came-vd";
 
@@ -176,21 +194,8 @@ fn one_mesh(
     write_mesh(&full, &full_path)?;
     let stream_path = work.join(format!("{stem}.mc"));
     std::fs::write(&stream_path, &stream)?;
-    let bounds =
-        Aabb::around(full.positions.iter().copied()).ok_or_else(|| Error::mesh("an empty mesh"))?;
-    let centre = (bounds.min + bounds.max) / 2.0;
-    let diagonal = (bounds.max - bounds.min).length();
-    let towards = TOWARDS.normalize();
-    let spot = full
-        .positions
-        .iter()
-        .copied()
-        .max_by(|a, b| {
-            (*a - centre)
-                .dot(towards)
-                .total_cmp(&(*b - centre).dot(towards))
-        })
-        .ok_or_else(|| Error::mesh("an empty mesh"))?;
+    let (centre, diagonal, spot) = framing(&full)?;
+    let towards = towards();
     let reference = FullMesh::new(&full);
     let camera_from = |eye: DVec3, target: DVec3| Camera {
         eye,

@@ -122,11 +122,7 @@ pub fn deviations(
         at_corner.sort_unstable_by_key(|&(a, _)| a);
         samples.sort_unstable_by_key(|&(s, _)| s);
         let sample_at = run_starts(samples.iter().map(|&(s, _)| s), level.len());
-        let faces_at = |node: u32| {
-            let from = at_corner.partition_point(|&(a, _)| a < node);
-            let to = at_corner.partition_point(|&(a, _)| a <= node);
-            at_corner[from..to].iter().map(|&(_, f)| f)
-        };
+        let faces_at = |node: u32| faces_of(&at_corner, node);
         let measured: Vec<f64> = (0..level.len())
             .into_par_iter()
             .map(|i| {
@@ -196,40 +192,15 @@ pub fn deviations(
         under.sort_unstable();
         level_faces.sort_unstable();
         level_faces.dedup();
-        let full_faces_at = |node: u32| {
-            let from = under.partition_point(|&(a, _)| a < node);
-            let to = under.partition_point(|&(a, _)| a <= node);
-            under[from..to].iter().map(|&(_, f)| f)
-        };
         let reverse: Vec<f64> = level_faces
             .par_iter()
             .map(|corners| {
-                let [a, b, c] = corners.map(point);
-                let probes = [
-                    (a + b + c) / 3.0,
-                    (a + b) / 2.0,
-                    (b + c) / 2.0,
-                    (c + a) / 2.0,
-                ];
                 let near: Vec<[DVec3; 3]> = corners
                     .iter()
-                    .flat_map(|&x| full_faces_at(x))
+                    .flat_map(|&x| faces_of(&under, x))
                     .map(|f| faces[f as usize].map(leaf_point))
                     .collect();
-                let mut worst = 0.0f64;
-                for q in probes {
-                    let mut d = f64::INFINITY;
-                    for t in &near {
-                        d = d.min(point_triangle_distance_squared(q, t));
-                        if d <= worst {
-                            break;
-                        }
-                    }
-                    if d.is_finite() {
-                        worst = worst.max(d);
-                    }
-                }
-                worst.sqrt()
+                farthest_probe(corners.map(point), &near, 0.0).sqrt()
             })
             .collect();
         for (corners, e) in level_faces.iter().zip(reverse) {
@@ -271,11 +242,6 @@ pub fn deviations(
         under_fine.sort_unstable();
         touching.sort_unstable();
         let touching_at = run_starts(touching.iter().map(|&(s, _)| s), level.len());
-        let fine_faces_at = |node: u32| {
-            let from = under_fine.partition_point(|&(a, _)| a < node);
-            let to = under_fine.partition_point(|&(a, _)| a <= node);
-            under_fine[from..to].iter().map(|&(_, f)| f)
-        };
         let mixed: Vec<f64> = (0..level.len())
             .into_par_iter()
             .map(|i| {
@@ -297,35 +263,13 @@ pub fn deviations(
                 fan.dedup();
                 let mut worst = 0.0f64;
                 for corners in &fan {
-                    let [a, b, c] = corners.map(point);
+                    // v's own faces under v, the others' under their finer ancestors.
                     let near: Vec<[DVec3; 3]> = corners
                         .iter()
-                        .flat_map(|&x| -> Box<dyn Iterator<Item = u32> + '_> {
-                            if x == v {
-                                Box::new(full_faces_at(x))
-                            } else {
-                                Box::new(fine_faces_at(x))
-                            }
-                        })
+                        .flat_map(|&x| faces_of(if x == v { &under } else { &under_fine }, x))
                         .map(|f| faces[f as usize].map(leaf_point))
                         .collect();
-                    for q in [
-                        (a + b) / 2.0,
-                        (b + c) / 2.0,
-                        (c + a) / 2.0,
-                        (a + b + c) / 3.0,
-                    ] {
-                        let mut d = f64::INFINITY;
-                        for t in &near {
-                            d = d.min(point_triangle_distance_squared(q, t));
-                            if d <= worst {
-                                break;
-                            }
-                        }
-                        if d.is_finite() {
-                            worst = worst.max(d);
-                        }
-                    }
+                    worst = farthest_probe(corners.map(point), &near, worst);
                 }
                 worst.sqrt()
             })
@@ -342,6 +286,39 @@ pub fn deviations(
         own[n + i] = own[n + i].max(own[t as usize]).max(own[u as usize]);
     }
     own
+}
+
+/// The faces listed for `node` in `list`, (node, face) pairs sorted by node.
+fn faces_of(list: &[(u32, u32)], node: u32) -> impl Iterator<Item = u32> + '_ {
+    let from = list.partition_point(|&(a, _)| a < node);
+    let to = list.partition_point(|&(a, _)| a <= node);
+    list[from..to].iter().map(|&(_, f)| f)
+}
+
+/// The larger of `worst` and the largest squared distance from a probe of the face on
+/// corners `p` (its centroid and edge midpoints: where a face spanning a gap or cutting a
+/// corner strays farthest) to the nearest of `near`; a probe with nothing near counts nothing.
+/// A probe stops looking once it is within `worst`, which it can no longer raise.
+fn farthest_probe(p: [DVec3; 3], near: &[[DVec3; 3]], mut worst: f64) -> f64 {
+    let [a, b, c] = p;
+    for q in [
+        (a + b + c) / 3.0,
+        (a + b) / 2.0,
+        (b + c) / 2.0,
+        (c + a) / 2.0,
+    ] {
+        let mut d = f64::INFINITY;
+        for t in near {
+            d = d.min(point_triangle_distance_squared(q, t));
+            if d <= worst {
+                break;
+            }
+        }
+        if d.is_finite() {
+            worst = worst.max(d);
+        }
+    }
+    worst
 }
 
 /// Where each slot's run starts in a list sorted by slot (and, last, where the list ends).
