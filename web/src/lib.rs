@@ -7,7 +7,9 @@
 //! files. Errors are JavaScript `Error`s carrying the library's one-line message
 //! (docs/CONTRACT.md §7); a corrupt or cut stream ends in one, never in a trap.
 
+use glam::DVec3;
 use js_sys::{Array, Float64Array, Object, Reflect, Uint32Array};
+use meshcodec::codecs::came::refine::{head_length, Budget, Camera, Fetch, View, ViewMesh};
 use meshcodec::codecs::{self, LevelMesh, Stop};
 use meshcodec::container::{Header, StreamReader};
 use meshcodec::mesh::attributes::Attributes;
@@ -248,5 +250,129 @@ impl ProgressiveDecoder {
     #[wasm_bindgen(getter)]
     pub fn level(&self) -> u32 {
         self.handed as u32
+    }
+}
+
+/// A `came` stream refined to a camera, its meta-nodes fetched by the caller (a browser's
+/// `Range` requests): made from the stream's first bytes (`cameHeadLength` says how many), it
+/// adapts to a camera with the units at hand, lists the units it wants as byte ranges
+/// (`wanted`), takes their bytes (`supply`) and adapts again.
+#[wasm_bindgen]
+pub struct CameView {
+    mesh: ViewMesh,
+}
+
+/// How many of a `came` stream's first bytes `new CameView` needs (header, index, first unit),
+/// or `undefined` while `prefix` is too short to say (fetch a longer one).
+#[wasm_bindgen(js_name = cameHeadLength)]
+pub fn came_head_length(prefix: &[u8]) -> Result<Option<f64>, JsError> {
+    Ok(head_length(prefix).map_err(to_js)?.map(|n| n as f64))
+}
+
+fn vector(v: &[f64], name: &str) -> Result<DVec3, JsError> {
+    match v {
+        [x, y, z] => Ok(DVec3::new(*x, *y, *z)),
+        _ => Err(JsError::new(&format!("{name}: three numbers expected"))),
+    }
+}
+
+#[wasm_bindgen]
+impl CameView {
+    /// The front at the root, from the stream's first `cameHeadLength(…)` bytes (or more).
+    #[wasm_bindgen(constructor)]
+    pub fn new(head: &[u8]) -> Result<CameView, JsError> {
+        let mesh = ViewMesh::open(head.to_vec(), Fetch::External).map_err(to_js)?;
+        Ok(CameView { mesh })
+    }
+
+    /// Adapts to a camera (`eye`, `target`, `up` as [x, y, z]; vertical field of view in
+    /// degrees; viewport in pixels) at `tolerance` pixels, with the units supplied so far;
+    /// `twoSided` refines faces turned away too. Returns `{splits, collapses, waiting,
+    /// settled, faces, vertices}`; `waiting` splits wait for the units `wanted` lists.
+    #[allow(clippy::too_many_arguments)]
+    pub fn adapt(
+        &mut self,
+        eye: &[f64],
+        target: &[f64],
+        up: &[f64],
+        fov_degrees: f64,
+        width: u32,
+        height: u32,
+        tolerance: f64,
+        two_sided: bool,
+    ) -> Result<Object, JsError> {
+        let camera = Camera {
+            eye: vector(eye, "eye")?,
+            target: vector(target, "target")?,
+            up: vector(up, "up")?,
+            fov_degrees,
+            width,
+            height,
+        };
+        let view = View::new(&camera, tolerance)
+            .map_err(to_js)?
+            .two_sided(two_sided);
+        let done = self.mesh.adapt(&view, Budget::UNLIMITED);
+        let object = Object::new();
+        set(&object, "splits", done.splits as f64)?;
+        set(&object, "collapses", done.collapses as f64)?;
+        set(&object, "waiting", done.waiting as f64)?;
+        set(&object, "settled", done.settled)?;
+        set(&object, "faces", self.mesh.face_count() as f64)?;
+        set(&object, "vertices", self.mesh.vertex_count() as f64)?;
+        Ok(object)
+    }
+
+    /// The units the adaptations asked for since the last call, as `[unit, firstByte,
+    /// endByte, …]` (byte offsets in the stream, the end exclusive), in the order asked.
+    pub fn wanted(&mut self) -> Float64Array {
+        let flat: Vec<f64> = self
+            .mesh
+            .wanted()
+            .into_iter()
+            .flat_map(|(unit, range)| [unit as f64, range.start as f64, range.end as f64])
+            .collect();
+        Float64Array::from(flat.as_slice())
+    }
+
+    /// Hands over unit `unit`'s bytes, as `wanted` asked: decoded now, taken in at the next
+    /// `adapt` (refused there, its branch left coarse, if cut or corrupt). An `Error` if the
+    /// unit was not asked for or was supplied already.
+    pub fn supply(&mut self, unit: u32, bytes: &[u8]) -> Result<(), JsError> {
+        self.mesh.supply(unit as usize, bytes).map_err(to_js)
+    }
+
+    /// The adapted mesh: `{positions: Float64Array, indices: Uint32Array, vertices, triangles}`.
+    pub fn mesh(&self) -> Result<Object, JsError> {
+        let mesh = self.mesh.mesh();
+        let positions: Vec<f64> = mesh
+            .positions
+            .iter()
+            .flat_map(|p| [p.x, p.y, p.z])
+            .collect();
+        let indices: Vec<u32> = mesh.faces.iter().flatten().copied().collect();
+        let object = Object::new();
+        set(
+            &object,
+            "positions",
+            Float64Array::from(positions.as_slice()),
+        )?;
+        set(&object, "indices", Uint32Array::from(indices.as_slice()))?;
+        set(&object, "vertices", mesh.positions.len() as f64)?;
+        set(&object, "triangles", mesh.faces.len() as f64)?;
+        Ok(object)
+    }
+
+    /// What has been fetched: `{bytesRead, streamBytes, unitsLoaded, unitsRefused, units}`
+    /// (bytes read: the first bytes and every unit supplied).
+    pub fn fetched(&self) -> Result<Object, JsError> {
+        let f = self.mesh.fetched();
+        let object = Object::new();
+        set(&object, "bytesRead", f.bytes_read as f64)?;
+        set(&object, "streamBytes", f.stream_bytes as f64)?;
+        set(&object, "unitsLoaded", f.units_loaded as f64)?;
+        set(&object, "unitsRefused", f.units_refused as f64)?;
+        set(&object, "units", f.units as f64)?;
+        Ok(object)
     }
 }

@@ -68,6 +68,7 @@ use crate::mesh::TriMesh;
 use crate::prefetch::prefetch;
 use glam::DVec3;
 use smallvec::SmallVec;
+use std::ops::Range;
 use std::path::Path;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -299,6 +300,8 @@ pub struct ViewMesh {
     units: Vec<UnitState>,
     /// Asked for and not arrived.
     outstanding: usize,
+    /// Per meta-node: its bytes were handed over ([`Fetch::External`]).
+    supplied: Vec<bool>,
     refusals: Vec<(usize, String)>,
     bytes_read: u64,
     stream_bytes: u64,
@@ -351,6 +354,7 @@ impl ViewMesh {
             loader,
             units,
             outstanding: 1,
+            supplied: vec![false; opened.index.len()],
             refusals: Vec::new(),
             bytes_read: opened.head_bytes,
             stream_bytes: opened.stream_bytes,
@@ -374,6 +378,38 @@ impl ViewMesh {
     /// needed.
     pub fn from_stream(bytes: &[u8]) -> Result<ViewMesh> {
         ViewMesh::open(bytes.to_vec(), Fetch::Inline)
+    }
+
+    /// The meta-nodes asked for since the last call, with their byte ranges in the stream, in
+    /// the order the adaptations asked for them, when the stream was opened with
+    /// [`Fetch::External`] (none otherwise): fetch them and hand their bytes to
+    /// [`ViewMesh::supply`].
+    pub fn wanted(&mut self) -> Vec<(usize, Range<u64>)> {
+        self.loader.take_wanted()
+    }
+
+    /// Hands over the bytes of meta-node `unit`, fetched as [`ViewMesh::wanted`] asked: the
+    /// unit is decoded now and taken in at the next adaptation (refused there, its branch left
+    /// coarse, if the bytes are cut or corrupt). An error if the unit was not asked for or was
+    /// handed over already.
+    pub fn supply(&mut self, unit: usize, bytes: &[u8]) -> Result<()> {
+        match self.units.get(unit) {
+            None => {
+                return Err(Error::Unsupported(format!(
+                    "unit {unit} supplied; the stream has {} units",
+                    self.units.len()
+                )))
+            }
+            Some(UnitState::Requested) if !self.supplied[unit] => {}
+            Some(_) => {
+                return Err(Error::Unsupported(format!(
+                    "unit {unit} supplied, but it is not waited for"
+                )))
+            }
+        }
+        self.supplied[unit] = true;
+        self.loader.supply(unit, bytes);
+        Ok(())
     }
 
     /// Faces present.
@@ -1566,6 +1602,7 @@ fn ray_triangle(origin: DVec3, direction: DVec3, a: DVec3, b: DVec3, c: DVec3) -
 
 #[cfg(test)]
 mod tests {
+    use super::super::loader::head_length;
     use super::super::view::Camera;
     use super::*;
     use crate::codecs::{self, EncodeOptions, Stop};
@@ -1647,6 +1684,67 @@ mod tests {
         );
         vm.check_invariants().unwrap();
         assert_eq!((vm.vertex_count(), vm.face_count()), (1, 0));
+    }
+
+    /// A client fetching meta-nodes itself (a browser's `Range` requests) from the header, the
+    /// index and the first unit reaches the front that inline fetching reaches, asking for each
+    /// unit once and reading only what it asks for.
+    #[test]
+    fn fetching_units_externally_reaches_the_inline_front() {
+        let bytes = stream();
+        assert_eq!(head_length(&bytes[..8]).unwrap(), None);
+        let head = head_length(bytes).unwrap().unwrap() as usize;
+        assert!(head < bytes.len());
+        let view = View::new(&camera(DVec3::new(0.5, 0.8, 3.0)), 1.0).unwrap();
+        let mut inline = ViewMesh::from_stream(bytes).unwrap();
+        inline.settle(&view, Budget::UNLIMITED, 64);
+        let mut external = ViewMesh::open(bytes[..head].to_vec(), Fetch::External).unwrap();
+        assert!(
+            external.supply(0, &bytes[..1]).is_err(),
+            "the first unit is in"
+        );
+        assert!(external.supply(1 << 20, &[]).is_err(), "no such unit");
+        let mut fetched = head as u64;
+        let mut asked = std::collections::HashSet::new();
+        let mut settled = false;
+        for _ in 0..64 {
+            let done = external.adapt(&view, Budget::UNLIMITED);
+            external.check_invariants().unwrap();
+            let wanted = external.wanted();
+            if done.settled {
+                assert!(wanted.is_empty());
+                settled = true;
+                break;
+            }
+            for (unit, range) in wanted {
+                assert!(asked.insert(unit), "unit {unit} asked for twice");
+                fetched += range.end - range.start;
+                let unit_bytes = &bytes[range.start as usize..range.end as usize];
+                external.supply(unit, unit_bytes).unwrap();
+                assert!(external.supply(unit, unit_bytes).is_err(), "supplied twice");
+            }
+        }
+        assert!(settled && !asked.is_empty());
+        assert_eq!(external.fetched().bytes_read, fetched);
+        assert_eq!(external.fetched().units_loaded, asked.len() + 1);
+        assert_eq!(triangles(&external.mesh()), triangles(&inline.mesh()));
+    }
+
+    /// Bytes that are not a unit's (cut short) leave its branch coarse, refused, not a panic.
+    #[test]
+    fn a_cut_unit_supplied_is_refused() {
+        let bytes = stream();
+        let head = head_length(bytes).unwrap().unwrap() as usize;
+        let mut external = ViewMesh::open(bytes[..head].to_vec(), Fetch::External).unwrap();
+        external.adapt(&View::everything(), Budget::UNLIMITED);
+        let wanted = external.wanted();
+        let (unit, range) = wanted.first().cloned().expect("the full view wants units");
+        let cut = &bytes[range.start as usize..range.end as usize - 1];
+        external.supply(unit, cut).unwrap();
+        external.adapt(&View::everything(), Budget::UNLIMITED);
+        external.check_invariants().unwrap();
+        assert_eq!(external.refusals().len(), 1);
+        assert!(external.refusals()[0].1.contains("supplied"));
     }
 
     pub(super) fn camera(eye: DVec3) -> Camera {

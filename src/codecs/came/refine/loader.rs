@@ -57,6 +57,19 @@ impl ByteSource for Vec<u8> {
     }
 }
 
+/// How many of a stream's first bytes [`Fetch::External`] needs to open it (its header, its
+/// index and its first unit), once `prefix` holds the header and the index; `None` while it
+/// does not (fetch a longer prefix and ask again).
+pub fn head_length(prefix: &[u8]) -> Result<Option<u64>> {
+    match read_header_and_index(prefix) {
+        Ok((_, index, payload_start)) => Ok(Some(
+            payload_start as u64 + index.units.first().map_or(0, |u| u.end()),
+        )),
+        Err(Error::Truncated(_)) => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
 /// How units are fetched.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fetch {
@@ -66,6 +79,12 @@ pub enum Fetch {
     /// The units one adaptation asks for are read and decoded at the start of the next, on
     /// the caller's thread (deterministic: for tests and fuzzing).
     Inline,
+    /// The caller fetches the units asked for ([`ViewMesh::wanted`](super::ViewMesh::wanted),
+    /// their byte ranges) and hands their bytes over
+    /// ([`ViewMesh::supply`](super::ViewMesh::supply)), where reads are asynchronous: a
+    /// browser's `Range` requests. The source holds the stream's first bytes only: the header,
+    /// the index and the first unit.
+    External,
 }
 
 /// What the front takes a coded deviation for, times: the deviations are measured on the level
@@ -270,14 +289,25 @@ pub(super) enum Loader {
         requests: mpsc::Sender<usize>,
         results: mpsc::Receiver<Loaded>,
     },
+    External {
+        worker: Box<Worker>,
+        /// Asked for, not yet handed to the caller.
+        wanted: Vec<usize>,
+        /// Supplied by the caller and decoded, not yet collected.
+        supplied: Vec<Loaded>,
+    },
 }
 
 impl Loader {
     /// Reads the header and index of the stream in `source` and its first (root) unit.
     pub fn open(mut source: Box<dyn ByteSource>, fetch: Fetch) -> Result<(Loader, Opened)> {
         let size = source.size();
-        // The header's and index's length is known once they parse: read growing prefixes.
-        let mut want = 4096u64;
+        // The header's and index's length is known once they parse: read growing prefixes
+        // (an external source's bytes all at once: the caller fetched them for this).
+        let mut want = match (fetch, size) {
+            (Fetch::External, Some(size)) => size.max(1),
+            _ => 4096u64,
+        };
         let mut head = Vec::new();
         let mut head_bytes = 0u64;
         let (header, index, payload_start) = loop {
@@ -294,6 +324,8 @@ impl Loader {
         };
         let payload_start = payload_start as u64;
         let stream_bytes = payload_start + index.payload_bytes;
+        // An external source is a prefix: its length says nothing of the stream's.
+        let size = size.filter(|_| fetch != Fetch::External);
         if let Some(extra) = size
             .and_then(|s| s.checked_sub(stream_bytes))
             .filter(|&e| e > 0)
@@ -343,6 +375,11 @@ impl Loader {
                 worker,
                 queue: VecDeque::new(),
             },
+            Fetch::External => Loader::External {
+                worker,
+                wanted: Vec::new(),
+                supplied: Vec::new(),
+            },
             Fetch::Background => {
                 let (requests, inbox) = mpsc::channel::<usize>();
                 let (outbox, results) = mpsc::channel();
@@ -376,6 +413,47 @@ impl Loader {
                 // A loader thread that ended (it only ends with us) leaves the unit waiting.
                 let _ = requests.send(unit);
             }
+            Loader::External { wanted, .. } => wanted.push(unit),
+        }
+    }
+
+    /// The units asked for since the last call, each with its byte range in the stream, in
+    /// the order they were asked for (external fetching; none otherwise).
+    pub fn take_wanted(&mut self) -> Vec<(usize, std::ops::Range<u64>)> {
+        match self {
+            Loader::External { worker, wanted, .. } => wanted
+                .drain(..)
+                .map(|unit| {
+                    let entry = worker.index.units[unit];
+                    let start = worker.payload_start + entry.offset;
+                    (unit, start..start + entry.length)
+                })
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Decodes `bytes`, the caller's fetch of `unit`'s byte range: collected at the next
+    /// adaptation, refused there if they are not the unit's bytes (cut, or corrupt).
+    pub fn supply(&mut self, unit: usize, bytes: &[u8]) {
+        if let Loader::External {
+            worker, supplied, ..
+        } = self
+        {
+            let length = worker.index.units[unit].length;
+            let outcome = if bytes.len() as u64 != length {
+                Err(Error::Truncated(format!(
+                    "unit {unit} is {length} bytes; {} were supplied",
+                    bytes.len()
+                )))
+            } else {
+                worker.decoder.load(unit, bytes, &worker.header)
+            };
+            supplied.push(Loaded {
+                unit,
+                bytes: bytes.len() as u64,
+                outcome,
+            });
         }
     }
 
@@ -384,6 +462,7 @@ impl Loader {
     pub fn collect(&mut self, outstanding: usize, block: bool) -> Vec<Loaded> {
         match self {
             Loader::Inline { worker, queue } => queue.drain(..).map(|u| worker.load(u)).collect(),
+            Loader::External { supplied, .. } => std::mem::take(supplied),
             Loader::Background { results, .. } => {
                 let mut out: Vec<Loaded> = results.try_iter().collect();
                 while block && out.len() < outstanding {
