@@ -8,6 +8,12 @@
 // `onLoad` runs once the last level is in; `onLevel` after each level (geometry.userData.meshcodec
 // holds its figures and its positions in double precision). Errors arrive at `onError` as
 // `Error`s with the library's one-line message.
+//
+// View-dependent `came` streams: with `loader.viewDependent = true`, a `came` stream is not
+// downloaded: its first bytes are read, `onLevel` runs with userData.meshcodec.came set (and
+// the box the stream's grid spans), and `loader.refine(geometry, camera, width, height)` adapts
+// the geometry to a three.js camera, the worker fetching the meta-nodes it needs by Range
+// requests; `onLevel` runs after each adaptation with faces, bytes read and adaptation time.
 import { BufferAttribute, BufferGeometry, Loader } from "three";
 
 let nextId = 1;
@@ -17,6 +23,8 @@ export class MeshcodecLoader extends Loader {
     super(manager);
     this.worker = null;
     this.pending = new Map();
+    /** Refine came streams to a camera rather than download them. */
+    this.viewDependent = false;
   }
 
   /** The worker, started on first use. */
@@ -34,7 +42,8 @@ export class MeshcodecLoader extends Loader {
   /** Streams `url` into a BufferGeometry, returned at once and refined as levels arrive. */
   load(url, onLoad, onProgress, onError, onLevel) {
     const resolved = this.manager.resolveURL(this.path + url);
-    return this.decode({ url: new URL(resolved, globalThis.location?.href).href }, onLoad, onProgress, onError, onLevel);
+    const request = { url: new URL(resolved, globalThis.location?.href).href, viewDependent: this.viewDependent };
+    return this.decode(request, onLoad, onProgress, onError, onLevel);
   }
 
   /** The same for bytes already read (an ArrayBuffer, handed over to the worker). */
@@ -68,6 +77,14 @@ export class MeshcodecLoader extends Loader {
           end();
           onLoad?.(geometry);
           break;
+        case "came":
+          geometry.userData.meshcodec = { came: true, id, codec: message.codec, box: message.box, figures: message };
+          onLevel?.(geometry, geometry.userData.meshcodec);
+          break;
+        case "view":
+          setView(geometry, message);
+          onLevel?.(geometry, geometry.userData.meshcodec);
+          break;
         case "error": {
           end();
           const error = new Error(message.message);
@@ -82,12 +99,47 @@ export class MeshcodecLoader extends Loader {
     return geometry;
   }
 
+  /** Adapts a view-dependent geometry (see the top) to a camera — `{eye, target, up}` as
+   * [x, y, z] and `fov` (vertical, degrees), or a three.js PerspectiveCamera looking at
+   * `target` — on a viewport of `width` × `height` pixels, at `tolerance` pixels. */
+  refine(geometry, camera, width, height, { tolerance = 1, twoSided = false, target } = {}) {
+    const data = geometry.userData.meshcodec;
+    if (!data?.came) throw new Error("not a view-dependent came geometry");
+    const view = camera.isPerspectiveCamera
+      ? {
+          eye: camera.position.toArray(),
+          target: (target ?? camera.getWorldDirection(camera.position.clone()).add(camera.position)).toArray(),
+          up: camera.up.toArray(),
+          fov: camera.fov,
+        }
+      : { eye: camera.eye, target: camera.target, up: camera.up ?? [0, 1, 0], fov: camera.fov };
+    view.width = Math.max(1, Math.round(width));
+    view.height = Math.max(1, Math.round(height));
+    this.start().postMessage({ type: "camera", id: data.id, camera: view, tolerance, twoSided });
+  }
+
   dispose() {
     this.worker?.terminate();
     this.worker = null;
     this.pending.clear();
     return this;
   }
+}
+
+/** Puts an adapted mesh of a came stream into `geometry`, with its figures in userData. */
+function setView(geometry, view) {
+  geometry.setAttribute("position", new BufferAttribute(Float32Array.from(view.positions), 3));
+  geometry.setIndex(new BufferAttribute(view.indices, 1));
+  geometry.computeVertexNormals();
+  geometry.computeBoundingSphere();
+  const data = geometry.userData.meshcodec;
+  Object.assign(data, {
+    figures: view,
+    faces: view.faces,
+    vertices: view.vertices,
+    positions: view.positions,
+    indices: view.indices,
+  });
 }
 
 /** Puts a decoded level into `geometry`: single-precision positions for drawing (a vertex a

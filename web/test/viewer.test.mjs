@@ -34,6 +34,7 @@ before(async () => {
   execFileSync(native, ["encode", "--codec", "emc", "bunny", join(scratch, "bunny-emc.mc")]);
   const bytes = readFileSync(join(scratch, "bunny-emc.mc"));
   writeFileSync(join(scratch, "bunny-emc-cut.mc"), bytes.subarray(0, Math.floor(bytes.length * 0.6)));
+  execFileSync(native, ["encode", "--codec", "came", "bunny", join(scratch, "bunny-came-viewer.mc")]);
   // 200 KB a second: bunny's 68 KB arrive over a third of a second, its levels one by one.
   server = await serve({ root, rate: 200_000 });
   browser = await chromium.launch({
@@ -47,13 +48,13 @@ after(async () => {
   server?.server.close();
 });
 
-async function openViewer(stream) {
+async function openViewer(stream, until = () => ["done", "error"].includes(window.viewer?.state.status)) {
   const page = await browser.newPage({ viewport: { width: 800, height: 600 } });
   const problems = [];
   page.on("pageerror", (e) => problems.push(`page error: ${e.message}`));
   page.on("console", (m) => m.type() === "error" && problems.push(`console: ${m.text()}`));
   await page.goto(`http://127.0.0.1:${server.port}/web/viewer/index.html?src=/target/web-test/${stream}`);
-  await page.waitForFunction(() => ["done", "error"].includes(window.viewer?.state.status), null, { timeout: 60_000 });
+  await page.waitForFunction(until, null, { timeout: 60_000 });
   return { page, problems };
 }
 
@@ -187,6 +188,61 @@ test("a cut stream ends in the viewer's error line", async () => {
   assert.match(state.error, /ended after \d+ bytes/);
   assert.ok(state.level >= 1, "the levels its bytes hold were shown");
   assert.equal(await page.textContent("#error"), state.error);
+  assert.deepEqual(problems, []);
+  await page.close();
+});
+
+test("a came stream is refined to the viewer's camera from the meta-nodes it fetches by range", async (t) => {
+  const stream = join(scratch, "bunny-came-viewer.mc");
+  const path = "/target/web-test/bunny-came-viewer.mc";
+  const size = readFileSync(stream).length;
+  // A close look at the bunny's flank, as experiment came-vd's near view.
+  const eye = [-0.0775, 0.1389, 0.0767];
+  const target = [-0.0775, 0.1317, 0.0527];
+  const { page, problems } = await openViewer(
+    `bunny-came-viewer.mc&eye=${eye.join(",")}&target=${target.join(",")}&fov=50`,
+    () => window.viewer?.state.status === "error" || window.viewer?.state.came?.settled,
+  );
+  const state = await page.evaluate(() => window.viewer.state);
+  assert.equal(state.error, null);
+  assert.equal(state.codec, "came");
+  const came = state.came;
+  t.diagnostic(
+    `first frame after ${came.firstFrameBytes} bytes; settled with ${state.faces} faces after ${came.bytesRead} of ${size} bytes, ${came.unitsLoaded} of ${came.units} meta-nodes, ${came.views} adaptations`,
+  );
+  // The server sent what the viewer read, and no more: a part of the stream.
+  assert.equal(server.sent.get(path), came.bytesRead);
+  assert.ok(came.bytesRead < 0.9 * size, `read ${came.bytesRead} of ${size} bytes`);
+  assert.ok(came.firstFrameBytes < size / 4, `first frame after ${came.firstFrameBytes} bytes`);
+  // The mesh it holds is the one meshcodec view makes for the same camera and viewport.
+  const out = join(scratch, "viewer-came-native.ply");
+  execFileSync(native, ["view", stream, out, "--eye", eye.join(","), "--target", target.join(","), "--fov", "50", "--size", "800x600"]);
+  const ply = readFileSync(out);
+  const headerEnd = ply.indexOf("end_header\n") + "end_header\n".length;
+  const vertices = Number(/element vertex (\d+)/.exec(ply.subarray(0, headerEnd).toString("latin1"))[1]);
+  const faces = Number(/element face (\d+)/.exec(ply.subarray(0, headerEnd).toString("latin1"))[1]);
+  const data = new DataView(ply.buffer, ply.byteOffset + headerEnd);
+  const theirs = new Float64Array(vertices * 3).map((_, i) => data.getFloat64(i * 8, true));
+  const theirFaces = [];
+  for (let f = 0; f < faces; f++) {
+    const at = vertices * 24 + f * 13 + 1;
+    theirFaces.push([0, 1, 2].map((c) => data.getInt32(at + 4 * c, true)));
+  }
+  const ours = await page.evaluate(() => {
+    const data = window.viewer.mesh.geometry.userData.meshcodec;
+    return { positions: Array.from(data.positions), indices: Array.from(data.indices) };
+  });
+  assertSameBits(new Float64Array(ours.positions), theirs, "the viewer's adapted mesh");
+  const key = (t) => {
+    const least = t.indexOf(Math.min(...t));
+    return [...t.slice(least), ...t.slice(0, least)].join(" ");
+  };
+  const ourFaces = [];
+  for (let f = 0; f < ours.indices.length; f += 3) ourFaces.push(key(ours.indices.slice(f, f + 3)));
+  assert.deepEqual(ourFaces.sort(), theirFaces.map(key).sort());
+  // Drawn: the flank fills much of the frame.
+  await page.waitForFunction((frames) => window.viewer.state.frames > frames + 2, state.frames);
+  await page.screenshot({ path: join(scratch, "viewer-came.png") });
   assert.deepEqual(problems, []);
   await page.close();
 });

@@ -1,6 +1,9 @@
 // The viewer: opens the stream named by ?src= (or a file dropped on the page), shows each level
 // as it arrives with a progress bar and a line of figures, and orbits around the mesh. Its state
 // is window.viewer.state (for people and for tests: the level shown, its figures, errors).
+// A `came` stream named by ?src= is refined to the camera as it moves, its meta-nodes fetched by
+// Range requests (?view=levels downloads it level by level instead); the figures then say the
+// faces, the bytes read and the adaptation time.
 import * as THREE from "three";
 import { OrbitControls } from "three/addons/controls/OrbitControls.js";
 import { MeshcodecLoader } from "../loader.js";
@@ -66,8 +69,11 @@ const state = { status: "idle", level: 0, levels: 0, levelsSeen: [], received: 0
 window.viewer = { state, scene, camera, mesh: null };
 
 const loader = new MeshcodecLoader();
+loader.viewDependent = new URLSearchParams(location.search).get("view") !== "levels";
 let mesh = null;
 let framed = false;
+/** The address's camera while the controls have not moved it. */
+let exactCamera = null;
 
 function resize() {
   const { clientWidth: w, clientHeight: h } = canvas;
@@ -114,6 +120,35 @@ function frame(geometry) {
   controls.update();
 }
 
+/** Looks at the box a came stream's grid spans, before any of its faces is in. */
+function frameBox([low, high]) {
+  const center = new THREE.Vector3(...low).add(new THREE.Vector3(...high)).multiplyScalar(0.5);
+  const radius = new THREE.Vector3(...high).sub(new THREE.Vector3(...low)).length() / 2;
+  frame({ boundingSphere: { center, radius } });
+}
+
+/** Asks the worker to adapt the came stream's mesh to the camera now (it adapts to the newest). */
+function refineToCamera() {
+  if (!mesh?.geometry.userData.meshcodec?.came) return;
+  const size = renderer.getDrawingBufferSize(new THREE.Vector2());
+  // The address's camera exactly as given (`meshcodec view` takes the same numbers) until the
+  // controls move it.
+  const view = exactCamera
+    ? { eye: exactCamera.eye.toArray(), target: exactCamera.target.toArray(), up: exactCamera.up.toArray(), fov: exactCamera.fov }
+    : camera;
+  loader.refine(mesh.geometry, view, size.x, size.y, { tolerance: state.tolerance, target: controls.target });
+}
+
+function showCame(f) {
+  const share = f.streamBytes ? ` (${((100 * f.bytesRead) / f.streamBytes).toFixed(1)}%)` : "";
+  const adapt = f.adaptMs === undefined ? "" : ` · adapted in ${f.adaptMs.toFixed(1)} ms`;
+  figures.textContent =
+    `${state.codec} · ${state.faces.toLocaleString()} faces · ${f.bytesRead.toLocaleString()} of ${f.streamBytes.toLocaleString()} bytes read${share}` +
+    ` · ${f.unitsLoaded} of ${f.units} meta-nodes${adapt} · ${state.tolerance} px` +
+    (state.came.settled ? "" : " · refining");
+  fill.style.width = `${f.streamBytes ? (100 * f.bytesRead) / f.streamBytes : 0}%`;
+}
+
 function showFigures() {
   const bytes = state.total ? `${state.received.toLocaleString()} of ${state.total.toLocaleString()} bytes` : `${state.received.toLocaleString()} bytes`;
   const rate = state.meshVertices ? ` · ${((state.received * 8) / state.meshVertices).toFixed(2)} bits a vertex` : "";
@@ -136,6 +171,8 @@ function open(request, name) {
     error: null,
     appearance: [],
     appearanceShown: false,
+    came: null,
+    tolerance: Number(new URLSearchParams(location.search).get("tolerance")) || 1,
   });
   errorLine.textContent = "";
   framed = false;
@@ -149,6 +186,35 @@ function open(request, name) {
     showFigures();
   };
   const onLevel = (geometry, level) => {
+    if (level.came) {
+      const figures = level.figures;
+      state.codec = level.codec;
+      if (!state.came) {
+        // Opened: the header, the index and the first meta-node are in.
+        state.came = { opened: figures.bytesRead, settled: false, firstFrameBytes: 0, views: 0 };
+        if (fixedCamera) placeCamera(fixedCamera);
+        else frameBox(level.box);
+        exactCamera = fixedCamera;
+        framed = true;
+        refineToCamera();
+      } else {
+        Object.assign(state.came, {
+          settled: figures.settled,
+          adaptMs: figures.adaptMs,
+          bytesRead: figures.bytesRead,
+          streamBytes: figures.streamBytes,
+          unitsLoaded: figures.unitsLoaded,
+          units: figures.units,
+          firstFrameBytes: figures.firstFrameBytes,
+          views: state.came.views + 1,
+        });
+        state.faces = figures.faces;
+        state.vertices = figures.vertices;
+        state.status = figures.settled ? "done" : "loading";
+      }
+      showCame(figures);
+      return;
+    }
     Object.assign(state, {
       level: level.level,
       levels: level.levels,
@@ -190,7 +256,14 @@ function open(request, name) {
   scene.add(mesh);
 }
 
-addEventListener("resize", resize);
+addEventListener("resize", () => {
+  resize();
+  refineToCamera();
+});
+controls.addEventListener("start", () => {
+  exactCamera = null;
+});
+controls.addEventListener("change", refineToCamera);
 addEventListener("dragover", (e) => {
   e.preventDefault();
   document.body.classList.add("dragging");
