@@ -704,12 +704,15 @@ pub struct LevelPayload<'a> {
     pub bytes: &'a [u8],
 }
 
-/// Reads a stream's units: in order as levels, or any one by its index entry.
+/// Reads a stream's units: in order as levels, or any one by its index entry. Its bytes are
+/// borrowed ([`StreamReader::open`]) or its own ([`StreamReader::open_owned`]), and then grow as
+/// more of the stream arrives ([`StreamReader::extend`]), so that a decoder fed chunks goes on
+/// from where it stopped.
 #[derive(Clone, Debug)]
 pub struct StreamReader<'a> {
     header: Header,
     index: Index,
-    bytes: &'a [u8],
+    bytes: std::borrow::Cow<'a, [u8]>,
     payload_start: usize,
     next_level: usize,
 }
@@ -717,29 +720,40 @@ pub struct StreamReader<'a> {
 impl<'a> StreamReader<'a> {
     /// Parses the header and index of `bytes` (a whole stream or a prefix).
     pub fn open(bytes: &'a [u8]) -> Result<Self> {
-        let (header, index, payload_start) = read_header_and_index(bytes)?;
-        let present = (bytes.len() - payload_start) as u64;
-        if present > index.payload_bytes {
-            return Err(Error::malformed(
-                index.len(),
-                payload_start + index.payload_bytes as usize,
-                format!(
-                    "{} bytes after the last unit",
-                    present - index.payload_bytes
-                ),
-            ));
-        }
-        Ok(StreamReader {
+        Self::from_cow(std::borrow::Cow::Borrowed(bytes))
+    }
+
+    fn from_cow(bytes: std::borrow::Cow<'a, [u8]>) -> Result<Self> {
+        let (header, index, payload_start) = read_header_and_index(&bytes)?;
+        let reader = StreamReader {
             header,
             index,
             bytes,
             payload_start,
             next_level: 0,
-        })
+        };
+        reader.check_length()?;
+        Ok(reader)
+    }
+
+    /// Refuses bytes past the payload's end.
+    fn check_length(&self) -> Result<()> {
+        let present = (self.bytes.len() - self.payload_start) as u64;
+        if present > self.index.payload_bytes {
+            return Err(Error::malformed(
+                self.index.len(),
+                self.payload_start + self.index.payload_bytes as usize,
+                format!(
+                    "{} bytes after the last unit",
+                    present - self.index.payload_bytes
+                ),
+            ));
+        }
+        Ok(())
     }
 
     /// Its header, index, payload offset and bytes.
-    pub fn into_parts(self) -> (Header, Index, usize, &'a [u8]) {
+    pub fn into_parts(self) -> (Header, Index, usize, std::borrow::Cow<'a, [u8]>) {
         (self.header, self.index, self.payload_start, self.bytes)
     }
 
@@ -764,12 +778,12 @@ impl<'a> StreamReader<'a> {
     }
 
     /// The whole stream (or prefix) being read.
-    pub fn bytes(&self) -> &'a [u8] {
-        self.bytes
+    pub fn bytes(&self) -> &[u8] {
+        &self.bytes
     }
 
     /// Unit `i`, when all its bytes are present.
-    pub fn unit(&self, i: usize) -> Option<LevelPayload<'a>> {
+    pub fn unit(&self, i: usize) -> Option<LevelPayload<'_>> {
         let entry = self.index.units.get(i)?;
         let start = self.payload_start + entry.offset as usize;
         let end = self.payload_start + entry.end() as usize;
@@ -782,7 +796,7 @@ impl<'a> StreamReader<'a> {
 
     /// The appearance unit — its bytes, number and first byte — when the stream has one and
     /// it is wholly present.
-    pub fn appearance_unit(&self) -> Option<(&'a [u8], usize, usize)> {
+    pub fn appearance_unit(&self) -> Option<(&[u8], usize, usize)> {
         let entry = self.index.appearance?;
         let start = self.payload_start + entry.offset as usize;
         let end = self.payload_start + entry.end() as usize;
@@ -793,12 +807,13 @@ impl<'a> StreamReader<'a> {
 
     /// The next complete level, or `None` when the stream has no more (all levels read, or the
     /// bytes end inside the next one: then [`StreamReader::truncated`] is true).
-    pub fn next_level(&mut self) -> Option<LevelPayload<'a>> {
-        let unit = self.unit(self.next_level);
-        if unit.is_some() {
-            self.next_level += 1;
+    pub fn next_level(&mut self) -> Option<LevelPayload<'_>> {
+        let present = self.unit(self.next_level).is_some();
+        if !present {
+            return None;
         }
-        unit
+        self.next_level += 1;
+        self.unit(self.next_level - 1)
     }
 
     /// True when the bytes end before the payload does.
@@ -808,7 +823,7 @@ impl<'a> StreamReader<'a> {
 
     /// The bytes present of the next level when the stream was cut inside it, for codecs that
     /// can decode part of a level.
-    pub fn partial_level(&self) -> Option<LevelPayload<'a>> {
+    pub fn partial_level(&self) -> Option<LevelPayload<'_>> {
         let entry = self.index.units.get(self.next_level)?;
         let start = self.payload_start + entry.offset as usize;
         let bytes = self.bytes.get(start..)?;
@@ -817,6 +832,31 @@ impl<'a> StreamReader<'a> {
             start,
             bytes,
         })
+    }
+}
+
+impl StreamReader<'static> {
+    /// Parses the header and index of `bytes` (a whole stream or a prefix), keeping them.
+    pub fn open_owned(bytes: Vec<u8>) -> Result<Self> {
+        Self::from_cow(std::borrow::Cow::Owned(bytes))
+    }
+}
+
+impl StreamReader<'_> {
+    /// Takes the stream's next bytes (as they arrive): the levels they complete can be read
+    /// next. Bytes past the payload's end are refused, and not taken.
+    pub fn extend(&mut self, more: &[u8]) -> Result<()> {
+        let room = (self.payload_start as u64 + self.index.payload_bytes)
+            .saturating_sub(self.bytes.len() as u64);
+        if more.len() as u64 > room {
+            return Err(Error::malformed(
+                self.index.len(),
+                self.payload_start + self.index.payload_bytes as usize,
+                format!("{} bytes after the last unit", more.len() as u64 - room),
+            ));
+        }
+        self.bytes.to_mut().extend_from_slice(more);
+        Ok(())
     }
 }
 
@@ -829,6 +869,28 @@ pub struct OwnedLevel {
     pub start: usize,
     /// The payload.
     pub bytes: Vec<u8>,
+}
+
+impl LevelPayload<'_> {
+    /// A copy of the payload.
+    pub fn to_owned_level(&self) -> OwnedLevel {
+        OwnedLevel {
+            index: self.index,
+            start: self.start,
+            bytes: self.bytes.to_vec(),
+        }
+    }
+}
+
+impl OwnedLevel {
+    /// The payload, borrowed.
+    pub fn payload(&self) -> LevelPayload<'_> {
+        LevelPayload {
+            index: self.index,
+            start: self.start,
+            bytes: &self.bytes,
+        }
+    }
 }
 
 /// Where levels come from: bytes in memory, or an input stream read as levels are needed.

@@ -37,16 +37,17 @@ function concat(a, b) {
   return out;
 }
 
-/** Runs of units contiguous in the stream, each fetched with one request: [{start, end,
- * units: [[unit, start, end], …]}]. */
-function runs(wanted) {
+/** The units wanted ([unit, start, end, …]) in runs, each fetched with one request: units
+ * neighbouring in the stream, or apart by at most `gap` bytes (read and dropped: fewer
+ * requests for a few more bytes). [{start, end, units: [[unit, start, end], …]}] */
+function runs(wanted, gap) {
   const units = [];
   for (let i = 0; i < wanted.length; i += 3) units.push([wanted[i], wanted[i + 1], wanted[i + 2]]);
   units.sort((a, b) => a[1] - b[1]);
   const out = [];
   for (const unit of units) {
     const last = out[out.length - 1];
-    if (last && last.end === unit[1]) {
+    if (last && unit[1] - last.end <= gap) {
       last.end = unit[2];
       last.units.push(unit);
     } else {
@@ -58,30 +59,78 @@ function runs(wanted) {
 
 export class CameStream {
   /** A stream whose first bytes are in: use `CameStream.open`. */
-  constructor(view, read, head) {
+  constructor(view, read, head, gap) {
     this.view = view;
     this.read = read;
-    /** The stream's first bytes, as fetched to open it (the first units may lie in them). */
-    this.head = head;
+    /** Bytes between two wanted units that one request reads through. */
+    this.gap = gap;
+    /** Every byte range fetched ({start, bytes}, sorted by start): the head, and each
+     * request's bytes, gaps included, so that no byte is fetched twice. */
+    this.held = [{ start: 0, bytes: head }];
     /** Bytes fetched so far (header, index, units), and requests made. */
     this.bytesFetched = head.length;
     this.requests = 1;
   }
 
-  /** Bytes start … end − 1 of the stream: what the head holds of them, the rest fetched. */
-  async bytes(start, end) {
-    const held = this.head.length;
-    if (end <= held) return this.head.subarray(start, end);
-    const from = Math.max(start, held);
-    const rest = await this.read(from, end);
-    this.requests++;
-    this.bytesFetched += rest.length;
-    return start < held ? concat(this.head.subarray(start), rest) : rest;
+  /** The index of the last held range starting at or before `at` (0 if none). */
+  heldAt(at) {
+    let low = 0;
+    let high = this.held.length;
+    while (high - low > 1) {
+      const middle = (low + high) >> 1;
+      if (this.held[middle].start <= at) low = middle;
+      else high = middle;
+    }
+    return low;
+  }
+
+  /** Bytes start … end − 1 of the stream if they were fetched, else null. Held ranges never
+   * overlap; a unit may span neighbouring ones. */
+  heldBytes(start, end) {
+    let k = this.heldAt(start);
+    const pieces = [];
+    let at = start;
+    while (at < end && k < this.held.length) {
+      const h = this.held[k];
+      if (h.start > at || h.start + h.bytes.length <= at) return null;
+      const to = Math.min(end, h.start + h.bytes.length);
+      pieces.push(h.bytes.subarray(at - h.start, to - h.start));
+      at = to;
+      k++;
+    }
+    if (at < end) return null;
+    return pieces.length === 1 ? pieces[0] : pieces.reduce(concat);
+  }
+
+  /** Fetches what is not held of bytes start … end − 1: one request a missing stretch. */
+  async fetchMissing(start, end) {
+    const stretches = [];
+    let at = start;
+    for (let k = this.heldAt(start); k < this.held.length && at < end; k++) {
+      const h = this.held[k];
+      if (h.start + h.bytes.length <= at) continue;
+      if (h.start >= end) break;
+      if (h.start > at) stretches.push([at, h.start]);
+      at = Math.max(at, h.start + h.bytes.length);
+    }
+    if (at < end) stretches.push([at, end]);
+    await Promise.all(
+      stretches.map(async ([from, to]) => {
+        const bytes = await this.read(from, to);
+        this.requests++;
+        this.bytesFetched += bytes.length;
+        if (bytes.length === 0) return;
+        const k = this.heldAt(from);
+        const after = this.held[k].start <= from ? k + 1 : k;
+        this.held.splice(after, 0, { start: from, bytes });
+      }),
+    );
   }
 
   /** Opens a `came` stream from `source` (a URL, fetched by Range requests; or a
-   * `read(start, end)` function) having read its header, its index and its first unit. */
-  static async open(source, { firstRequest = 16384 } = {}) {
+   * `read(start, end)` function) having read its header, its index and its first unit.
+   * `gap`: units at most this many bytes apart are fetched with one request. */
+  static async open(source, { firstRequest = 16384, gap = 1024 } = {}) {
     const read = typeof source === "function" ? source : rangeReader(source);
     let head = await read(0, firstRequest);
     let requests = 1;
@@ -98,7 +147,7 @@ export class CameStream {
       head = concat(head, await read(head.length, need));
       requests++;
     }
-    const stream = new CameStream(new CameView(head), read, head);
+    const stream = new CameStream(new CameView(head), read, head, gap);
     stream.requests = requests;
     return stream;
   }
@@ -109,16 +158,26 @@ export class CameStream {
     const started = performance.now();
     const adapted = this.view.adapt(camera.eye, camera.target, camera.up ?? [0, 1, 0], camera.fov, camera.width, camera.height, tolerance, twoSided);
     adapted.ms = performance.now() - started;
-    const fetches = runs(this.view.wanted()).map(async (run) => {
-      const bytes = await this.bytes(run.start, run.end);
-      return run.units.map(([unit, start, end]) => [unit, bytes.subarray(start - run.start, end - run.start)]);
+    // Units held already (read through a gap before) are not fetched again; the others are
+    // fetched in runs, and all are handed back in the order the adaptation asked for them.
+    const wanted = this.view.wanted();
+    const missing = [];
+    for (let i = 0; i < wanted.length; i += 3) {
+      if (!this.heldBytes(wanted[i + 1], wanted[i + 2])) missing.push(wanted[i], wanted[i + 1], wanted[i + 2]);
+    }
+    const fetches = Promise.all(runs(missing, this.gap).map((run) => this.fetchMissing(run.start, run.end)));
+    const fetched = fetches.then(() => {
+      const units = [];
+      for (let i = 0; i < wanted.length; i += 3) units.push([wanted[i], this.heldBytes(wanted[i + 1], wanted[i + 2])]);
+      return units;
     });
-    return { adapted, fetched: Promise.all(fetches).then((parts) => parts.flat()) };
+    return { adapted, fetched };
   }
 
   /** Hands over fetched units (as `round` returns them), decoded at once. */
   supply(units) {
-    for (const [unit, bytes] of units) this.view.supply(unit, bytes);
+    // Bytes the source did not have (a stream cut short) are no unit's: refused, not thrown.
+    for (const [unit, bytes] of units) this.view.supply(unit, bytes ?? new Uint8Array(0));
   }
 
   /** Refines to `camera` until the front settles (at most `rounds` adaptations, as `meshcodec

@@ -143,6 +143,29 @@ pub fn decode_every_way(bytes: &[u8]) {
     if codecs::by_id(header.codec_id).is_ok_and(|c| c.name().starts_with("pm")) {
         walk_pm_iterator(bytes);
     }
+    check_progressive(bytes);
+}
+
+/// The stream fed to [`codecs::Progressive`] in a few chunks: every level handed over is the
+/// level `decode` makes of the bytes received (what a browser's `ProgressiveDecoder` shows).
+fn check_progressive(bytes: &[u8]) {
+    let mut progressive = codecs::Progressive::new();
+    let step = bytes.len() / 3 + 1;
+    let mut received = 0;
+    for chunk in bytes.chunks(step) {
+        received += chunk.len();
+        match progressive.push(chunk) {
+            Ok(Some((mesh, level))) => {
+                let whole = codecs::decode(&bytes[..received], Stop::Levels(level));
+                assert!(
+                    whole.as_ref().is_ok_and(|(m, n)| *n == level && *m == mesh),
+                    "level {level} handed over after {received} bytes differs from its decode: {whole:?}"
+                );
+            }
+            Ok(None) => {}
+            Err(_) => return,
+        }
+    }
 }
 
 /// `codecs::level_ends` of a stream of `levels` levels whose first `decoded` levels decoded:
@@ -562,10 +585,42 @@ pub fn adapt_came(data: &[u8]) {
     }
     front.settle(&View::everything(), Budget::UNLIMITED, 64);
     assert_eq!(front.check_invariants(), Ok(()));
+    adapt_came_external(&stream_of("came", body), views);
     let mesh = front.mesh();
     assert!(mesh
         .faces
         .iter()
         .flatten()
         .all(|&v| (v as usize) < mesh.positions.len()));
+}
+
+/// The same stream refined with its units fetched by the caller (`Fetch::External`, a
+/// browser's `Range` requests) from its first bytes: units handed over as asked, some cut
+/// short or asked for twice as `views` says; every invariant holds after each adaptation.
+fn adapt_came_external(stream: &[u8], views: &[u8]) {
+    use meshcodec::codecs::came::refine::{head_length, Budget, Fetch, View, ViewMesh};
+    let Ok(Some(head)) = head_length(stream) else {
+        return;
+    };
+    let head = (head as usize).min(stream.len());
+    let Ok(mut front) = ViewMesh::open(stream[..head].to_vec(), Fetch::External) else {
+        return;
+    };
+    let cut = views.first().copied().unwrap_or(0);
+    for round in 0..32 {
+        let done = front.adapt(&View::everything(), Budget::UNLIMITED);
+        assert_eq!(front.check_invariants(), Ok(()));
+        if done.settled {
+            break;
+        }
+        for (k, (unit, range)) in front.wanted().into_iter().enumerate() {
+            let start = (range.start as usize).min(stream.len());
+            let mut end = (range.end as usize).min(stream.len());
+            if cut != 0 && (k + round) % (cut as usize) == 0 {
+                end = end.saturating_sub(1).max(start);
+            }
+            assert!(front.supply(unit, &stream[start..end]).is_ok());
+            assert!(front.supply(unit, &stream[start..end]).is_err());
+        }
+    }
 }

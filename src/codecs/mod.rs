@@ -11,6 +11,7 @@ pub mod came;
 pub mod emc;
 pub mod names;
 pub mod pm;
+mod progressive;
 pub mod raw;
 pub mod stats;
 
@@ -189,6 +190,13 @@ pub trait LevelDecoder: Send {
     fn partial_levels(&mut self) -> Option<&mut dyn PartialLevels> {
         None
     }
+    /// Takes the stream's next bytes as they arrive (a decoder opened by [`open_owned`] on a
+    /// prefix): the levels they complete decode next, from where the decoder stands.
+    /// `Ok(false)` from a decoder that cannot take more, and has not taken them (it is opened
+    /// again on the longer prefix); bytes past the stream's end are an error.
+    fn extend(&mut self, _more: &[u8]) -> Result<bool> {
+        Ok(false)
+    }
 }
 
 /// A decoder that can stop after any pass of a level.
@@ -206,6 +214,8 @@ pub trait PartialLevels {
     /// more could be decoded.
     fn advance_partial(&mut self) -> Result<bool>;
 }
+
+pub use progressive::Progressive;
 
 /// Every codec of this build.
 pub fn registry() -> Vec<&'static dyn Codec> {
@@ -362,9 +372,21 @@ pub fn canonical_attributed_for(
 /// A decoder for any stream, chosen by the codec id in its header; a stream with an appearance
 /// unit decodes it after its last level.
 pub fn open(bytes: &[u8]) -> Result<Box<dyn LevelDecoder + '_>> {
-    let reader = StreamReader::open(bytes)?;
+    open_reader(StreamReader::open(bytes)?)
+}
+
+/// [`open`] on bytes the decoder keeps, so that it can take more as they arrive
+/// ([`LevelDecoder::extend`]; [`Progressive`] feeds it).
+pub fn open_owned(bytes: Vec<u8>) -> Result<Box<dyn LevelDecoder>> {
+    open_reader(StreamReader::open_owned(bytes)?)
+}
+
+fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
     let appearance = reader.header().appearance.clone().filter(|a| !a.in_levels);
-    let unit = reader.appearance_unit();
+    // Kept apart from the reader, which the codec's decoder takes.
+    let unit = reader
+        .appearance_unit()
+        .map(|(bytes, number, start)| (bytes.to_vec(), number, start));
     let codec = by_id(reader.header().codec_id)?;
     let in_levels = reader
         .header()

@@ -8,6 +8,7 @@ import { readFileSync } from "node:fs";
 import { fileURLToPath } from "node:url";
 import draco3d from "draco3d";
 import init, { decode } from "../pkg/meshcodec.js";
+import { dracoDecode as decodeWith, dracoEncode as encodeWith } from "./draco-lib.mjs";
 
 const [stream, rounds = "5", repeats = "5"] = process.argv.slice(2);
 if (!stream) {
@@ -19,48 +20,8 @@ const bytes = new Uint8Array(readFileSync(stream));
 const mesh = decode(bytes);
 const [encoderModule, decoderModule] = await Promise.all([draco3d.createEncoderModule({}), draco3d.createDecoderModule({})]);
 
-function dracoEncode({ positions, indices }) {
-  const encoder = new encoderModule.Encoder();
-  const builder = new encoderModule.MeshBuilder();
-  const dracoMesh = new encoderModule.Mesh();
-  builder.AddFacesToMesh(dracoMesh, indices.length / 3, indices);
-  builder.AddFloatAttributeToMesh(dracoMesh, encoderModule.POSITION, positions.length / 3, 3, Float32Array.from(positions));
-  encoder.SetAttributeQuantization(encoderModule.POSITION, 12);
-  encoder.SetSpeedOptions(0, 0);
-  encoder.SetEncodingMethod(encoderModule.MESH_EDGEBREAKER_ENCODING);
-  const out = new encoderModule.DracoInt8Array();
-  const length = encoder.EncodeMeshToDracoBuffer(dracoMesh, out);
-  if (length <= 0) throw new Error(`Draco could not encode: ${encoder.GetErrorMessage?.() ?? ""}`);
-  const encoded = new Int8Array(length);
-  for (let i = 0; i < length; i++) encoded[i] = out.GetValue(i);
-  for (const object of [out, dracoMesh, builder, encoder]) encoderModule.destroy(object);
-  return encoded;
-}
-
-/** Draco's decode as three.js's DRACOLoader does it: the mesh, then its arrays. */
-function dracoDecode(encoded) {
-  const decoder = new decoderModule.Decoder();
-  const buffer = new decoderModule.DecoderBuffer();
-  buffer.Init(encoded, encoded.length);
-  const dracoMesh = new decoderModule.Mesh();
-  const status = decoder.DecodeBufferToMesh(buffer, dracoMesh);
-  if (!status.ok()) throw new Error(`Draco: ${status.error_msg()}`);
-  const points = dracoMesh.num_points();
-  const faces = dracoMesh.num_faces();
-  const attribute = decoder.GetAttribute(dracoMesh, decoder.GetAttributeId(dracoMesh, decoderModule.POSITION));
-  const floats = points * 3;
-  let ptr = decoderModule._malloc(floats * 4);
-  decoder.GetAttributeDataArrayForAllPoints(dracoMesh, attribute, decoderModule.DT_FLOAT32, floats * 4, ptr);
-  const positions = new Float32Array(decoderModule.HEAPF32.buffer, ptr, floats).slice();
-  decoderModule._free(ptr);
-  ptr = decoderModule._malloc(faces * 12);
-  decoder.GetTrianglesUInt32Array(dracoMesh, faces * 12, ptr);
-  const indices = new Uint32Array(decoderModule.HEAPU32.buffer, ptr, faces * 3).slice();
-  decoderModule._free(ptr);
-  for (const object of [dracoMesh, buffer, decoder]) decoderModule.destroy(object);
-  return { positions, indices };
-}
-
+const dracoEncode = (m) => encodeWith(encoderModule, m);
+const dracoDecode = (e) => decodeWith(decoderModule, e);
 const encoded = dracoEncode(mesh);
 const check = dracoDecode(encoded);
 if (check.indices.length !== mesh.indices.length) throw new Error("Draco's mesh has another face count");

@@ -10,7 +10,7 @@
 use glam::DVec3;
 use js_sys::{Array, Float64Array, Object, Reflect, Uint32Array};
 use meshcodec::codecs::came::refine::{head_length, Budget, Camera, Fetch, View, ViewMesh};
-use meshcodec::codecs::{self, LevelMesh, Stop};
+use meshcodec::codecs::{self, LevelMesh, Progressive, Stop};
 use meshcodec::container::{Header, StreamReader};
 use meshcodec::mesh::attributes::Attributes;
 use wasm_bindgen::prelude::*;
@@ -181,14 +181,12 @@ pub fn info(bytes: &[u8]) -> Result<Object, JsError> {
 }
 
 /// A decoder fed a stream's bytes as they arrive (the chunks of `fetch()`'s `ReadableStream`):
-/// each `push` returns the newest level its bytes completed, if any.
+/// each `push` returns the newest level its bytes completed, if any. `emc`, `emc-paper` and
+/// `raw` streams decode each level once, going on from the last; the others are decoded again
+/// from their first level for each level handed over (`incremental` says which).
 #[wasm_bindgen]
 pub struct ProgressiveDecoder {
-    bytes: Vec<u8>,
-    /// Where each level ends, once the header and index are in.
-    ends: Option<Vec<u64>>,
-    /// Levels handed over so far.
-    handed: usize,
+    inner: Progressive,
 }
 
 impl Default for ProgressiveDecoder {
@@ -203,9 +201,7 @@ impl ProgressiveDecoder {
     #[wasm_bindgen(constructor)]
     pub fn new() -> ProgressiveDecoder {
         ProgressiveDecoder {
-            bytes: Vec::new(),
-            ends: None,
-            handed: 0,
+            inner: Progressive::new(),
         }
     }
 
@@ -213,43 +209,45 @@ impl ProgressiveDecoder {
     /// `decode` returns), or `undefined` when the chunk completed none. Levels completed by
     /// the same chunk are handed over as one, the newest.
     pub fn push(&mut self, chunk: &[u8]) -> Result<JsValue, JsError> {
-        self.bytes.extend_from_slice(chunk);
-        if self.ends.is_none() {
-            match codecs::level_ends(&self.bytes) {
-                Ok(ends) => self.ends = Some(ends),
-                Err(meshcodec::Error::Truncated(_)) => return Ok(JsValue::UNDEFINED),
-                Err(e) => return Err(to_js(e)),
-            }
-        }
-        let ends = self.ends.as_deref().unwrap_or_default();
-        let complete = ends
-            .iter()
-            .take_while(|&&end| end <= self.bytes.len() as u64)
-            .count();
-        if complete <= self.handed {
+        let Some((mesh, level)) = self.inner.push(chunk).map_err(to_js)? else {
             return Ok(JsValue::UNDEFINED);
+        };
+        if mesh.mesh.positions.is_empty() {
+            return Err(JsError::new(&format!(
+                "the first {} bytes hold no complete level",
+                self.inner.received()
+            )));
         }
-        self.handed = complete;
-        let level = decode(&self.bytes, Some(complete as u32), None)?;
-        Ok(level.into())
+        let header = self
+            .inner
+            .header()
+            .ok_or_else(|| JsError::new("a level before the header"))?;
+        Ok(level_object(&mesh, level, self.inner.levels(), header)?.into())
     }
 
     /// Bytes taken so far.
     #[wasm_bindgen(getter)]
     pub fn received(&self) -> f64 {
-        self.bytes.len() as f64
+        self.inner.received() as f64
     }
 
     /// Levels the stream holds (0 until its header and index are in).
     #[wasm_bindgen(getter)]
     pub fn levels(&self) -> u32 {
-        self.ends.as_ref().map_or(0, |e| e.len() as u32)
+        self.inner.levels() as u32
     }
 
     /// Levels handed over so far.
     #[wasm_bindgen(getter)]
     pub fn level(&self) -> u32 {
-        self.handed as u32
+        self.inner.level() as u32
+    }
+
+    /// Whether each level is decoded once, going on from the last (else from the first level
+    /// at each hand-over).
+    #[wasm_bindgen(getter)]
+    pub fn incremental(&self) -> bool {
+        self.inner.incremental()
     }
 }
 

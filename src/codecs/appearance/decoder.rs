@@ -11,7 +11,7 @@ pub struct WithAppearance<'a> {
     inner: Box<dyn LevelDecoder + 'a>,
     spec: AppearanceSpec,
     /// The unit's bytes when wholly present, its number and first byte.
-    unit: Option<(&'a [u8], usize, usize)>,
+    unit: Option<(Vec<u8>, usize, usize)>,
     decoded: Option<Attributes>,
 }
 
@@ -21,7 +21,7 @@ impl<'a> WithAppearance<'a> {
     pub fn new(
         inner: Box<dyn LevelDecoder + 'a>,
         spec: AppearanceSpec,
-        unit: Option<(&'a [u8], usize, usize)>,
+        unit: Option<(Vec<u8>, usize, usize)>,
     ) -> Self {
         WithAppearance {
             inner,
@@ -45,9 +45,9 @@ impl LevelDecoder for WithAppearance<'_> {
     fn advance(&mut self) -> Result<bool> {
         let advanced = self.inner.advance()?;
         if advanced && self.inner.levels_decoded() == self.inner.levels() {
-            if let Some((bytes, unit, start)) = self.unit {
+            if let Some((bytes, unit, start)) = &self.unit {
                 let full = self.inner.mesh()?;
-                self.decoded = Some(super::decode(bytes, unit, start, &self.spec, &full.mesh)?);
+                self.decoded = Some(super::decode(bytes, *unit, *start, &self.spec, &full.mesh)?);
             }
         }
         Ok(advanced)

@@ -328,7 +328,7 @@ pub struct CameDecoder<'a, U: UnitDecoder> {
     payload_start: usize,
     /// The stream or prefix the units are read from (empty for a detached decoder, which is
     /// given each unit's bytes).
-    bytes: &'a [u8],
+    bytes: std::borrow::Cow<'a, [u8]>,
     params: Params,
     units: U,
     tree: DecodedTree,
@@ -361,14 +361,21 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         params: Params,
         units: U,
     ) -> Result<CameDecoder<'static, U>> {
-        CameDecoder::with_parts(header, index, payload_start, &[], params, units)
+        CameDecoder::with_parts(
+            header,
+            index,
+            payload_start,
+            std::borrow::Cow::Borrowed(&[]),
+            params,
+            units,
+        )
     }
 
     fn with_parts(
         header: Header,
         index: Index,
         payload_start: usize,
-        bytes: &'a [u8],
+        bytes: std::borrow::Cow<'a, [u8]>,
         params: Params,
         units: U,
     ) -> Result<Self> {
@@ -477,10 +484,11 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         };
         let start = self.payload_start + entry.offset as usize;
         let end = self.payload_start + entry.end() as usize;
-        let Some(bytes) = self.bytes.get(start..end) else {
+        // A copy: the decoder's bytes may be its own, and decoding changes the decoder.
+        let Some(bytes) = self.bytes.get(start..end).map(<[u8]>::to_vec) else {
             return Ok(false);
         };
-        self.decode_unit_bytes(i, bytes)?;
+        self.decode_unit_bytes(i, &bytes)?;
         Ok(true)
     }
 

@@ -115,7 +115,9 @@ impl<'a> PMeshIter<'a> {
         Self::from_source(Box::new(ReadLevels::open(reader)?))
     }
 
-    fn from_source(mut stream: Box<dyn LevelSource + Send + 'a>) -> Result<PMeshIter<'a>> {
+    pub(crate) fn from_source(
+        mut stream: Box<dyn LevelSource + Send + 'a>,
+    ) -> Result<PMeshIter<'a>> {
         let header = stream.header().clone();
         let params = PmParams::from_header(&header)?;
         let base = stream

@@ -653,7 +653,7 @@ impl Codec for Pm {
         PmParams::from_header(&header)?;
         Ok(Box::new(PmDecoder {
             levels: stream.index().len(),
-            bytes: stream.bytes(),
+            stream: Some(stream),
             header,
             iter: None,
             decoded: 0,
@@ -826,7 +826,8 @@ fn encode_pm(
 /// Level-by-level decoder over a [`PMeshIter`]; the first level (the base mesh) is read by the
 /// first `advance`.
 struct PmDecoder<'a> {
-    bytes: &'a [u8],
+    /// The stream, until the iterator takes it (once its base mesh is present).
+    stream: Option<StreamReader<'a>>,
     header: Header,
     iter: Option<PMeshIter<'a>>,
     levels: usize,
@@ -849,13 +850,12 @@ impl LevelDecoder for PmDecoder<'_> {
     fn advance(&mut self) -> Result<bool> {
         let advanced = match self.iter.as_mut() {
             Some(iter) => iter.next_level()?,
-            None => match PMeshIter::from_stream(self.bytes) {
-                Ok(iter) => {
-                    self.iter = Some(iter);
+            None => match self.stream.take_if(|s| s.unit(0).is_some()) {
+                Some(stream) => {
+                    self.iter = Some(PMeshIter::from_source(Box::new(stream))?);
                     true
                 }
-                Err(Error::Truncated(_)) => false,
-                Err(e) => return Err(e),
+                None => false,
             },
         };
         self.decoded += advanced as usize;

@@ -112,6 +112,10 @@ struct RawDecoder<'a> {
 }
 
 impl LevelDecoder for RawDecoder<'_> {
+    fn extend(&mut self, more: &[u8]) -> Result<bool> {
+        self.stream.extend(more)?;
+        Ok(true)
+    }
     fn header(&self) -> &Header {
         self.stream.header()
     }
@@ -125,10 +129,10 @@ impl LevelDecoder for RawDecoder<'_> {
     }
 
     fn advance(&mut self) -> Result<bool> {
+        let header = self.stream.header().clone();
         let Some(level) = self.stream.next_level() else {
             return Ok(false);
         };
-        let header = self.stream.header().clone();
         let (v, t) = (header.vertices, header.triangles);
         let q = header.grid.bits as u64;
         let b = index_bits(v) as u64;

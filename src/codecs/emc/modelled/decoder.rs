@@ -252,14 +252,15 @@ impl<'a> EmcDecoder<'a> {
 
     fn decode_passes_here(&mut self, passes: usize) -> Result<bool> {
         self.check_failed()?;
-        let Some(payload) = self.stream.next_level() else {
+        // Owned: decoding the level changes the decoder, which may own the stream's bytes.
+        let Some(payload) = self.stream.next_level().map(|p| p.to_owned_level()) else {
             return Ok(false);
         };
         let level = self.levels_done + 1;
         let fault = |what: String| Error::malformed(level, payload.start, what);
         let threads = rayon::current_num_threads() > 1;
         let mut side =
-            DecoderSide::new(payload.bytes, self.params.slabs as usize, threads).map_err(fault)?;
+            DecoderSide::new(&payload.bytes, self.params.slabs as usize, threads).map_err(fault)?;
         let outcome = (|| {
             self.walker.level(
                 &mut side,
@@ -321,6 +322,10 @@ impl<'a> EmcDecoder<'a> {
 }
 
 impl LevelDecoder for EmcDecoder<'_> {
+    fn extend(&mut self, more: &[u8]) -> Result<bool> {
+        self.stream.extend(more)?;
+        Ok(true)
+    }
     fn header(&self) -> &Header {
         &self.header
     }

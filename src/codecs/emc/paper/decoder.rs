@@ -133,6 +133,10 @@ impl<'a> EmcDecoder<'a> {
 }
 
 impl LevelDecoder for EmcDecoder<'_> {
+    fn extend(&mut self, more: &[u8]) -> Result<bool> {
+        self.stream.extend(more)?;
+        Ok(true)
+    }
     fn header(&self) -> &Header {
         &self.header
     }
@@ -146,10 +150,10 @@ impl LevelDecoder for EmcDecoder<'_> {
     }
 
     fn advance(&mut self) -> Result<bool> {
-        let Some(payload) = self.stream.next_level() else {
+        let Some(payload) = self.stream.next_level().map(|p| p.to_owned_level()) else {
             return Ok(false);
         };
-        match self.decode_level(&payload) {
+        match self.decode_level(&payload.payload()) {
             Ok(()) => {
                 self.levels_done += 1;
                 Ok(true)
@@ -183,10 +187,10 @@ impl PassStops for EmcDecoder<'_> {
     }
 
     fn advance_passes(&mut self, passes: usize) -> Result<bool> {
-        let Some(payload) = self.stream.next_level() else {
+        let Some(payload) = self.stream.next_level().map(|p| p.to_owned_level()) else {
             return Ok(false);
         };
-        match self.decode_passes(&payload, passes) {
+        match self.decode_passes(&payload.payload(), passes) {
             Ok(()) => Ok(true),
             Err(Stop::Fault(e)) => Err(e),
             Err(Stop::OutOfBits) => Err(Error::malformed(
@@ -200,11 +204,11 @@ impl PassStops for EmcDecoder<'_> {
 
 impl PartialLevels for EmcDecoder<'_> {
     fn advance_partial(&mut self) -> Result<bool> {
-        let Some(payload) = self.stream.partial_level() else {
+        let Some(payload) = self.stream.partial_level().map(|p| p.to_owned_level()) else {
             return Ok(false);
         };
         let before = self.state.depth.iter().map(|&d| d as usize).sum::<usize>();
-        match self.decode_level(&payload) {
+        match self.decode_level(&payload.payload()) {
             Ok(()) | Err(Stop::OutOfBits) => {}
             Err(Stop::Fault(e)) => return Err(e),
         }
