@@ -21,10 +21,12 @@ const TYPES = {
 
 /** Serves `root` on 127.0.0.1:`port` (0: any free port), `.mc` streams at `rate` bytes a second
  * when given (so that levels arrive one after another, as over a slow network); resolves to
- * {server, port, sent}. */
+ * {server, port, sent, requests}: `sent` the bytes sent a path, `requests` each request as
+ * {path, start, end (inclusive), status} in the order they came. */
 export function serve({ root, port = 0, rate = 0 }) {
   root = resolve(root);
   const sent = new Map();
+  const requests = [];
   const server = createServer((request, response) => {
     const path = decodeURIComponent(new URL(request.url, "http://localhost").pathname);
     const file = normalize(join(root, path));
@@ -65,6 +67,7 @@ export function serve({ root, port = 0, rate = 0 }) {
       headers["Content-Range"] = `bytes ${start}-${end}/${stat.size}`;
     }
     headers["Content-Length"] = String(end - start + 1);
+    requests.push({ path, start, end, status: range && headers["Content-Range"] ? 206 : 200 });
     response.writeHead(range && headers["Content-Range"] ? 206 : 200, headers);
     if (request.method === "HEAD") {
       response.end();
@@ -92,7 +95,7 @@ export function serve({ root, port = 0, rate = 0 }) {
     stream.pipe(response);
   });
   return new Promise((done) => {
-    server.listen(port, "127.0.0.1", () => done({ server, port: server.address().port, sent }));
+    server.listen(port, "127.0.0.1", () => done({ server, port: server.address().port, sent, requests }));
   });
 }
 

@@ -210,8 +210,14 @@ test("a came stream is refined to the viewer's camera from the meta-nodes it fet
   t.diagnostic(
     `first frame after ${came.firstFrameBytes} bytes; settled with ${state.faces} faces after ${came.bytesRead} of ${size} bytes, ${came.unitsLoaded} of ${came.units} meta-nodes, ${came.views} adaptations`,
   );
-  // The server sent what the viewer read, and no more: a part of the stream.
+  // The server sent what the viewer read, and no more: a part of the stream, by Range
+  // requests; before the first frame, one request for the head.
   assert.equal(server.sent.get(path), came.bytesRead);
+  const asked = server.requests.filter((r) => r.path === path);
+  assert.ok(asked.every((r) => r.status === 206));
+  assert.equal(asked[0].start, 0);
+  assert.equal(asked[0].end + 1, came.firstFrameBytes, "the first frame after the first request");
+  t.diagnostic(`${asked.length} requests`);
   assert.ok(came.bytesRead < 0.9 * size, `read ${came.bytesRead} of ${size} bytes`);
   assert.ok(came.firstFrameBytes < size / 4, `first frame after ${came.firstFrameBytes} bytes`);
   // The mesh it holds is the one meshcodec view makes for the same camera and viewport.

@@ -1,0 +1,393 @@
+//! `came`'s encoder: what it derives once for all units (positions, spheres, deviations,
+//! cones, the triangles born at each split), then each unit's two passes.
+
+use super::super::knowledge::Status;
+use super::super::partition::Partition;
+use super::super::{born_triangles, BornTriangle};
+use super::contexts::*;
+use crate::coding::arith::{ArithEncoder, BitContext, UintContext};
+use crate::coding::SyntaxClass;
+use crate::hierarchy::came::cones::{self, coded_cones, CodedCone, ANGLE_BITS, NO_CONE};
+use crate::hierarchy::came::deviation::{
+    decoded_deviation, deviation_code, deviations, round_up, DEVIATION_BITS,
+};
+use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
+use crate::hierarchy::came::{NodeId, VertexTree};
+use crate::mesh::attribute_quantization::octahedral_max;
+use crate::mesh::CanonicalMesh;
+
+/// Codes a node's cone: its half-angle code, then, unless its parent has a cone (whose axis
+/// it takes), its axis.
+fn put_cone(enc: &mut ArithEncoder, ctx: &mut Contexts, parent: CodedCone, cone: CodedCone) {
+    let class = cone_class(parent);
+    let g = SyntaxClass::Geometry;
+    put_symbol(
+        enc,
+        &mut ctx.cone_angle[class],
+        cone.angle.into(),
+        ANGLE_BITS,
+        g,
+        "cones",
+    );
+    if (cone.angle as u32) < NO_CONE && class == 0 {
+        let centre = octahedral_max(cones::AXIS_BITS) / 2;
+        for k in 0..2 {
+            let d = cone.axis[k] as i64 - centre as i64;
+            enc.int(&mut ctx.cone_axis[k], d, g, "cones");
+        }
+    }
+}
+
+/// What the encoder derives once for all units.
+pub(super) struct Encoder<'a> {
+    tree: &'a VertexTree,
+    part: &'a Partition,
+    grid_bits: u8,
+    /// Position of each node: its representative vertex.
+    positions: Vec<[f64; 3]>,
+    /// The decoder's (rounded-up) sphere radii, and each inner non-root node's ratio code.
+    radii: Vec<f64>,
+    ratio_codes: Vec<u32>,
+    /// The decoder's (rounded-up) deviations, and each inner non-root node's deviation code.
+    deviations: Vec<f32>,
+    deviation_codes: Vec<u32>,
+    /// Each node's normal cone as coded.
+    cones: Vec<CodedCone>,
+    born: Vec<Vec<BornTriangle>>,
+}
+
+impl<'a> Encoder<'a> {
+    pub(super) fn new(
+        tree: &'a VertexTree,
+        mesh: &CanonicalMesh,
+        part: &'a Partition,
+    ) -> Encoder<'a> {
+        let n = tree.leaves;
+        let leaf: Vec<[f64; 3]> = mesh.cells.iter().map(|c| c.map(|x| x as f64)).collect();
+        let positions: Vec<[f64; 3]> = (0..tree.node_count() as u32)
+            .map(|v| leaf[tree.representative(v) as usize])
+            .collect();
+        let exact = exact_radii(&leaf, &tree.children, &positions);
+        let mut radii = vec![0.0; tree.node_count()];
+        let mut ratio_codes = vec![0; tree.node_count()];
+        radii[tree.root as usize] = exact[tree.root as usize].ceil();
+        for s in tree.breadth_first() {
+            let [t, u] = tree.children_of(s).expect("inner");
+            for c in [t, u] {
+                if (c as usize) >= n {
+                    let base = ratio_base(
+                        radii[s as usize],
+                        positions[s as usize],
+                        positions[c as usize],
+                    );
+                    let code = ratio_code(exact[c as usize], base, RADIUS_BITS);
+                    radii[c as usize] = decoded_radius(code, base, RADIUS_BITS);
+                    ratio_codes[c as usize] = code;
+                }
+            }
+        }
+        let measured = deviations(tree, &leaf, &mesh.faces, &positions);
+        let mut deviations = vec![0.0f32; tree.node_count()];
+        let mut deviation_codes = vec![0; tree.node_count()];
+        deviations[tree.root as usize] = round_up(measured[tree.root as usize].ceil());
+        for s in tree.breadth_first() {
+            let [t, u] = tree.children_of(s).expect("inner");
+            for c in [t, u] {
+                if (c as usize) >= n {
+                    let parent = deviations[s as usize];
+                    let code = deviation_code(measured[c as usize], parent);
+                    deviations[c as usize] = decoded_deviation(code, parent);
+                    deviation_codes[c as usize] = code;
+                }
+            }
+        }
+        let cones = coded_cones(tree, &mesh.cells, &mesh.faces, mesh.grid.cell);
+        Encoder {
+            tree,
+            part,
+            grid_bits: mesh.grid.bits,
+            positions,
+            radii,
+            ratio_codes,
+            deviations,
+            deviation_codes,
+            cones,
+            born: born_triangles(tree, mesh),
+        }
+    }
+
+    fn status(&self, x: u32, unit: NodeId) -> Status {
+        self.part.knowledge.status(x, self.tree.is_leaf(x), unit)
+    }
+
+    /// Codes unit `m`: its bytes, ledger and bits per field.
+    pub(super) fn unit(
+        &self,
+        m: usize,
+    ) -> (
+        Vec<u8>,
+        crate::coding::BitLedger,
+        std::collections::BTreeMap<&'static str, f64>,
+    ) {
+        let tree = self.tree;
+        let meta = &self.part.units[m];
+        let unit = tree.ids[meta.root as usize];
+        let mut enc = ArithEncoder::default();
+        let mut ctx = Contexts::new();
+        use SyntaxClass::{Connectivity as C, Geometry as G};
+        enc.bit(&mut ctx.whole, meta.whole, C, "connectivity");
+        if m == 0 {
+            let p = self.positions[tree.root as usize];
+            for x in p {
+                enc.raw(x as u64, self.grid_bits as u32, G, "coordinates");
+            }
+            let r = self.radii[tree.root as usize] as u64;
+            enc.uint(&mut UintContext::default(), r, G, "spheres");
+            let e = self.deviations[tree.root as usize] as u64;
+            enc.uint(&mut UintContext::default(), e, G, "deviations");
+            let cone = self.cones[tree.root as usize];
+            put_cone(&mut enc, &mut ctx, CodedCone::NONE, cone);
+        }
+        // Pass 1: shape, positions, spheres.
+        for &s in &meta.nodes {
+            let [t, u] = tree.children_of(s).expect("inner");
+            let depth = tree.ids[s as usize].len() as usize + 1;
+            for (side, c) in [t, u].into_iter().enumerate() {
+                let ctx_leaf = &mut ctx.leaf_child[depth.min(DEPTHS - 1)][side];
+                enc.bit(ctx_leaf, tree.is_leaf(c), C, "connectivity");
+            }
+            let class = scale(self.radii[s as usize]);
+            let d = sub(self.positions[u as usize], self.positions[s as usize]);
+            for (axis, &x) in d.iter().enumerate() {
+                enc.int(
+                    &mut ctx.coordinates(class)[axis],
+                    x as i64,
+                    G,
+                    "coordinates",
+                );
+            }
+            for (side, c) in [t, u].into_iter().enumerate() {
+                if tree.is_leaf(c) {
+                    continue;
+                }
+                let deviation = self.deviation_codes[c as usize];
+                put_symbol(
+                    &mut enc,
+                    &mut ctx.ratio[side],
+                    self.ratio_codes[c as usize],
+                    RADIUS_BITS,
+                    G,
+                    "spheres",
+                );
+                put_symbol(
+                    &mut enc,
+                    &mut ctx.deviation,
+                    deviation,
+                    DEVIATION_BITS,
+                    G,
+                    "deviations",
+                );
+                let (parent, cone) = (self.cones[s as usize], self.cones[c as usize]);
+                put_cone(&mut enc, &mut ctx, parent, cone);
+            }
+        }
+        // Pass 2: triangles and dependencies.
+        for &s in &meta.nodes {
+            let [t, u] = tree.children_of(s).expect("inner");
+            let sid = tree.ids[s as usize];
+            let born = &self.born[s as usize - tree.leaves];
+            let shape = tree.is_leaf(t) as usize * 2 + tree.is_leaf(u) as usize;
+            enc.uint(
+                &mut ctx.triangles[shape],
+                born.len() as u64,
+                C,
+                "connectivity",
+            );
+            let mut previous = 0;
+            for tri in born {
+                let [l1, l2, l3] = tri.leaves;
+                let (pt, pu, ps) = (
+                    self.positions[t as usize],
+                    self.positions[u as usize],
+                    self.positions[s as usize],
+                );
+                self.put_leaf_path(&mut enc, &mut ctx, t, l1, pu, Kind::N1, unit);
+                self.put_leaf_path(&mut enc, &mut ctx, u, l2, pt, Kind::N2, unit);
+                let junction = tree.ids[l3 as usize].common_len(sid);
+                let up = sid.len() - junction;
+                enc.uint(&mut ctx.up, up as u64 - 1, C, "connectivity");
+                let start = self.other_child(s, up);
+                self.put_leaf_path(&mut enc, &mut ctx, start, l3, ps, Kind::N3, unit);
+                enc.bit(
+                    &mut ctx.orientation[previous],
+                    tri.flipped,
+                    C,
+                    "connectivity",
+                );
+                previous = 1 + tri.flipped as usize;
+            }
+            let deps = &tree.dependencies[s as usize - tree.leaves];
+            enc.uint(&mut ctx.dependencies, deps.len() as u64, C, "dependencies");
+            for &y in deps {
+                // Almost always an ancestor of an n3 corner below its junction: which
+                // triangle's, and how far above the corner.
+                let yid = tree.ids[y as usize];
+                let on = born.iter().position(|t| {
+                    let leaf = tree.ids[t.leaves[2] as usize];
+                    yid.is_ancestor_of(leaf) && yid.len() > leaf.common_len(sid)
+                });
+                let which = on.unwrap_or(born.len());
+                enc.uint(&mut ctx.dependency_on, which as u64, C, "dependencies");
+                if let Some(k) = on {
+                    let leaf = tree.ids[born[k].leaves[2] as usize];
+                    let rise = leaf.len() - yid.len() - 1;
+                    enc.uint(&mut ctx.dependency_rise, rise as u64, C, "dependencies");
+                    continue;
+                }
+                let junction = yid.common_len(sid);
+                let up = sid.len() - junction;
+                enc.uint(&mut ctx.dependency_up, up as u64 - 1, C, "dependencies");
+                let start = self.other_child(s, up);
+                self.put_dependency_path(&mut enc, &mut ctx, start, y, unit);
+            }
+        }
+        let fields = std::mem::take(&mut enc.field_bits);
+        let (bytes, ledger) = enc.finish();
+        (bytes, ledger, fields)
+    }
+
+    /// The child of s's ancestor `up` levels above that is not on s's path.
+    fn other_child(&self, s: u32, up: u8) -> u32 {
+        let mut x = s;
+        for _ in 1..up {
+            x = self.tree.parent[x as usize];
+        }
+        let j = self.tree.parent[x as usize];
+        let [a, b] = self.tree.children_of(j).expect("a junction is inner");
+        if a == x {
+            b
+        } else {
+            a
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn put_leaf_path(
+        &self,
+        enc: &mut ArithEncoder,
+        ctx: &mut Contexts,
+        start: u32,
+        leaf: u32,
+        target: [f64; 3],
+        kind: Kind,
+        unit: NodeId,
+    ) {
+        let tree = self.tree;
+        let lid = tree.ids[leaf as usize];
+        let mut x = start;
+        let c = SyntaxClass::Connectivity;
+        loop {
+            let status = self.status(x, unit);
+            let depth = tree.ids[x as usize].len();
+            match status {
+                Status::Leaf => return,
+                Status::Unknown => {
+                    let is_leaf = tree.is_leaf(x);
+                    enc.bit(
+                        &mut ctx.leaf_on_path[(depth as usize).min(DEPTHS - 1)],
+                        is_leaf,
+                        c,
+                        "connectivity",
+                    );
+                    if is_leaf {
+                        return;
+                    }
+                }
+                _ => {}
+            }
+            let [a, b] = tree.children_of(x).expect("paths pass inner nodes");
+            let bit = lid.bit(depth);
+            if status == Status::Inner {
+                let near = nearer(
+                    [self.positions[a as usize], self.positions[b as usize]],
+                    target,
+                );
+                enc.bit(
+                    &mut ctx.towards[kind as usize],
+                    bit == near,
+                    c,
+                    "connectivity",
+                );
+            } else {
+                enc.bit(&mut ctx.blind[kind as usize], bit, c, "connectivity");
+            }
+            x = if bit { b } else { a };
+        }
+    }
+
+    fn put_dependency_path(
+        &self,
+        enc: &mut ArithEncoder,
+        ctx: &mut Contexts,
+        start: u32,
+        target: u32,
+        unit: NodeId,
+    ) {
+        let tree = self.tree;
+        let tid = tree.ids[target as usize];
+        let c = SyntaxClass::Connectivity;
+        let mut x = start;
+        let mut steps = 0usize;
+        loop {
+            let status = self.status(x, unit);
+            enc.bit(&mut ctx.stop[steps.min(15)], x == target, c, "dependencies");
+            if x == target {
+                return;
+            }
+            let [a, b] = tree.children_of(x).expect("paths pass inner nodes");
+            let bit = tid.bit(tree.ids[x as usize].len());
+            if status == Status::Inner {
+                let leaves =
+                    [self.status(a, unit), self.status(b, unit)].map(|s| s == Status::Leaf);
+                if !leaves[0] && !leaves[1] {
+                    let near = nearer(
+                        [self.positions[a as usize], self.positions[b as usize]],
+                        self.positions[start as usize],
+                    );
+                    enc.bit(
+                        &mut ctx.towards[Kind::Dependency as usize],
+                        bit == near,
+                        c,
+                        "dependencies",
+                    );
+                }
+            } else {
+                enc.bit(
+                    &mut ctx.blind[Kind::Dependency as usize],
+                    bit,
+                    c,
+                    "dependencies",
+                );
+            }
+            x = if bit { b } else { a };
+            steps += 1;
+        }
+    }
+}
+
+/// Codes `value` (< 2^bits) bit by bit down a binary tree of contexts.
+fn put_symbol(
+    enc: &mut ArithEncoder,
+    contexts: &mut [BitContext],
+    value: u32,
+    bits: u8,
+    class: SyntaxClass,
+    field: &'static str,
+) {
+    let mut node = 1usize;
+    for i in (0..bits).rev() {
+        let bit = value >> i & 1 == 1;
+        enc.bit(&mut contexts[node], bit, class, field);
+        node = node * 2 + bit as usize;
+    }
+}

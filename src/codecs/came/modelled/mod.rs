@@ -1,0 +1,116 @@
+//! `came`: the CAME hierarchy with every syntax element arithmetic-coded, losslessly
+//! (docs/FORMAT.md §8.2).
+//!
+//! Inner nodes sit at their representative vertex (left children followed down), so v_t = v_s
+//! and a split codes one integer vector d_u = v_u − v_s, with contexts from the parent's sphere.
+//! A unit codes its splits' shape, positions and spheres first (pass 1), then their triangles and
+//! dependencies (pass 2), so that paths walk a known shape: no length is coded where the decoder
+//! knows where leaves are, and each direction is coded as "towards the child nearer the other
+//! corner" where both children's positions are known. Contexts start afresh in every unit.
+
+mod contexts;
+mod decoder;
+mod encoder;
+#[cfg(test)]
+mod tests;
+
+use contexts::RADIUS_BITS;
+pub use decoder::ModelledUnits;
+use encoder::Encoder;
+
+use super::decoded::CameDecoder;
+use super::partition::Tails;
+use super::{encode_stream, Layout, Params};
+use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
+use crate::container::{Header, StreamReader};
+use crate::error::{Error, Result};
+use crate::hierarchy::came::cones::{self};
+use crate::hierarchy::came::deviation::DEVIATION_BITS;
+use crate::mesh::quantize::GridShape;
+use crate::mesh::CanonicalMesh;
+
+/// The `came` codec.
+pub struct Came;
+
+impl Codec for Came {
+    fn name(&self) -> &'static str {
+        names::CAME.name
+    }
+
+    fn id(&self) -> u8 {
+        names::CAME.id
+    }
+
+    fn summary(&self) -> &'static str {
+        "Grabner's compressed vertex hierarchy of any mesh, context-modelled and lossless"
+    }
+
+    fn default_options(&self) -> EncodeOptions {
+        EncodeOptions {
+            quant_bits: 12,
+            grid: GridShape::Cubic,
+        }
+    }
+
+    fn capabilities(&self) -> &'static [Capability] {
+        &[Capability::Attributes]
+    }
+
+    fn measure(&self, _stream: &[u8]) -> Result<Stats> {
+        Ok(Stats::default())
+    }
+
+    fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
+        let layout = Layout {
+            id: self.id(),
+            tails: Tails::Whole,
+            component_bits: 0,
+            radius_bits: RADIUS_BITS,
+            cone_bits: cones::AXIS_BITS,
+            deviation_bits: DEVIATION_BITS,
+        };
+        encode_stream(mesh, layout, |tree, part| {
+            let encoder = Encoder::new(tree, mesh, part);
+            (0..part.units.len()).map(|m| encoder.unit(m)).collect()
+        })
+    }
+
+    fn level_ends(&self, stream: &StreamReader) -> Result<Vec<u64>> {
+        super::level_ends(stream, &params(stream.header())?)
+    }
+
+    fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
+        let params = params(stream.header())?;
+        Ok(Box::new(CameDecoder::new(stream, params, ModelledUnits)?))
+    }
+}
+
+/// A `came` stream's parameters, checked.
+pub fn params(header: &Header) -> Result<Params> {
+    let params = Params::from_bytes(&header.params, 0..=0)?;
+    if params.radius_bits != RADIUS_BITS {
+        return Err(Error::malformed(
+            0,
+            0,
+            "came streams use 4-bit radius ratios",
+        ));
+    }
+    if ![0, DEVIATION_BITS].contains(&params.deviation_bits) {
+        return Err(Error::malformed(
+            0,
+            0,
+            format!("came streams code deviations on {DEVIATION_BITS} bits"),
+        ));
+    }
+    if ![0, cones::AXIS_BITS].contains(&params.cone_bits) {
+        return Err(Error::malformed(
+            0,
+            0,
+            format!(
+                "came streams code normal cones on {} bits a coordinate",
+                cones::AXIS_BITS
+            ),
+        ));
+    }
+    Ok(params)
+}

@@ -1,0 +1,130 @@
+//! `came`'s promises on generated meshes: every decoded cone holds its subtree's face normals,
+//! every sphere its subtree's vertices; a meta-node decodes alone once its ancestors are; prefixes
+//! decode the levels they hold and the whole stream is exact.
+
+use super::*;
+use crate::codecs::{canonical_for, decode, Stop};
+use crate::hierarchy::came::NodeId;
+use crate::mesh::generate;
+
+fn stream(mesh: &crate::mesh::TriMesh) -> (CanonicalMesh, Vec<u8>) {
+    let canonical = canonical_for(mesh, &Came.default_options()).unwrap();
+    let bytes = Came.encode(&canonical).unwrap().bytes;
+    (canonical, bytes)
+}
+
+fn decoder(bytes: &[u8]) -> CameDecoder<'_, ModelledUnits> {
+    let reader = StreamReader::open(bytes).unwrap();
+    let params = params(reader.header()).unwrap();
+    CameDecoder::new(reader, params, ModelledUnits).unwrap()
+}
+
+#[test]
+fn every_decoded_cone_holds_the_normal_of_every_face_at_its_subtree() {
+    let mut mesh = generate::icosphere(3);
+    let far = generate::torus(1.0, 0.3, 30, 12);
+    mesh.append(&far, glam::DVec3::new(3.0, 0.5, 0.0), 1.0);
+    let (canonical, bytes) = stream(&mesh);
+    let mut d = decoder(&bytes);
+    while d.advance().unwrap() {}
+    let tree = d.tree();
+    let leaf_at: std::collections::HashMap<[u32; 3], NodeId> = tree
+        .nodes
+        .iter()
+        .filter(|n| n.leaf)
+        .map(|n| (n.position.map(|x| x as u32), n.id))
+        .collect();
+    let cell = glam::DVec3::from_array(canonical.grid.cell);
+    let (mut checked, mut with_cone) = (0, 0);
+    for face in &canonical.faces {
+        let p = face
+            .map(|v| glam::DVec3::from_array(canonical.cells[v as usize].map(f64::from)) * cell);
+        let normal = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+        for &v in face {
+            let leaf = leaf_at[&canonical.cells[v as usize]];
+            for len in 0..leaf.len() {
+                let a = &tree.nodes[tree.get(leaf.ancestor(len)).unwrap() as usize];
+                let cone = a.cone.decoded();
+                checked += 1;
+                if !cone.is_some() {
+                    continue;
+                }
+                with_cone += 1;
+                let axis = glam::DVec3::from_array(cone.axis.map(f64::from));
+                let off = normal.cross(axis).length().atan2(normal.dot(axis));
+                assert!(off <= cone.half_angle as f64 + 1e-5, "{:?}", a.id);
+            }
+        }
+    }
+    assert!(
+        with_cone > checked / 4,
+        "{with_cone} of {checked} with a cone"
+    );
+}
+
+#[test]
+fn every_sphere_holds_every_vertex_of_its_subtree() {
+    let mut mesh = generate::icosphere(4);
+    let far = generate::torus(1.0, 0.3, 30, 12);
+    mesh.append(&far, glam::DVec3::new(3.0, 0.5, 0.0), 1.0);
+    let (_, bytes) = stream(&mesh);
+    let mut d = decoder(&bytes);
+    while d.advance().unwrap() {}
+    let tree = d.tree();
+    let mut checked = 0;
+    for leaf in tree.nodes.iter().filter(|n| n.leaf) {
+        let p = glam::DVec3::from_array(leaf.position);
+        for len in 0..leaf.id.len() {
+            let a = &tree.nodes[tree.get(leaf.id.ancestor(len)).unwrap() as usize];
+            let distance = p.distance(glam::DVec3::from_array(a.position));
+            assert!(
+                distance <= a.radius,
+                "{:?}: {distance} > {}",
+                a.id,
+                a.radius
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 10 * tree.nodes.len() / 2);
+}
+
+#[test]
+fn a_meta_node_decodes_alone_once_its_ancestors_are() {
+    let (_, bytes) = stream(&generate::icosphere(5));
+    let mut full = decoder(&bytes);
+    while full.advance().unwrap() {}
+    let reader = StreamReader::open(&bytes).unwrap();
+    let units = reader.index().units.clone();
+    assert!(units.len() > 8, "{} units", units.len());
+    let last = units.len() - 1;
+    let mut chain = vec![last];
+    while let Some(p) = units[*chain.last().unwrap()].parent {
+        chain.push(p);
+    }
+    chain.reverse();
+    let mut alone = decoder(&bytes);
+    let e = alone.decode_unit(last).unwrap_err();
+    assert!(e.to_string().contains("parent unit decoded first"), "{e}");
+    for &i in &chain {
+        assert!(alone.decode_unit(i).unwrap());
+    }
+    let corners = |d: &CameDecoder<'_, ModelledUnits>| -> Vec<[NodeId; 3]> {
+        d.unit_triangles(last)
+            .unwrap()
+            .iter()
+            .map(|t| t.corners)
+            .collect()
+    };
+    assert!(!corners(&alone).is_empty());
+    assert_eq!(corners(&alone), corners(&full));
+    assert!(alone.decode_unit(last).is_err());
+}
+
+#[test]
+fn prefixes_decode_the_levels_they_hold_and_the_whole_stream_is_exact() {
+    let (canonical, bytes) = stream(&generate::icosphere(4));
+    let (whole, _) = decode(&bytes, Stop::All).unwrap();
+    canonical.check_lossless(&whole.mesh).unwrap();
+    crate::codecs::came::tests::check_prefixes(&canonical, &bytes);
+}

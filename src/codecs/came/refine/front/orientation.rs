@@ -1,0 +1,386 @@
+//! The orientation guard (the module docs of `front`): which present faces are certain to turn
+//! as their counterparts do, the faces listed to be made certain, and the splits and refused
+//! collapses that make them so.
+
+use super::super::loader::NONE;
+use super::super::view::View;
+use super::{Adapted, Budget, Ready, State, Suspicion, ViewMesh};
+use glam::DVec3;
+
+/// A margin for the rounding of the orientation tests' products (relative to their size).
+const SLACK: f64 = 1.0 + 1e-9;
+
+/// For a triangle on corners `p` whose counterpart's corners lie within `r` of them: a lower
+/// bound on the cosine of the angle between the two normals, from the best choice of corner a
+/// (with e₁ = b − a, e₂ = c − a, R₁ = r_a + r_b, R₂ = r_a + r_c, the counterpart's normal n'
+/// has n·n' ≥ |n|(|n| − |e₁|R₂ − R₁|e₂| − R₁R₂) and |n'| ≤ (|e₁| + R₁)(|e₂| + R₂)); `None`
+/// when no choice bounds it above 0.
+fn spheres_hold_orientation(p: [DVec3; 3], r: [f64; 3]) -> Option<f64> {
+    let area = (p[1] - p[0]).cross(p[2] - p[0]).length();
+    if !(area > 0.0 && area.is_finite()) {
+        return None;
+    }
+    (0..3)
+        .filter_map(|a| {
+            let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+            let (e1, e2) = ((p[b] - p[a]).length(), (p[c] - p[a]).length());
+            let (r1, r2) = (r[a] + r[b], r[a] + r[c]);
+            let slack = (e1 * r2 + r1 * e2 + r1 * r2) * SLACK;
+            (area > slack).then(|| (area - slack) / ((e1 + r1) * (e2 + r2)))
+        })
+        .reduce(f64::max)
+}
+
+impl ViewMesh {
+    /// Lists triangle `f` to have its orientation checked.
+    pub(super) fn suspect(&mut self, f: u32) {
+        if self.suspected[f as usize] == Suspicion::None {
+            self.suspects.push(f);
+        }
+        self.suspected[f as usize] = Suspicion::Moved;
+        self.retry_around(f);
+    }
+
+    /// Lists the collapses that moving, making or removing present triangle `f` may have made
+    /// possible for its orientation (those of its corners' parents) to be tried again.
+    pub(super) fn retry_around(&mut self, f: u32) {
+        for c in self.corners[f as usize] {
+            let p = self.parent[c as usize];
+            if p != NONE && !self.in_retry[p as usize] {
+                self.in_retry[p as usize] = true;
+                self.retry.push(p);
+            }
+        }
+    }
+
+    /// Whether the face on active nodes `corners` shows in the view: it meets the frustum and
+    /// spans the tolerance on the screen ([`View::shows_triangle`]).
+    pub(super) fn in_view(&self, view: &View, corners: [u32; 3]) -> bool {
+        view.shows_triangle(corners.map(|v| self.spheres[v as usize].0))
+    }
+
+    /// Whether triangle `f`, on active nodes `corners`, surely turns the way of its counterpart
+    /// (the module docs' tests: leaves, error spheres, normal cones, and the spheres of the
+    /// deepest loaded nodes on its corners' leaf paths).
+    pub(super) fn orientation_certain(&self, corners: [u32; 3], f: u32) -> bool {
+        if corners.iter().all(|&v| self.is_leaf(v)) {
+            return true;
+        }
+        let p = corners.map(|v| self.spheres[v as usize].0);
+        let r = corners.map(|v| self.spheres[v as usize].1);
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        let area = n.length();
+        if !(area > 0.0 && area.is_finite()) {
+            return false;
+        }
+        if spheres_hold_orientation(p, r).is_some_and(|cos| cos > 0.0) {
+            return true;
+        }
+        let cones = corners.iter().any(|&v| {
+            let cone = &self.cones[v as usize];
+            let axis = DVec3::new(
+                cone.axis[0] as f64,
+                cone.axis[1] as f64,
+                cone.axis[2] as f64,
+            );
+            // θ + α < 90° ⇔ cos θ > sin α (α widened by the cone's margin).
+            cone.is_some() && n.dot(axis) > cone.sin as f64 * area * SLACK
+        });
+        cones || self.deeper_nodes_hold_orientation(n, corners, f)
+    }
+
+    /// The counterpart's corners lie within the spheres of the deepest loaded nodes on their
+    /// leaf paths (the leaves themselves, radius 0, once loaded): a proxy triangle Q on those
+    /// nodes, whose normal makes an angle β with the face's n, and whose spheres bound the
+    /// angle γ between Q's normal and the counterpart's; the face is certain when β + γ < 90°.
+    ///
+    /// Each leaf path is walked down from the corner above the leaf (`corners`: active nodes,
+    /// or a collapse's parent), not from the root: half the steps or fewer, in nodes near each
+    /// other.
+    pub(super) fn deeper_nodes_hold_orientation(
+        &self,
+        n: DVec3,
+        corners: [u32; 3],
+        f: u32,
+    ) -> bool {
+        let leaves = self.leaf_corners[f as usize];
+        let deepest = leaves.map(|leaf| {
+            let above = corners
+                .into_iter()
+                .find(|&c| self.ids[c as usize].is_ancestor_of(leaf))
+                .unwrap_or(0);
+            self.toward_from(above, leaf).0
+        });
+        let q = deepest.map(|v| self.spheres[v as usize].0);
+        let r = deepest.map(|v| self.spheres[v as usize].1);
+        let Some(cos_gamma) = spheres_hold_orientation(q, r) else {
+            return false;
+        };
+        let m = (q[1] - q[0]).cross(q[2] - q[0]);
+        let cos_beta = n.dot(m) / (n.length() * m.length());
+        if !(cos_beta > 0.0 && cos_gamma > 0.0) {
+            return false;
+        }
+        // β + γ < 90° ⇔ cos(β + γ) > 0, with a margin for rounding.
+        let (sin_beta, sin_gamma) = (
+            (1.0 - cos_beta * cos_beta).max(0.0).sqrt(),
+            (1.0 - cos_gamma * cos_gamma).max(0.0).sqrt(),
+        );
+        cos_beta * cos_gamma - sin_beta * sin_gamma > 1e-9
+    }
+
+    /// Whether ecol of split node `s` leaves every face it moves that is in view certain of
+    /// its orientation (the faces born at `s`, on both children, go).
+    ///
+    /// A refused node is listed (`refused`), and the face that refused it is checked first the
+    /// next time (a node the guard split is refused again and again while its view lasts: one
+    /// face checked, not its dozen). `retry`: check a listed node again.
+    ///
+    /// While the front holds more faces than a face budget allows, the budget comes first: the
+    /// collapse is made, and the faces it leaves not certain stay listed.
+    pub(super) fn collapse_keeps_orientation(
+        &mut self,
+        s: u32,
+        view: &View,
+        budget: Budget,
+        retry: bool,
+    ) -> bool {
+        let su = s as usize;
+        if !view.keeps_orientation() {
+            return true;
+        }
+        // (Not when trying again after the guard, which would undo its splits over and over.)
+        if !retry && budget.faces.is_some_and(|target| self.faces > target) {
+            return true;
+        }
+        if self.refused_listed[su] && !retry {
+            return false;
+        }
+        let [t, u] = self.children[su];
+        // Face `f` once `s` is collapsed: in view and not certain?
+        let spoilt = |f: u32| {
+            let corners = self.corners[f as usize];
+            if !self.present[f as usize] || corners.contains(&t) && corners.contains(&u) {
+                return false;
+            }
+            if !corners.contains(&t) && !corners.contains(&u) {
+                return false;
+            }
+            let moved = corners.map(|v| if v == t || v == u { s } else { v });
+            self.in_view(view, moved) && !self.orientation_certain(moved, f)
+        };
+        let held = self.held_by[su];
+        let culprit = if held != NONE && spoilt(held) {
+            Some(held)
+        } else {
+            [t, u].iter().find_map(|&c| {
+                self.faces_at[c as usize]
+                    .iter()
+                    .copied()
+                    .find(|&f| spoilt(f))
+            })
+        };
+        match culprit {
+            Some(f) => {
+                self.held_by[su] = f;
+                if !self.refused_listed[su] {
+                    self.refused_listed[su] = true;
+                    self.refused.push(s);
+                }
+                false
+            }
+            None => true,
+        }
+    }
+
+    /// Makes every listed face certain of its orientation (the module docs): splits its
+    /// coarsest corner that can be split, with that split's dependencies, and the children
+    /// those splits activate on down as far as the view wants; a face that must wait for a
+    /// meta-node, or for the next call's budget, stays listed.
+    pub(super) fn guard(
+        &mut self,
+        view: &View,
+        budget: Budget,
+        done: &mut Adapted,
+        below: &mut Vec<u32>,
+    ) {
+        if !view.keeps_orientation() {
+            // The faces stay listed, for a view that keeps orientation.
+            return;
+        }
+        let mut held = Vec::new();
+        let mut unsure = 0;
+        let mut activated = Vec::new();
+        let waiting_before = done.waiting;
+        // The view's splits that wait, of the children the guard's splits activate.
+        self.waited_now.clear();
+        while let Some(f) = self.suspects.pop() {
+            let fu = f as usize;
+            let corners = self.corners[fu];
+            let certain = match self.suspected[fu] {
+                _ if !self.present[fu] => true,
+                Suspicion::Moved => self.orientation_certain(corners, f),
+                _ => false,
+            };
+            if certain {
+                self.suspected[fu] = Suspicion::None;
+                continue;
+            }
+            self.suspected[fu] = Suspicion::Uncertain;
+            if !self.in_view(view, corners) {
+                held.push(f);
+                continue;
+            }
+            if done.splits + done.collapses >= budget.operations
+                || self.faces >= budget.faces.unwrap_or(usize::MAX)
+            {
+                held.push(f);
+                unsure += 1;
+                continue;
+            }
+            let mut corners = corners;
+            corners.sort_by(|&a, &b| {
+                let radius = |v: u32| self.spheres[v as usize].1;
+                radius(b).total_cmp(&radius(a))
+            });
+            let mut outcome = Ready::Never;
+            let mut no_room = false;
+            for x in corners {
+                if self.is_leaf(x) {
+                    continue;
+                }
+                activated.clear();
+                self.held_by[x as usize] = f;
+                // Within a face budget: a split that would take the front past it waits.
+                let room = budget
+                    .faces
+                    .map_or(usize::MAX, |f| f.saturating_sub(self.faces));
+                let (splits, stop) = self.force_split(x, &mut activated, room);
+                if splits == 0 && stop == Ready::Now {
+                    no_room = true;
+                    break;
+                }
+                done.splits += splits;
+                // The view did not ask for these splits: their collapses are tried again
+                // after the guard and whenever a face they would move moves (the plan's own
+                // later splits may already have made them certain).
+                for i in 0..splits {
+                    let v = self.plan[i];
+                    if !self.refused_listed[v as usize] {
+                        self.refused_listed[v as usize] = true;
+                        self.refused.push(v);
+                    }
+                    if !self.in_retry[v as usize] {
+                        self.in_retry[v as usize] = true;
+                        self.retry.push(v);
+                    }
+                }
+                for &c in &activated {
+                    if self.state[c as usize] == State::Active && self.wants(view, c) {
+                        self.refine_down(c, view, budget, done, below);
+                    }
+                }
+                outcome = stop;
+                if stop != Ready::Never {
+                    break;
+                }
+            }
+            if no_room {
+                held.push(f);
+                unsure += 1;
+                continue;
+            }
+            match outcome {
+                // Its corner moved: it is checked again.
+                Ready::Now => self.suspects.push(f),
+                Ready::Waiting => {
+                    done.waiting += 1;
+                    held.push(f);
+                    unsure += 1;
+                }
+                Ready::Never => {
+                    done.blocked += 1;
+                    held.push(f);
+                    unsure += 1;
+                }
+            }
+        }
+        self.suspects = held;
+        done.unsure = unsure;
+        if done.waiting > waiting_before {
+            // The next call with the same view revisits the view's splits that wait (as after
+            // the passes) and then these faces.
+            let waited = std::mem::take(&mut self.waited_now);
+            self.waiting_nodes.extend_from_slice(&waited);
+            self.waited_now = waited;
+            if !done.capped && self.cursor == 0 {
+                self.waited_for = Some(view.clone());
+            }
+            done.settled = false;
+        }
+        if done.splits + done.collapses >= budget.operations && !self.suspects.is_empty() {
+            done.settled = false;
+        }
+    }
+
+    /// After the passes: the collapses a face's orientation may have refused tried again, and
+    /// the guard ([`Self::guard`]), until neither does anything. Tried again: those near a face
+    /// that moved, appeared or went since they were last tried (`retry`: the parents of its
+    /// corners), and every refused one after a meta-node arrives (the certificates read the
+    /// deepest loaded nodes) or after whole passes (a view that may be new).
+    pub(super) fn settle_orientation(
+        &mut self,
+        view: &View,
+        budget: Budget,
+        done: &mut Adapted,
+        below: &mut Vec<u32>,
+        new_view: bool,
+    ) {
+        let mut nodes = std::mem::take(&mut self.retry);
+        if new_view {
+            nodes.append(&mut self.refused);
+        }
+        if !view.keeps_orientation() {
+            // Nothing was refused for orientation: the faces' moves need no retrying.
+            for &p in &nodes {
+                self.in_retry[p as usize] = false;
+                self.refused_listed[p as usize] = false;
+            }
+            nodes.clear();
+            self.retry = nodes;
+            return;
+        }
+        loop {
+            let before = (done.splits, done.collapses);
+            for &p in &nodes {
+                self.refused_listed[p as usize] = false;
+                self.in_retry[p as usize] = false;
+            }
+            for &p in &nodes {
+                if done.splits + done.collapses >= budget.operations {
+                    // Kept for the next call.
+                    if !self.in_retry[p as usize] {
+                        self.in_retry[p as usize] = true;
+                        self.retry.push(p);
+                    }
+                    continue;
+                }
+                self.collapse_from(p, view, budget, done, true);
+            }
+            self.guard(view, budget, done, below);
+            nodes.clear();
+            std::mem::swap(&mut nodes, &mut self.retry);
+            let spent = done.splits + done.collapses >= budget.operations;
+            if spent || (done.splits, done.collapses) == before && nodes.is_empty() {
+                break;
+            }
+        }
+        // Empty, or (the budget having run out) those left for the next call.
+        self.retry = nodes;
+        if done.splits + done.collapses >= budget.operations {
+            // The budget ran out here, after the passes: a collapse chain may have stopped
+            // short, so the next call makes whole passes rather than revisiting what waited.
+            self.waited_for = None;
+        }
+    }
+}

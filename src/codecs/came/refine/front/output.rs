@@ -1,0 +1,197 @@
+//! What the front gives out: the adapted mesh, its present triangles, picking, and the check of
+//! every invariant of `front`'s module docs.
+
+use super::super::loader::NONE;
+use super::{Pick, State, Suspicion, ViewMesh};
+use crate::hierarchy::came::NodeId;
+use crate::mesh::TriMesh;
+use glam::DVec3;
+
+impl ViewMesh {
+    /// Where the vertex with leaf path `leaf` stands in the adapted mesh: the position of the
+    /// active node on its path (`None` if the path leaves the hierarchy above the front).
+    pub fn position_of(&self, leaf: NodeId) -> Option<DVec3> {
+        self.active_on(leaf).map(|v| self.spheres[v as usize].0)
+    }
+
+    /// The present triangles: each one's corners' leaf paths (which name the full mesh's
+    /// triangle it stands for) and its corners' positions in the adapted mesh.
+    pub fn present_triangles(&self) -> impl Iterator<Item = ([NodeId; 3], [DVec3; 3])> + '_ {
+        (0..self.present.len())
+            .filter(|&t| self.present[t])
+            .map(|t| {
+                let at = self.corners[t].map(|v| self.spheres[v as usize].0);
+                (self.leaf_corners[t], at)
+            })
+    }
+
+    /// The adapted mesh: the active nodes' positions, the present triangles.
+    pub fn mesh(&self) -> TriMesh {
+        let mut index = vec![NONE; self.ids.len()];
+        let mut positions = Vec::with_capacity(self.active.len());
+        for &v in &self.active {
+            index[v as usize] = positions.len() as u32;
+            positions.push(self.spheres[v as usize].0);
+        }
+        let faces = self
+            .present
+            .iter()
+            .zip(&self.corners)
+            .filter(|(&p, _)| p)
+            .map(|(_, c)| c.map(|v| index[v as usize]))
+            .collect();
+        TriMesh { positions, faces }
+    }
+
+    /// The nearest present triangle the ray from `origin` along `direction` hits.
+    pub fn pick(&self, origin: DVec3, direction: DVec3) -> Option<Pick> {
+        let mut best: Option<Pick> = None;
+        for (t, &present) in self.present.iter().enumerate() {
+            if !present {
+                continue;
+            }
+            let [a, b, c] = self.corners[t].map(|v| self.spheres[v as usize].0);
+            if let Some(d) = ray_triangle(origin, direction, a, b, c) {
+                if best.is_none_or(|p| d < p.distance) {
+                    best = Some(Pick {
+                        triangle: t as u32,
+                        distance: d,
+                        point: origin + direction * d,
+                    });
+                }
+            }
+        }
+        best
+    }
+
+    /// Checks every invariant of the module docs; the first broken one, described.
+    pub fn check_invariants(&self) -> std::result::Result<(), String> {
+        let n = self.ids.len();
+        if self.state[0] == State::Below {
+            return Err("the root is below the front".into());
+        }
+        for v in 0..n {
+            let st = self.state[v];
+            let inner = self.children[v][0] != NONE;
+            for c in self.children[v].into_iter().filter(|&c| c != NONE) {
+                let cs = self.state[c as usize];
+                let fine = match st {
+                    State::Split => cs != State::Below,
+                    _ => cs == State::Below,
+                };
+                if !fine {
+                    return Err(format!("node {v} is {st:?}, its child {c} {cs:?}"));
+                }
+            }
+            if st == State::Split && !inner {
+                return Err(format!("leaf {v} is split"));
+            }
+            let bit = self.active_bits[v / 64] >> (v % 64) & 1 == 1;
+            if (st == State::Active) != (self.active_slot[v] != NONE)
+                || (st == State::Active) != bit
+            {
+                return Err(format!("node {v} is {st:?} but listed otherwise"));
+            }
+            if st == State::Split {
+                if let Some(d) = self.depends_on[v]
+                    .iter()
+                    .find(|d| d.node == NONE || self.state[d.node as usize] != State::Split)
+                {
+                    return Err(format!(
+                        "split node {v} depends on {:?}, which is not split",
+                        d.id
+                    ));
+                }
+            }
+        }
+        let mut dependants = vec![0u32; n];
+        for v in (0..n).filter(|&v| self.state[v] == State::Split) {
+            for d in &self.depends_on[v] {
+                dependants[d.node as usize] += 1;
+            }
+        }
+        if dependants != self.split_dependants {
+            return Err("the counts of split dependants are off".into());
+        }
+        let mut listed = vec![0usize; n];
+        let mut faces = 0;
+        for v in 0..n {
+            for &t in &self.born[v] {
+                let tu = t as usize;
+                if self.present[tu] != (self.state[v] == State::Split) {
+                    return Err(format!(
+                        "triangle {t} present {} at a {:?} birth node",
+                        self.present[tu], self.state[v]
+                    ));
+                }
+                if !self.present[tu] {
+                    continue;
+                }
+                faces += 1;
+                let c = self.corners[tu];
+                for (k, (&corner, &leaf)) in c.iter().zip(&self.leaf_corners[tu]).enumerate() {
+                    let cu = corner as usize;
+                    if self.state[cu] != State::Active || !self.ids[cu].is_ancestor_of(leaf) {
+                        return Err(format!(
+                            "triangle {t}'s corner {k} is not its leaf's active node"
+                        ));
+                    }
+                    listed[cu] += 1;
+                }
+                if c[0] == c[1] || c[1] == c[2] || c[0] == c[2] {
+                    return Err(format!("triangle {t} has a repeated corner"));
+                }
+            }
+        }
+        if faces != self.faces {
+            return Err(format!("{faces} triangles present, {} counted", self.faces));
+        }
+        if let Some(t) = (0..self.present.len()).find(|&t| {
+            self.present[t]
+                && self.suspected[t] == Suspicion::None
+                && !self.orientation_certain(self.corners[t], t as u32)
+        }) {
+            return Err(format!(
+                "triangle {t} is not certain of its orientation and not listed"
+            ));
+        }
+        let marked = self
+            .suspected
+            .iter()
+            .filter(|&&m| m != Suspicion::None)
+            .count();
+        if marked != self.suspects.len()
+            || self
+                .suspects
+                .iter()
+                .any(|&t| self.suspected[t as usize] == Suspicion::None)
+        {
+            return Err("the listed triangles and their marks disagree".into());
+        }
+        for &v in &self.active {
+            let list = &self.faces_at[v as usize];
+            if list.len() != listed[v as usize]
+                || list.iter().any(|&t| !self.corners[t as usize].contains(&v))
+            {
+                return Err(format!("node {v}'s triangle list is off"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Möller–Trumbore: the distance along the ray to triangle (a, b, c), either side facing.
+fn ray_triangle(origin: DVec3, direction: DVec3, a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
+    let (e1, e2) = (b - a, c - a);
+    let p = direction.cross(e2);
+    let det = e1.dot(p);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let s = origin - a;
+    let u = s.dot(p) / det;
+    let q = s.cross(e1);
+    let v = direction.dot(q) / det;
+    let t = e2.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t >= 0.0).then_some(t)
+}

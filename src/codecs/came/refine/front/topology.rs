@@ -1,0 +1,288 @@
+//! The front's moves: activating nodes, vertex splits and edge collapses, forced splits through
+//! the dependencies (planned all or nothing), and walking leaf paths to the active nodes.
+
+use super::super::loader::NONE;
+use super::{Ready, State, ViewMesh};
+use crate::hierarchy::came::NodeId;
+use smallvec::SmallVec;
+
+impl ViewMesh {
+    pub(super) fn activate(&mut self, v: u32) {
+        self.state[v as usize] = State::Active;
+        self.active_slot[v as usize] = self.active.len() as u32;
+        self.active.push(v);
+        self.active_bits[v as usize / 64] |= 1 << (v % 64);
+    }
+
+    pub(super) fn deactivate(&mut self, v: u32, to: State) {
+        self.state[v as usize] = to;
+        let slot = self.active_slot[v as usize] as usize;
+        self.active.swap_remove(slot);
+        if let Some(&moved) = self.active.get(slot) {
+            self.active_slot[moved as usize] = slot as u32;
+        }
+        self.active_slot[v as usize] = NONE;
+        self.active_bits[v as usize / 64] &= !(1 << (v % 64));
+    }
+
+    /// The active node on leaf path `leaf`; `None` if the path ends at a split node (a
+    /// corrupt stream's corner).
+    pub(super) fn active_on(&self, leaf: NodeId) -> Option<u32> {
+        let mut v = 0u32;
+        while self.state[v as usize] == State::Split {
+            let len = self.ids[v as usize].len();
+            if len >= leaf.len() {
+                return None;
+            }
+            v = self.children[v as usize][leaf.bit(len) as usize];
+        }
+        Some(v)
+    }
+
+    /// The deepest loaded node on the path to `id`, and whether it is `id`.
+    pub(super) fn toward(&self, id: NodeId) -> (u32, bool) {
+        self.toward_from(0, id)
+    }
+
+    /// [`ViewMesh::toward`], walking down from `start`, an ancestor of `id` (or `id`).
+    pub(super) fn toward_from(&self, start: u32, id: NodeId) -> (u32, bool) {
+        let mut v = start;
+        loop {
+            let len = self.ids[v as usize].len();
+            if len >= id.len() {
+                return (v, self.ids[v as usize] == id);
+            }
+            match self.children[v as usize][id.bit(len) as usize] {
+                NONE => return (v, false),
+                c => v = c,
+            }
+        }
+    }
+
+    /// A node to split before `v` may be: its first dependency not split (or planned to be),
+    /// or the deepest loaded node on the way to one not loaded yet.
+    pub(super) fn unmet_dependency(&mut self, v: u32) -> Option<u32> {
+        for k in 0..self.depends_on[v as usize].len() {
+            let dep = self.depends_on[v as usize][k];
+            let node = if dep.node != NONE {
+                dep.node
+            } else {
+                match self.toward(dep.id) {
+                    (x, true) => {
+                        self.depends_on[v as usize][k].node = x;
+                        x
+                    }
+                    (x, false) => return Some(x),
+                }
+            };
+            if self.planned_state(node) != State::Split {
+                return Some(node);
+            }
+        }
+        None
+    }
+
+    /// The active node on leaf path `leaf` among those sharing a face with active node `s`
+    /// (where a triangle born at `s` finds its third corner: a neighbour of `v_s`, Hoppe's
+    /// v_l or v_r), without a walk from the root.
+    pub(super) fn neighbour_on(&self, s: u32, leaf: NodeId) -> Option<u32> {
+        self.faces_at[s as usize].iter().find_map(|&f| {
+            self.corners[f as usize]
+                .into_iter()
+                .find(|&n| n != s && self.ids[n as usize].is_ancestor_of(leaf))
+        })
+    }
+
+    /// vsplit of active inner node `s` whose dependencies are split. Does nothing and returns
+    /// false if a corner cannot follow it (a leaf path ending at `s` or at a split node: only in
+    /// a corrupt stream).
+    pub(super) fn split(&mut self, s: u32) -> bool {
+        let su = s as usize;
+        let depth = self.ids[su].len();
+        let own = self.ids[su];
+        let deep = |c: NodeId| c.len() > depth;
+        for &f in &self.faces_at[su] {
+            for k in 0..3 {
+                if self.corners[f as usize][k] == s && !deep(self.leaf_corners[f as usize][k]) {
+                    return false;
+                }
+            }
+        }
+        // The born triangles' corners: two under v_s, at v_t and v_u once it is split; the
+        // third a neighbour (an active node elsewhere, which this split does not move).
+        let mut born: SmallVec<[[u32; 3]; 4]> = SmallVec::new();
+        for &f in &self.born[su] {
+            let mut corners = [NONE; 3];
+            for (k, &c) in self.leaf_corners[f as usize].iter().enumerate() {
+                corners[k] = if own.is_ancestor_of(c) {
+                    if !deep(c) {
+                        return false;
+                    }
+                    self.children[su][c.bit(depth) as usize]
+                } else {
+                    match self.neighbour_on(s, c).or_else(|| self.active_on(c)) {
+                        Some(v) => v,
+                        None => return false,
+                    }
+                };
+            }
+            born.push(corners);
+        }
+        let [t, u] = self.children[su];
+        self.deactivate(s, State::Split);
+        self.activate(t);
+        self.activate(u);
+        for f in std::mem::take(&mut self.faces_at[su]) {
+            let fu = f as usize;
+            for k in 0..3 {
+                if self.corners[fu][k] == s {
+                    let child = self.children[su][self.leaf_corners[fu][k].bit(depth) as usize];
+                    self.corners[fu][k] = child;
+                    self.faces_at[child as usize].push(f);
+                }
+            }
+            self.suspect(f);
+        }
+        for (i, corners) in born.into_iter().enumerate() {
+            let f = self.born[su][i];
+            for &c in &corners {
+                self.faces_at[c as usize].push(f);
+            }
+            self.corners[f as usize] = corners;
+            self.present[f as usize] = true;
+            self.suspect(f);
+        }
+        self.faces += self.born[su].len();
+        for &d in &self.depends_on[su] {
+            self.split_dependants[d.node as usize] += 1;
+        }
+        true
+    }
+
+    /// Whether node `v` is a leaf of the hierarchy (not a node whose split is still to load).
+    pub(super) fn is_leaf(&self, v: u32) -> bool {
+        self.children[v as usize][0] == NONE && self.opens[v as usize] == NONE
+    }
+
+    /// Whether ecol of split node `s` is legal: both children active, no split dependant.
+    pub(super) fn can_collapse(&self, s: u32) -> bool {
+        let su = s as usize;
+        self.state[su] == State::Split
+            && self.split_dependants[su] == 0
+            && self.children[su]
+                .iter()
+                .all(|&c| self.state[c as usize] == State::Active)
+    }
+
+    /// ecol of `s` ([`Self::can_collapse`]).
+    pub(super) fn collapse(&mut self, s: u32) {
+        let su = s as usize;
+        for i in 0..self.born[su].len() {
+            let f = self.born[su][i];
+            self.retry_around(f);
+            for c in self.corners[f as usize] {
+                let list = &mut self.faces_at[c as usize];
+                if let Some(at) = list.iter().position(|&g| g == f) {
+                    list.swap_remove(at);
+                }
+            }
+            self.corners[f as usize] = [NONE; 3];
+            self.present[f as usize] = false;
+        }
+        self.faces -= self.born[su].len();
+        for c in self.children[su] {
+            for f in std::mem::take(&mut self.faces_at[c as usize]) {
+                for corner in &mut self.corners[f as usize] {
+                    if *corner == c {
+                        *corner = s;
+                    }
+                }
+                self.faces_at[su].push(f);
+                self.suspect(f);
+            }
+            self.deactivate(c, State::Below);
+        }
+        self.activate(s);
+        for &d in &self.depends_on[su] {
+            let count = &mut self.split_dependants[d.node as usize];
+            *count -= 1;
+            if *count == 0 {
+                self.freed.push(d.node);
+            }
+        }
+    }
+
+    /// The node's state once the splits planned so far are made.
+    pub(super) fn planned_state(&self, v: u32) -> State {
+        let vu = v as usize;
+        match self.state[vu] {
+            _ if self.planned[vu] => State::Split,
+            State::Below if self.planned[self.parent[vu] as usize] => State::Active,
+            state => state,
+        }
+    }
+
+    /// Splits active node `s`, and first whatever its dependencies need (Hoppe's forced
+    /// split), all or nothing: the splits are planned first, and made only if every one can be
+    /// (none waits for a meta-node) — so that a chain cut short is not left half made for the
+    /// next pass to collapse and the one after to make again; and only if they add at most
+    /// `room` faces (else none is made, and (0, `Ready::Now`) returned). Returns the splits made and
+    /// whether it stopped short, and appends the children it activated to `activated`.
+    pub(super) fn force_split(
+        &mut self,
+        s: u32,
+        activated: &mut Vec<u32>,
+        room: usize,
+    ) -> (usize, Ready) {
+        let mut plan = std::mem::take(&mut self.plan);
+        plan.clear();
+        let mut stack = std::mem::take(&mut self.stack);
+        stack.clear();
+        stack.push(s);
+        let outcome = loop {
+            let Some(&v) = stack.last() else {
+                break Ready::Now;
+            };
+            if stack.len() > self.ids.len() {
+                // The dependencies form a cycle: a corrupt stream.
+                break Ready::Never;
+            }
+            match self.planned_state(v) {
+                State::Split => {
+                    stack.pop();
+                }
+                State::Below => stack.push(self.parent[v as usize]),
+                State::Active => match self.ready(v) {
+                    Ready::Now => match self.unmet_dependency(v) {
+                        Some(d) => stack.push(d),
+                        None => {
+                            self.planned[v as usize] = true;
+                            plan.push(v);
+                            stack.pop();
+                        }
+                    },
+                    stop => break stop,
+                },
+            }
+        };
+        for &v in &plan {
+            self.planned[v as usize] = false;
+        }
+        let mut made = 0;
+        let mut outcome = outcome;
+        let added: usize = plan.iter().map(|&v| self.born[v as usize].len()).sum();
+        if outcome == Ready::Now && added <= room {
+            for &v in &plan {
+                if !self.split(v) {
+                    outcome = Ready::Never;
+                    break;
+                }
+                activated.extend(self.children[v as usize]);
+                made += 1;
+            }
+        }
+        self.plan = plan;
+        self.stack = stack;
+        (made, outcome)
+    }
+}
