@@ -4,6 +4,7 @@
 
 use super::syntax::{self, Layout, SplitContexts};
 use super::wedges::{self, SplitWedges, WedgeContexts, WedgeState};
+use super::weld;
 use super::PmParams;
 use crate::codecs::LevelMesh;
 use crate::coding::arith::ArithDecoder;
@@ -419,12 +420,12 @@ impl<'a> PMeshIter<'a> {
         let (w, spec) = (self.wedges.as_ref()?, self.header.appearance.as_ref()?);
         let (corners, wedge_vertex, codes) = match self.restoration() {
             // Mⁿ of a mesh cut to a manifold: the wedges of the mesh itself.
-            Some(r) => wedges::weld_face_values(
+            Some(r) => weld::weld_face_values(
                 r.faces(&self.mesh).into_iter(),
                 &r.corners(&w.state.corners),
                 r.vertex_count(),
             ),
-            None => wedges::weld(&w.state, &self.mesh),
+            None => weld::weld(&w.state, &self.mesh),
         };
         let cells = match self.restoration() {
             Some(r) => r.cells(),
@@ -589,7 +590,7 @@ impl Geomorph {
                     .zip(&coarse)
                     .map(|(f, c)| std::array::from_fn(|k| (f[k], c[k])))
                     .collect();
-                let (corners, wedge_vertex, codes) = wedges::weld_values(&iter.mesh, &pairs);
+                let (corners, wedge_vertex, codes) = weld::weld_values(&iter.mesh, &pairs);
                 let end = |pick: fn(&(CornerCode, CornerCode)) -> CornerCode,
                            cells: &[[i32; 3]]| {
                     let wedges = Welded {

@@ -48,6 +48,7 @@ pub mod repair;
 pub mod syntax;
 pub mod wedge_levels;
 pub mod wedges;
+pub mod weld;
 
 use super::stats::{PmField, WedgeField};
 use super::{

@@ -47,7 +47,7 @@
 //! all lie in it, in a stream of its own and with its own copy of the contexts (merged after
 //! the pass), and the visits on the slabs' boundaries (about 3%) follow in the level's stream.
 //! A slab never reads or writes another slab's vertices, so the decoder codes them on threads
-//! at once (`walk::Lanes` says why that is sound); on one thread it codes them one after
+//! at once (`walk::lanes::Lanes` says why that is sound); on one thread it codes them one after
 //! another, to the same mesh. The encoder codes them at once too, each slab planning its splits
 //! on its own clusters (`clusters::ClusterLanes`), to the same bytes as on one thread.
 //!

@@ -1,0 +1,432 @@
+//! One pass's run over the walker's per-vertex arrays: [`Lanes`], the raw views the slabs of a
+//! sliced pass share (and why that is sound), and [`Run`], which visits a slab's vertices.
+
+use super::super::contexts::{self, Contexts};
+use super::*;
+use crate::codecs::emc::state::{
+    check_edge_count, split_edges, EdgeCode, NeighbourLists, Neighbours, NO_SPLIT,
+};
+use crate::hierarchy::octree::StepOrder;
+use crate::prefetch::prefetch;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// How many visits ahead [`Run::prefetch_ring`] asks for a vertex's neighbours.
+pub(super) const PREFETCH_AHEAD: usize = 5;
+
+/// Twice the centre of a cell of prefix `cell`, whose half-widths have shifts `shifts`.
+pub(super) fn cell_centre(cell: [u32; 3], shifts: [u8; 3]) -> [i32; 3] {
+    // At most 2^25 (24 levels), so i32 holds it; the neighbours' offsets too.
+    [0, 1, 2].map(|a| (((cell[a] as i32) << 1) | 1) << shifts[a])
+}
+
+/// Raw views of the per-vertex arrays of a [`Walker`], shared by the [`Run`]s of a pass.
+///
+/// The slabs of a sliced pass run at once over these arrays. That is sound because each reads
+/// and writes only its own vertices: a slab visits only vertices whose neighbours all lie in
+/// the slab; a visit reads and writes the visited vertex, its neighbours and the vertex its
+/// split creates (which takes the slab's own ids); a split gives its vertex's neighbours only
+/// the created vertex, so no slab vertex ever gains a neighbour from elsewhere, whatever the
+/// stream says. Only the marks are read across slabs (the coded ring walks a neighbour's list,
+/// which may name another slab's vertices): they are atomic, and no slab's serial is
+/// another's, so what one slab reads of another's marks never counts.
+pub(super) struct Lanes {
+    pub(super) cells: *mut [u32; 3],
+    pub(super) depth: *mut u16,
+    pub(super) next_split: *mut u16,
+    pub(super) adjacency: *mut Neighbours,
+    pub(super) leaf: *mut bool,
+    pub(super) centres: *mut [i32; 3],
+    pub(super) marks: *const AtomicU64,
+    pub(super) len: usize,
+}
+
+// SAFETY: see the type's docs: the runs sharing a view touch disjoint vertices.
+#[allow(unsafe_code)]
+unsafe impl Sync for Lanes {}
+// SAFETY: as for `Sync`: a run moved to another thread still touches only its own vertices.
+#[allow(unsafe_code)]
+unsafe impl Send for Lanes {}
+
+/// One vertex's entry in an array of [`Lanes`], bounds-checked, to read.
+macro_rules! lane {
+    ($lanes:expr, $field:ident, $v:expr) => {{
+        let v: usize = $v;
+        assert!(v < $lanes.len, "vertex {v} outside the lanes");
+        // SAFETY: in bounds; the run owns vertex v (see `Lanes`).
+        unsafe { &*$lanes.$field.add(v) }
+    }};
+}
+
+/// One vertex's entry in an array of [`Lanes`], bounds-checked, to write.
+macro_rules! lane_mut {
+    ($lanes:expr, $field:ident, $v:expr) => {{
+        let v: usize = $v;
+        assert!(v < $lanes.len, "vertex {v} outside the lanes");
+        // SAFETY: in bounds; the run owns vertex v (see `Lanes`), and no other reference to
+        // the entry is alive.
+        unsafe { &mut *$lanes.$field.add(v) }
+    }};
+}
+
+/// One run of a pass over some of its visits: the whole pass, or one slab of a sliced pass, or
+/// the boundary that follows the slabs.
+pub(super) struct Run<'a> {
+    pub(super) lanes: &'a Lanes,
+    pub(super) shifts: &'a [[u8; 3]],
+    pub(super) order: StepOrder,
+    pub(super) contexts: &'a mut Contexts,
+    /// In a slab: the slab of every vertex at the pass's start, and this slab.
+    pub(super) slab: Option<(&'a [u8], u8)>,
+    pub(super) codes: Vec<EdgeCode>,
+    pub(super) serial: u64,
+    pub(super) serial_step: u64,
+    /// The ids this run's splits take: from `first_id`, the next one, and the end.
+    pub(super) first_id: usize,
+    pub(super) next_id: usize,
+    pub(super) end_id: usize,
+    /// Edges of the graph as this run knows them.
+    pub(super) edges: u64,
+    pub(super) max_vertices: u64,
+    pub(super) max_triangles: u64,
+    /// Vertices created, in order.
+    pub(super) created: Vec<u32>,
+}
+
+// The lanes are read and written here only (`lane!`, `lane_mut!`).
+
+#[allow(unsafe_code)]
+impl Run<'_> {
+    pub(super) fn adjacency(&self, v: usize) -> &Neighbours {
+        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
+        lane!(self.lanes, adjacency, v)
+    }
+
+    pub(super) fn centre(&self, v: usize) -> [i32; 3] {
+        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
+        *lane!(self.lanes, centres, v)
+    }
+
+    pub(super) fn leaf(&self, v: usize) -> bool {
+        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
+        *lane!(self.lanes, leaf, v)
+    }
+
+    pub(super) fn depth(&self, v: usize) -> usize {
+        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
+        *lane!(self.lanes, depth, v) as usize
+    }
+
+    /// Whether `v` is this run's to read: every vertex outside a slab; in a slab, its own
+    /// vertices and those its splits created.
+    pub(super) fn owns(&self, v: usize) -> bool {
+        match self.slab {
+            None => true,
+            Some((slab_of, slab)) => match slab_of.get(v) {
+                Some(&s) => s == slab,
+                None => (self.first_id..self.next_id).contains(&v),
+            },
+        }
+    }
+
+    /// Recomputes the cached centre of `v` from its cell.
+    pub(super) fn refresh(&mut self, v: usize) {
+        let shifts = self.shifts[self.depth(v)];
+        let cell = *lane!(self.lanes, cells, v);
+        *lane_mut!(self.lanes, centres, v) = cell_centre(cell, shifts);
+    }
+
+    /// RF: `v` takes `bit` at `step`.
+    pub(super) fn refine(&mut self, v: usize, step: usize, bit: u32) {
+        let axis = self.order.axis(step);
+        let cell = lane_mut!(self.lanes, cells, v);
+        cell[axis] = (cell[axis] << 1) | bit;
+        *lane_mut!(self.lanes, depth, v) += 1;
+    }
+
+    pub(super) fn work<S: Side>(
+        &mut self,
+        side: &mut S,
+        visits: &[u32],
+        work: Work,
+    ) -> Result<(), Stop> {
+        match work {
+            Work::Split(step) => self.pass(side, visits, step),
+            Work::Leaves(first) => self.leaf_pass(side, visits, first),
+        }
+    }
+
+    /// The clusters' pass of `step` over `visits`.
+    pub(super) fn pass<S: Side>(
+        &mut self,
+        side: &mut S,
+        visits: &[u32],
+        step: usize,
+    ) -> Result<(), Stop> {
+        let order = self.order;
+        let axis = order.axis(step);
+        let remaining = order.levels as usize - order.level(step);
+        for (i, &v) in visits.iter().enumerate() {
+            if let Some(&ahead) = visits.get(i + PREFETCH_AHEAD) {
+                self.prefetch_ring(ahead as usize, true);
+            }
+            let v = v as usize;
+            let valence = self.adjacency(v).len();
+            let (half, flip) = self.half_context(v, axis);
+            let splits = !self.leaf(v) && {
+                let c = contexts::split(half.offset, valence, remaining);
+                side.code(&mut self.contexts.split[c], Question::Split, false, v, step)?
+            };
+            if !splits {
+                let c = half.index;
+                let bit = side.code(&mut self.contexts.half[c], Question::Half, flip, v, step)?;
+                self.refine(v, step, bit as u32);
+                self.refresh(v);
+                continue;
+            }
+            if self.next_id == self.end_id {
+                return Err(Stop::Fault(match self.slab {
+                    None => format!(
+                        "more splits than the {} vertices the header declares",
+                        self.max_vertices
+                    ),
+                    Some((_, slab)) => {
+                        format!("slab {slab} splits more vertices than its table entry says")
+                    }
+                }));
+            }
+            let r = self.split(side, v, step, axis, remaining)?;
+            self.created.push(r as u32);
+        }
+        Ok(())
+    }
+
+    /// The leaves' three bits of the level whose first step is `first`, for `visits`.
+    pub(super) fn leaf_pass<S: Side>(
+        &mut self,
+        side: &mut S,
+        visits: &[u32],
+        first: usize,
+    ) -> Result<(), Stop> {
+        let axes = [0, 1, 2].map(|k| self.order.axis(first + k));
+        for (i, &v) in visits.iter().enumerate() {
+            if let Some(&ahead) = visits.get(i + PREFETCH_AHEAD) {
+                self.prefetch_ring(ahead as usize, false);
+            }
+            let v = v as usize;
+            let (mut index, mut flips) = ([0; 3], [false; 3]);
+            match self.moments(v) {
+                None => index = [contexts::half_isolated(true).index; 3],
+                Some(m) => {
+                    let shifts = self.shifts[self.depth(v)];
+                    let (by_axis, below) = leaf_contexts(&m, shifts);
+                    for k in 0..3 {
+                        (index[k], flips[k]) = (by_axis[axes[k]], below[axes[k]]);
+                    }
+                }
+            }
+            let bits = side.code3(&mut self.contexts.half, index, flips, v, first)?;
+            for (k, bit) in bits.into_iter().enumerate() {
+                self.refine(v, first + k, bit as u32);
+            }
+            self.refresh(v);
+        }
+        Ok(())
+    }
+
+    /// Asks the processor to load the centres of `v`'s neighbours (and their lists, with
+    /// `lists`), which the visit of `v`, one of this run's, reads a few visits from now: on a
+    /// large mesh they lie far apart in memory, and loading them while the visits before are
+    /// coded hides the wait (bunny-closed-35k ×16: a decode on one thread 8–10% faster).
+    pub(super) fn prefetch_ring(&self, v: usize, lists: bool) {
+        for &n in self.adjacency(v) {
+            prefetch(self.lanes.centres.wrapping_add(n as usize));
+            if lists {
+                prefetch(self.lanes.adjacency.wrapping_add(n as usize));
+            }
+        }
+    }
+
+    /// Reads `v`'s neighbours' lists and centres (a sum for [`std::hint::black_box`] to keep).
+    pub(super) fn touch(&self, v: usize) -> usize {
+        self.adjacency(v)
+            .iter()
+            .map(|&n| self.adjacency(n as usize).len() + self.centre(n as usize)[0] as usize)
+            .sum()
+    }
+
+    pub(super) fn moments(&self, v: usize) -> Option<Moments> {
+        neighbour_moments(self.centre(v), self.adjacency(v), |n| self.centre(n))
+    }
+
+    /// Context and flip of the half `v` takes along `axis`, from its neighbours' moments `m`
+    /// (relative to `v`'s centre); see [`estimate`].
+    #[inline]
+    pub(super) fn predict(
+        &self,
+        v: usize,
+        axis: usize,
+        m: &Moments,
+    ) -> (contexts::HalfContext, bool) {
+        let shifts = self.shifts[self.depth(v)];
+        let (prediction, variance) = estimate(m, axis, shifts);
+        let scale = per_half_width(shifts[axis]);
+        (
+            contexts::half(
+                self.leaf(v),
+                m.k,
+                prediction.abs() * scale,
+                variance * scale * scale,
+            ),
+            prediction < 0.0,
+        )
+    }
+
+    /// Context and flip of the half a vertex in the passes takes ([`Self::predict`] from its
+    /// neighbours as they are now).
+    pub(super) fn half_context(&self, v: usize, axis: usize) -> (contexts::HalfContext, bool) {
+        match self.moments(v) {
+            None => (contexts::half_isolated(self.leaf(v)), false),
+            Some(m) => self.predict(v, axis, &m),
+        }
+    }
+
+    /// What the already coded neighbours of the splitting vertex that are also neighbours of
+    /// `n` did: bit 0 some stayed, bit 1 some moved, bit 2 some were duplicated (read from the
+    /// marks of the current split). Around a manifold vertex the duplicated edges are where the
+    /// stayed arc meets the moved one.
+    pub(super) fn coded_ring(&self, n: usize) -> usize {
+        let mut seen = 0;
+        for &m in self.adjacency(n) {
+            let mark = lane!(self.lanes, marks, m as usize).load(Ordering::Relaxed);
+            seen |= if mark >> 3 == self.serial {
+                mark & 7
+            } else {
+                0
+            };
+        }
+        seen as usize
+    }
+
+    pub(super) fn split<S: Side>(
+        &mut self,
+        side: &mut S,
+        v: usize,
+        step: usize,
+        axis: usize,
+        remaining: usize,
+    ) -> Result<usize, Stop> {
+        let r = self.next_id;
+        side.begin_split(self.adjacency(v), v, r, step, self.lanes.len);
+        let valence = self.adjacency(v).len();
+        // The neighbours' lists and centres are about to be read (and most lists edited): load
+        // them now, side by side, rather than one after another between the questions (which
+        // leaves the processor waiting on each in turn).
+        std::hint::black_box(self.touch(v));
+        let c = contexts::connecting(valence, remaining);
+        let connecting = side.code(
+            &mut self.contexts.connecting[c],
+            Question::Connecting,
+            false,
+            v,
+            step,
+        )?;
+        let centre = self.centre(v);
+        let scale = per_half_width(self.shifts[self.depth(v)][axis]);
+        let mut codes = std::mem::take(&mut self.codes);
+        codes.clear();
+        // Marks left by earlier splits are told apart by their serial.
+        self.serial += self.serial_step;
+        let mut duplicates = 0;
+        for i in 0..valence {
+            let n = self.adjacency(v)[i] as usize;
+            let offset = self.centre(n).map(|x| x as i64);
+            let along = (offset[axis] - centre[axis] as i64) as f64 * scale;
+            let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+            let across = (offset[b] - centre[b] as i64)
+                .abs()
+                .max((offset[c] - centre[c] as i64).abs()) as f64
+                * scale;
+            let place = contexts::edge_place(along.abs(), across, self.leaf(n));
+            let ring = self.coded_ring(n);
+            let c = contexts::duplicate(place, ring, duplicates);
+            let code = if side.code(
+                &mut self.contexts.duplicate[c],
+                Question::Duplicate(i),
+                false,
+                v,
+                step,
+            )? {
+                duplicates += 1;
+                EdgeCode::Duplicate
+            } else if side.code(
+                &mut self.contexts.moves[contexts::moves(place, ring, along < 0.0)],
+                Question::Moves(i),
+                along < 0.0,
+                v,
+                step,
+            )? {
+                EdgeCode::Move
+            } else {
+                EdgeCode::Stay
+            };
+            codes.push(code);
+            let mark = self.serial << 3
+                | match code {
+                    EdgeCode::Stay => 1,
+                    EdgeCode::Move => 2,
+                    EdgeCode::Duplicate => 4,
+                };
+            lane!(self.lanes, marks, n).store(mark, Ordering::Relaxed);
+        }
+        // VS: `v` keeps the lower half, `r` takes the upper.
+        self.next_id += 1;
+        let mut cell = *lane!(self.lanes, cells, v);
+        lane_mut!(self.lanes, cells, v)[axis] = cell[axis] << 1;
+        cell[axis] = (cell[axis] << 1) | 1;
+        *lane_mut!(self.lanes, cells, r) = cell;
+        let depth = lane_mut!(self.lanes, depth, v);
+        *depth += 1;
+        let depth = *depth;
+        *lane_mut!(self.lanes, depth, r) = depth;
+        *lane_mut!(self.lanes, next_split, v) = NO_SPLIT;
+        *lane_mut!(self.lanes, next_split, r) = NO_SPLIT;
+        *lane_mut!(self.lanes, adjacency, r) = Neighbours::new();
+        self.edges += split_edges(&mut LaneLists(self.lanes), v, r, connecting, &codes);
+        check_edge_count(self.edges, self.max_triangles).map_err(Stop::Fault)?;
+        self.refresh(v);
+        self.refresh(r);
+        self.codes = codes;
+        *lane_mut!(self.lanes, leaf, r) = false;
+        for (half, vertex) in [(0, v), (1, r)] {
+            let valence = self.adjacency(vertex).len();
+            // The upper half's question knows the lower half's answer.
+            let kind = if half == 0 {
+                0
+            } else {
+                1 + self.leaf(v) as usize
+            };
+            let c = contexts::leaf(kind, valence, remaining);
+            *lane_mut!(self.lanes, leaf, vertex) = side.code(
+                &mut self.contexts.leaf[c],
+                Question::Leaf(half),
+                false,
+                vertex,
+                step,
+            )?;
+        }
+        side.end_split(v, r);
+        Ok(r)
+    }
+}
+
+/// The neighbour lists of [`Lanes`], for [`split_edges`].
+pub(super) struct LaneLists<'a>(&'a Lanes);
+
+// A lane's list, through `lane_mut!`.
+
+#[allow(unsafe_code)]
+impl NeighbourLists for LaneLists<'_> {
+    fn list(&mut self, v: usize) -> &mut Neighbours {
+        lane_mut!(self.0, adjacency, v)
+    }
+}
