@@ -70,8 +70,8 @@ pub enum Capability {
     /// Decodes what is present of a level the stream was cut in, through
     /// [`LevelDecoder::partial_levels`].
     PartialLevels,
-    /// Refines parts of the mesh view-dependently, units fetched by byte range (no codec of
-    /// this build).
+    /// Refines parts of the mesh view-dependently, units fetched by byte range, through
+    /// [`Codec::selective_refinement`] (`came`, `came-paper`).
     SelectiveRefinement,
     /// Carries appearance attributes — normals, texture coordinates, colours, materials — in
     /// an appearance unit decoded with the full level ([`encode_attributed`]; every codec whose
@@ -146,6 +146,11 @@ pub trait Codec: Send + Sync {
         _appearance: &CanonicalAttributes,
         _fit: AttributeFit,
     ) -> Option<Result<Encoded>> {
+        None
+    }
+    /// What the codec offers view-dependent refinement, for codecs with
+    /// [`Capability::SelectiveRefinement`] (the CAME codecs); `None` for the others.
+    fn selective_refinement(&self) -> Option<&dyn came::selective::SelectiveRefinement> {
         None
     }
     /// Whether this codec's streams carry appearance inside their levels.
@@ -540,6 +545,29 @@ mod tests {
                 "{}",
                 codec.name()
             );
+            // Selective refinement: the hook is there exactly when listed, and its whole
+            // hierarchy has a leaf a vertex; the others are refused by name in one line.
+            assert_eq!(
+                codec.selective_refinement().is_some(),
+                has(Capability::SelectiveRefinement),
+                "{}",
+                codec.name()
+            );
+            match came::decode_tree(&bytes) {
+                Ok((header, tree)) => {
+                    assert!(has(Capability::SelectiveRefinement), "{}", codec.name());
+                    let leaves = tree.nodes.iter().filter(|n| n.leaf).count();
+                    assert_eq!(leaves as u64, header.vertices, "{}", codec.name());
+                }
+                Err(e) => {
+                    assert!(
+                        !has(Capability::SelectiveRefinement),
+                        "{}: {e}",
+                        codec.name()
+                    );
+                    assert!(e.to_string().contains(codec.name()), "{e}");
+                }
+            }
             if !has(Capability::PassStops) {
                 let e = decode(&bytes, Stop::Passes(1)).unwrap_err();
                 assert!(e.to_string().contains("cannot stop inside a level"), "{e}");

@@ -33,6 +33,7 @@ pub mod modelled;
 pub mod paper;
 pub mod partition;
 pub mod refine;
+pub mod selective;
 
 use crate::codecs::{CameField, Stat, Stats};
 use crate::container::{Header, LevelCost, StreamWriter};
@@ -81,31 +82,25 @@ pub fn level_ends(stream: &crate::container::StreamReader, params: &Params) -> R
         .collect())
 }
 
-/// The whole hierarchy of a stream of either CAME codec, every unit decoded, with its header.
+/// The whole hierarchy of a stream of a codec with selective refinement (either CAME codec),
+/// every unit decoded, with its header.
 pub fn decode_tree(bytes: &[u8]) -> Result<(Header, decoded::DecodedTree)> {
     let reader = crate::container::StreamReader::open(bytes)?;
     let header = reader.header().clone();
-    let name = crate::codecs::by_id(header.codec_id)?.name();
-    let tree = match name {
-        "came" => {
-            let params = modelled::params(&header)?;
-            let mut d = decoded::CameDecoder::new(reader, params, modelled::ModelledUnits)?;
-            d.decode_everything()?;
-            d.into_tree()
-        }
-        "came-paper" => {
-            let params = paper::params(&header)?;
-            let mut d = decoded::CameDecoder::new(reader, params, paper::PaperUnits::default())?;
-            d.decode_everything()?;
-            d.into_tree()
-        }
-        other => {
-            return Err(Error::Unsupported(format!(
-                "{other} streams hold no vertex hierarchy; view-dependent refinement needs came or came-paper"
-            )))
-        }
-    };
+    let tree = refining_codec(&header)?.decode_tree(reader)?;
     Ok((header, tree))
+}
+
+/// The codec of the stream of `header`, for view-dependent refinement: an error for a codec
+/// whose streams hold no vertex hierarchy.
+pub fn refining_codec(header: &Header) -> Result<&'static dyn selective::SelectiveRefinement> {
+    let codec = crate::codecs::by_id(header.codec_id)?;
+    codec.selective_refinement().ok_or_else(|| {
+        Error::Unsupported(format!(
+            "{} streams hold no vertex hierarchy; view-dependent refinement needs a codec with selective refinement (came, came-paper)",
+            codec.name()
+        ))
+    })
 }
 
 /// Levels of the hierarchy per meta-node (the paper's L).

@@ -177,7 +177,11 @@ impl Codec for CamePaper {
     }
 
     fn capabilities(&self) -> &'static [Capability] {
-        &[]
+        &[Capability::SelectiveRefinement]
+    }
+
+    fn selective_refinement(&self) -> Option<&dyn super::selective::SelectiveRefinement> {
+        Some(self)
     }
 
     fn lossless(&self) -> bool {

@@ -53,7 +53,11 @@ impl Codec for Came {
     }
 
     fn capabilities(&self) -> &'static [Capability] {
-        &[Capability::Attributes]
+        &[Capability::Attributes, Capability::SelectiveRefinement]
+    }
+
+    fn selective_refinement(&self) -> Option<&dyn super::selective::SelectiveRefinement> {
+        Some(self)
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {

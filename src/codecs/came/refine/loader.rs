@@ -6,8 +6,9 @@
 //! source's length as its bound (a unit said to lie past the source's end is refused unread),
 //! and the decoded tree grows unit by unit.
 
-use crate::codecs::came::decoded::{to_world, CameDecoder, DecodedTree, DecodedUnit, UnitDecoder};
-use crate::codecs::came::{modelled, paper};
+use crate::codecs::came::decoded::{to_world, DecodedTree, DecodedUnit};
+use crate::codecs::came::refining_codec;
+use crate::codecs::came::selective::DetachedUnits;
 use crate::container::{read_header_and_index, Header, Index};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::NormalCone;
@@ -139,17 +140,6 @@ pub(super) struct Loaded {
     pub outcome: Result<UnitDelta>,
 }
 
-/// Decodes units given their bytes: either codec's [`CameDecoder`], detached from the stream.
-trait UnitLoading: Send {
-    fn load(&mut self, unit: usize, bytes: &[u8], header: &Header) -> Result<UnitDelta>;
-}
-
-impl<U: UnitDecoder + Send> UnitLoading for CameDecoder<'static, U> {
-    fn load(&mut self, unit: usize, bytes: &[u8], header: &Header) -> Result<UnitDelta> {
-        self.decode_unit_checked(unit, bytes, |decoded| delta(decoded, header))
-    }
-}
-
 /// What `decoded` added, checked so that the view-dependent mesh can take it as it is.
 fn delta(decoded: &DecodedUnit, header: &Header) -> Result<UnitDelta> {
     let bad = |what: &str| Error::malformed(0, 0, what.to_string());
@@ -221,7 +211,7 @@ pub(super) struct Worker {
     source: Box<dyn ByteSource>,
     /// The stream's first bytes, read with the header and index (the first units are in them).
     head: Vec<u8>,
-    decoder: Box<dyn UnitLoading>,
+    decoder: Box<dyn DetachedUnits>,
     header: Header,
     index: Index,
     payload_start: u64,
@@ -264,8 +254,19 @@ impl Worker {
         Loaded {
             unit,
             bytes: read,
-            outcome: self.decoder.load(unit, &bytes, &self.header),
+            outcome: self.decode(unit, &bytes),
         }
+    }
+
+    /// Decodes `unit` from its bytes: what it added, checked.
+    fn decode(&mut self, unit: usize, bytes: &[u8]) -> Result<UnitDelta> {
+        let header = &self.header;
+        let mut added = None;
+        self.decoder.decode_unit_then(unit, bytes, &mut |decoded| {
+            added = Some(delta(decoded, header)?);
+            Ok(())
+        })?;
+        added.ok_or_else(|| Error::malformed(0, 0, format!("unit {unit} added nothing")))
     }
 }
 
@@ -336,29 +337,7 @@ impl Loader {
                 format!("{extra} bytes after the last unit"),
             ));
         }
-        let name = crate::codecs::by_id(header.codec_id)?.name();
-        let start = payload_start as usize;
-        let decoder: Box<dyn UnitLoading> = match name {
-            "came" => Box::new(CameDecoder::detached(
-                header.clone(),
-                index.clone(),
-                start,
-                modelled::params(&header)?,
-                modelled::ModelledUnits,
-            )?),
-            "came-paper" => Box::new(CameDecoder::detached(
-                header.clone(),
-                index.clone(),
-                start,
-                paper::params(&header)?,
-                paper::PaperUnits::default(),
-            )?),
-            other => {
-                return Err(Error::Unsupported(format!(
-                    "{other} streams hold no vertex hierarchy; view-dependent refinement needs came or came-paper"
-                )))
-            }
-        };
+        let decoder = refining_codec(&header)?.detached(&header, &index, payload_start as usize)?;
         let mut worker = Box::new(Worker {
             source,
             head,
@@ -447,7 +426,7 @@ impl Loader {
                     bytes.len()
                 )))
             } else {
-                worker.decoder.load(unit, bytes, &worker.header)
+                worker.decode(unit, bytes)
             };
             supplied.push(Loaded {
                 unit,

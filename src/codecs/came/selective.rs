@@ -1,0 +1,105 @@
+//! What the CAME codecs offer view-dependent refinement ([`Capability::SelectiveRefinement`],
+//! reached through [`Codec::selective_refinement`]): a decoder of any unit once its ancestors
+//! are, given each unit's bytes wherever they were read, and the whole hierarchy at once. The
+//! refinement runtime (`refine`) and the tools ask the codec for these, never its name.
+//!
+//! [`Capability::SelectiveRefinement`]: crate::codecs::Capability::SelectiveRefinement
+//! [`Codec::selective_refinement`]: crate::codecs::Codec::selective_refinement
+
+use super::decoded::{CameDecoder, DecodedTree, DecodedUnit, UnitDecoder};
+use super::{modelled, paper};
+use crate::container::{Header, Index, StreamReader};
+use crate::error::Result;
+
+/// A codec whose units are meta-nodes of a vertex hierarchy.
+pub trait SelectiveRefinement: Sync {
+    /// A decoder of the stream of `header` and `index` (its payload at `payload_start`) that is
+    /// given each unit's bytes rather than holding the stream.
+    fn detached(
+        &self,
+        header: &Header,
+        index: &Index,
+        payload_start: usize,
+    ) -> Result<Box<dyn DetachedUnits>>;
+
+    /// Every unit of the stream `reader` reads, decoded: the whole hierarchy.
+    fn decode_tree(&self, reader: StreamReader<'_>) -> Result<DecodedTree>;
+}
+
+/// Either CAME codec's decoder detached from its stream ([`CameDecoder::detached`]).
+pub trait DetachedUnits: Send {
+    /// Decodes unit `i` from `bytes` (its whole payload), its ancestors decoded, then runs
+    /// `check` on what it added; an error from either leaves the tree as it was.
+    fn decode_unit_then(
+        &mut self,
+        i: usize,
+        bytes: &[u8],
+        check: &mut dyn FnMut(&DecodedUnit) -> Result<()>,
+    ) -> Result<()>;
+}
+
+impl<U: UnitDecoder + Send> DetachedUnits for CameDecoder<'static, U> {
+    fn decode_unit_then(
+        &mut self,
+        i: usize,
+        bytes: &[u8],
+        check: &mut dyn FnMut(&DecodedUnit) -> Result<()>,
+    ) -> Result<()> {
+        self.decode_unit_checked(i, bytes, check)
+    }
+}
+
+/// Decodes every unit of `reader` with `units`.
+fn whole<U: UnitDecoder>(
+    reader: StreamReader<'_>,
+    params: super::Params,
+    units: U,
+) -> Result<DecodedTree> {
+    let mut decoder = CameDecoder::new(reader, params, units)?;
+    decoder.decode_everything()?;
+    Ok(decoder.into_tree())
+}
+
+impl SelectiveRefinement for modelled::Came {
+    fn detached(
+        &self,
+        header: &Header,
+        index: &Index,
+        payload_start: usize,
+    ) -> Result<Box<dyn DetachedUnits>> {
+        Ok(Box::new(CameDecoder::detached(
+            header.clone(),
+            index.clone(),
+            payload_start,
+            modelled::params(header)?,
+            modelled::ModelledUnits,
+        )?))
+    }
+
+    fn decode_tree(&self, reader: StreamReader<'_>) -> Result<DecodedTree> {
+        let params = modelled::params(reader.header())?;
+        whole(reader, params, modelled::ModelledUnits)
+    }
+}
+
+impl SelectiveRefinement for paper::CamePaper {
+    fn detached(
+        &self,
+        header: &Header,
+        index: &Index,
+        payload_start: usize,
+    ) -> Result<Box<dyn DetachedUnits>> {
+        Ok(Box::new(CameDecoder::detached(
+            header.clone(),
+            index.clone(),
+            payload_start,
+            paper::params(header)?,
+            paper::PaperUnits::default(),
+        )?))
+    }
+
+    fn decode_tree(&self, reader: StreamReader<'_>) -> Result<DecodedTree> {
+        let params = paper::params(reader.header())?;
+        whole(reader, params, paper::PaperUnits::default())
+    }
+}
