@@ -215,6 +215,26 @@ impl View {
         self.deviates(center, radius, deviation, scale) && !self.faces_away(center, radius, cone)
     }
 
+    /// How far a node's deviation could reach on the screen, in tolerances: the ratio of the
+    /// two sides of [`View::wants_split`]'s test, e·√(1 + t²) / (κ·z_min) (infinite for a sphere
+    /// reaching the eye's plane, 0 for one out of the frustum or of no deviation). What the
+    /// meta-nodes a view waits for are fetched by, largest first.
+    pub fn screen_error(&self, center: DVec3, radius: f64, deviation: f64, scale: f64) -> f64 {
+        let k = self.kappa * scale;
+        if deviation <= 0.0 || !k.is_finite() || !self.sees(center, radius) {
+            return 0.0;
+        }
+        let d = center - self.eye;
+        let depth = d.dot(self.forward);
+        let nearest = depth - radius;
+        if nearest <= 0.0 || k == 0.0 {
+            return f64::INFINITY;
+        }
+        let lateral = (d - self.forward * depth).length() + radius;
+        let tangent = lateral / nearest;
+        deviation * (1.0 + tangent * tangent).sqrt() / (k * nearest)
+    }
+
     fn deviates(&self, center: DVec3, radius: f64, deviation: f64, scale: f64) -> bool {
         let k = self.kappa * scale;
         if deviation <= 0.0 || !k.is_finite() || !self.sees(center, radius) {
@@ -391,5 +411,44 @@ mod tests {
         c.fov_degrees = 180.0;
         assert!(View::new(&c, 1.0).is_err());
         assert!(View::new(&camera(), f64::NAN).is_err());
+    }
+
+    /// The screen error is what the split test compares with 1: at least 1 exactly where the
+    /// test refines (away from the boundary, where rounding may fall either way), growing as
+    /// the node nears the eye, infinite at the eye's plane, 0 out of view.
+    #[test]
+    fn screen_error_is_the_split_tests_ratio() {
+        let view = View::new(&camera(), 1.0).unwrap();
+        let mut previous = 0.0;
+        for z in [-40.0, -20.0, -5.0, 0.0, 5.0, 8.0, 9.5] {
+            let error = view.screen_error(DVec3::new(0.0, 0.0, z), 0.1, 0.01, 1.0);
+            assert!(error > previous, "{error} at z = {z} after {previous}");
+            previous = error;
+        }
+        assert_eq!(
+            view.screen_error(DVec3::new(0.0, 0.0, 9.95), 0.1, 0.01, 1.0),
+            f64::INFINITY
+        );
+        assert_eq!(
+            view.screen_error(DVec3::new(0.0, 0.0, 30.0), 0.1, 0.01, 1.0),
+            0.0
+        );
+        assert_eq!(view.screen_error(DVec3::ZERO, 0.1, 0.0, 1.0), 0.0);
+        for i in 0..400 {
+            let at = DVec3::new(
+                (i % 20) as f64 - 10.0,
+                ((i / 20) % 5) as f64 - 2.0,
+                -(i as f64) / 10.0,
+            );
+            let deviation = 0.001 * (1 + i % 7) as f64;
+            let error = view.screen_error(at, 0.05, deviation, 1.0);
+            if (error - 1.0).abs() > 1e-9 {
+                assert_eq!(
+                    error >= 1.0,
+                    view.wants_split(at, 0.05, deviation, &NONE, 1.0),
+                    "{at} {deviation}"
+                );
+            }
+        }
     }
 }

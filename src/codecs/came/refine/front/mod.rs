@@ -282,6 +282,9 @@ pub struct ViewMesh {
     units: Vec<UnitState>,
     /// Asked for and not arrived.
     outstanding: usize,
+    /// Meta-nodes this adaptation asked for, each with the node whose split waits for it: sent
+    /// to the loader at its end, most wanted first ([`ViewMesh::send_requests`]).
+    to_request: Vec<(u32, u32)>,
     /// Per meta-node: its bytes were handed over ([`Fetch::External`]).
     supplied: Vec<bool>,
     refusals: Vec<(usize, String)>,
@@ -336,6 +339,7 @@ impl ViewMesh {
             loader,
             units,
             outstanding: 1,
+            to_request: Vec::new(),
             supplied: vec![false; opened.index.len()],
             refusals: Vec::new(),
             bytes_read: opened.head_bytes,
@@ -455,6 +459,7 @@ impl ViewMesh {
         self.settle_orientation(view, budget, &mut done, &mut pass, new_view);
         self.pass = pass;
         self.regulate(budget.faces, done.capped);
+        self.send_requests(view);
         done
     }
 

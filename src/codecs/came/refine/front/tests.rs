@@ -130,6 +130,51 @@ fn fetching_units_externally_reaches_the_inline_front() {
     assert_eq!(triangles(&external.mesh()), triangles(&inline.mesh()));
 }
 
+/// The meta-nodes a view waits for are asked for in order of the screen error of the nodes
+/// waiting for them, largest first.
+#[test]
+fn meta_nodes_are_asked_for_most_wanted_first() {
+    let bytes = stream();
+    let head = head_length(bytes).unwrap().unwrap() as usize;
+    for eye in [
+        DVec3::new(0.5, 0.8, 3.0),
+        DVec3::new(-2.0, 1.0, 1.5),
+        DVec3::new(2.5, 0.2, 1.0),
+    ] {
+        let view = View::new(&camera(eye), 0.5).unwrap();
+        let mut front = ViewMesh::open(bytes[..head].to_vec(), Fetch::External).unwrap();
+        let mut checked = 0;
+        for _ in 0..16 {
+            let done = front.adapt(&view, Budget::UNLIMITED);
+            let wanted = front.wanted();
+            let errors: Vec<f64> = wanted
+                .iter()
+                .map(|&(unit, _)| {
+                    let v = (0..front.opens.len())
+                        .find(|&v| front.opens[v] == unit as u32)
+                        .expect("a node waits for each unit asked for");
+                    let (center, radius) = front.spheres[v];
+                    view.screen_error(center, radius, front.deviations[v], front.scale)
+                })
+                .collect();
+            assert!(
+                errors.windows(2).all(|w| w[0] >= w[1]),
+                "asked for out of order: {errors:?}"
+            );
+            checked += errors.len();
+            if done.settled {
+                break;
+            }
+            for (unit, range) in wanted {
+                front
+                    .supply(unit, &bytes[range.start as usize..range.end as usize])
+                    .unwrap();
+            }
+        }
+        assert!(checked > 1, "{checked} units asked for");
+    }
+}
+
 /// Bytes that are not a unit's (cut short) leave its branch coarse, refused, not a panic.
 #[test]
 fn a_cut_unit_supplied_is_refused() {
