@@ -15,7 +15,6 @@ use crate::hierarchy::came::cones::NormalCone;
 use crate::hierarchy::came::NodeId;
 use glam::DVec3;
 use smallvec::SmallVec;
-use std::collections::VecDeque;
 use std::io::{Read, Seek, SeekFrom};
 use std::sync::mpsc;
 
@@ -280,20 +279,57 @@ pub(super) struct Opened {
     pub root: Loaded,
 }
 
-/// The loader: a thread reading and decoding units, or a queue worked through inline.
+/// A unit asked for, with what orders it among the others: its priority (larger first: the
+/// screen error of the node waiting for it, never negative, as the bits of an `f64`, which
+/// order as the values do), then the order of asking.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct Request {
+    priority: u64,
+    first: std::cmp::Reverse<u64>,
+    unit: usize,
+}
+
+/// Units asked for and not yet fetched, the most wanted first.
+#[derive(Default)]
+pub(super) struct Requests {
+    heap: std::collections::BinaryHeap<Request>,
+    asked: u64,
+}
+
+impl Requests {
+    fn push(&mut self, unit: usize, priority: f64) {
+        self.asked += 1;
+        self.heap.push(Request {
+            priority: priority.max(0.0).to_bits(),
+            first: std::cmp::Reverse(self.asked),
+            unit,
+        });
+    }
+
+    fn pop(&mut self) -> Option<usize> {
+        self.heap.pop().map(|r| r.unit)
+    }
+
+    fn is_empty(&self) -> bool {
+        self.heap.is_empty()
+    }
+}
+
+/// The loader: a thread reading and decoding units, or a queue worked through inline; either
+/// way the units asked for are fetched most wanted first.
 pub(super) enum Loader {
     Inline {
         worker: Box<Worker>,
-        queue: VecDeque<usize>,
+        queue: Requests,
     },
     Background {
-        requests: mpsc::Sender<usize>,
+        requests: mpsc::Sender<(usize, f64)>,
         results: mpsc::Receiver<Loaded>,
     },
     External {
         worker: Box<Worker>,
         /// Asked for, not yet handed to the caller.
-        wanted: Vec<usize>,
+        wanted: Requests,
         /// Supplied by the caller and decoded, not yet collected.
         supplied: Vec<Loaded>,
     },
@@ -352,21 +388,34 @@ impl Loader {
         let loader = match fetch {
             Fetch::Inline => Loader::Inline {
                 worker,
-                queue: VecDeque::new(),
+                queue: Requests::default(),
             },
             Fetch::External => Loader::External {
                 worker,
-                wanted: Vec::new(),
+                wanted: Requests::default(),
                 supplied: Vec::new(),
             },
             Fetch::Background => {
-                let (requests, inbox) = mpsc::channel::<usize>();
+                let (requests, inbox) = mpsc::channel::<(usize, f64)>();
                 let (outbox, results) = mpsc::channel();
                 std::thread::Builder::new()
                     .name("came-loader".into())
                     .spawn(move || {
-                        // Ends when the view-dependent mesh is dropped (its sender with it).
-                        for unit in inbox {
+                        // Before each unit, every request that came meanwhile joins the queue,
+                        // so the most wanted goes first. Ends when the view-dependent mesh is
+                        // dropped (its sender with it).
+                        let mut queue = Requests::default();
+                        loop {
+                            if queue.is_empty() {
+                                match inbox.recv() {
+                                    Ok((unit, priority)) => queue.push(unit, priority),
+                                    Err(_) => break,
+                                }
+                            }
+                            for (unit, priority) in inbox.try_iter() {
+                                queue.push(unit, priority);
+                            }
+                            let Some(unit) = queue.pop() else { continue };
                             if outbox.send(worker.load(unit)).is_err() {
                                 break;
                             }
@@ -384,32 +433,32 @@ impl Loader {
         Ok((loader, opened))
     }
 
-    /// Asks for `unit` (once: the caller keeps track).
-    pub fn request(&mut self, unit: usize) {
+    /// Asks for `unit` (once: the caller keeps track), `priority` saying how much it is wanted
+    /// (the screen error of the node waiting for it): units waiting are fetched largest first.
+    pub fn request(&mut self, unit: usize, priority: f64) {
         match self {
-            Loader::Inline { queue, .. } => queue.push_back(unit),
+            Loader::Inline { queue, .. } => queue.push(unit, priority),
             Loader::Background { requests, .. } => {
                 // A loader thread that ended (it only ends with us) leaves the unit waiting.
-                let _ = requests.send(unit);
+                let _ = requests.send((unit, priority));
             }
-            Loader::External { wanted, .. } => wanted.push(unit),
+            Loader::External { wanted, .. } => wanted.push(unit, priority),
         }
     }
 
-    /// The units asked for since the last call, each with its byte range in the stream, in
-    /// the order they were asked for (external fetching; none otherwise).
+    /// The units asked for since the last call, each with its byte range in the stream, most
+    /// wanted first (external fetching; none otherwise).
     pub fn take_wanted(&mut self) -> Vec<(usize, std::ops::Range<u64>)> {
-        match self {
-            Loader::External { worker, wanted, .. } => wanted
-                .drain(..)
-                .map(|unit| {
-                    let entry = worker.index.units[unit];
-                    let start = worker.payload_start + entry.offset;
-                    (unit, start..start + entry.length)
-                })
-                .collect(),
-            _ => Vec::new(),
-        }
+        let Loader::External { worker, wanted, .. } = self else {
+            return Vec::new();
+        };
+        std::iter::from_fn(|| wanted.pop())
+            .map(|unit| {
+                let entry = worker.index.units[unit];
+                let start = worker.payload_start + entry.offset;
+                (unit, start..start + entry.length)
+            })
+            .collect()
     }
 
     /// Decodes `bytes`, the caller's fetch of `unit`'s byte range: collected at the next
@@ -440,7 +489,9 @@ impl Loader {
     /// arrived. `outstanding` is how many were asked for and not yet handed back.
     pub fn collect(&mut self, outstanding: usize, block: bool) -> Vec<Loaded> {
         match self {
-            Loader::Inline { worker, queue } => queue.drain(..).map(|u| worker.load(u)).collect(),
+            Loader::Inline { worker, queue } => std::iter::from_fn(|| queue.pop())
+                .map(|u| worker.load(u))
+                .collect(),
             Loader::External { supplied, .. } => std::mem::take(supplied),
             Loader::Background { results, .. } => {
                 let mut out: Vec<Loaded> = results.try_iter().collect();

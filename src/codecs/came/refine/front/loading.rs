@@ -2,7 +2,6 @@
 //! hierarchy under the front, and whether a node's split is loaded, on its way or impossible.
 
 use super::super::loader::{Loaded, UnitDelta, NONE};
-use super::super::view::View;
 use super::{Ready, State, Suspicion, UnitState, ViewMesh};
 use smallvec::SmallVec;
 
@@ -98,35 +97,15 @@ impl ViewMesh {
             UnitState::Idle => {
                 self.units[unit as usize] = UnitState::Requested;
                 self.outstanding += 1;
-                self.to_request.push((unit, v));
+                let (center, radius) = self.spheres[vu];
+                let priority =
+                    self.view_now
+                        .screen_error(center, radius, self.deviations[vu], self.scale);
+                self.loader.request(unit as usize, priority);
                 Ready::Waiting
             }
             UnitState::Requested => Ready::Waiting,
             UnitState::Loaded | UnitState::Refused => Ready::Never,
-        }
-    }
-
-    /// Sends the meta-nodes this adaptation asked for to the loader, in order of the screen
-    /// error of the nodes waiting for them ([`View::screen_error`]), largest first, so that
-    /// what the view misses most arrives first.
-    pub(super) fn send_requests(&mut self, view: &View) {
-        if self.to_request.is_empty() {
-            return;
-        }
-        let mut wanted: Vec<(f64, u32)> = self
-            .to_request
-            .drain(..)
-            .map(|(unit, v)| {
-                let (center, radius) = self.spheres[v as usize];
-                let error =
-                    view.screen_error(center, radius, self.deviations[v as usize], self.scale);
-                (error, unit)
-            })
-            .collect();
-        // Largest error first; ties (spheres reaching the eye's plane) in the order asked.
-        wanted.sort_by(|a, b| b.0.total_cmp(&a.0));
-        for (_, unit) in wanted {
-            self.loader.request(unit as usize);
         }
     }
 }

@@ -282,9 +282,9 @@ pub struct ViewMesh {
     units: Vec<UnitState>,
     /// Asked for and not arrived.
     outstanding: usize,
-    /// Meta-nodes this adaptation asked for, each with the node whose split waits for it: sent
-    /// to the loader at its end, most wanted first ([`ViewMesh::send_requests`]).
-    to_request: Vec<(u32, u32)>,
+    /// The view of the adaptation under way: the meta-nodes it asks for go to the loader with
+    /// the screen error of the node waiting for them ([`View::screen_error`]).
+    view_now: View,
     /// Per meta-node: its bytes were handed over ([`Fetch::External`]).
     supplied: Vec<bool>,
     refusals: Vec<(usize, String)>,
@@ -339,7 +339,7 @@ impl ViewMesh {
             loader,
             units,
             outstanding: 1,
-            to_request: Vec::new(),
+            view_now: View::nothing(),
             supplied: vec![false; opened.index.len()],
             refusals: Vec::new(),
             bytes_read: opened.head_bytes,
@@ -450,6 +450,9 @@ impl ViewMesh {
     /// while the view does not want them, until a pass changes nothing or the budget is spent.
     /// Splits that need a meta-node not loaded ask for it and wait.
     pub fn adapt(&mut self, view: &View, budget: Budget) -> Adapted {
+        if self.view_now != *view {
+            self.view_now = view.clone();
+        }
         let mut done = Adapted {
             loaded: self.take_arrivals(false),
             ..Adapted::default()
@@ -459,7 +462,6 @@ impl ViewMesh {
         self.settle_orientation(view, budget, &mut done, &mut pass, new_view);
         self.pass = pass;
         self.regulate(budget.faces, done.capped);
-        self.send_requests(view);
         done
     }
 
