@@ -10,7 +10,7 @@ import { join } from "node:path";
 
 import init from "../pkg/meshcodec.js";
 import { CameStream, bytesReader } from "../came.js";
-import { assertSameBits, native, root } from "./native.mjs";
+import { assertSameBits, native, readPly, root, triangleSet } from "./native.mjs";
 
 await init({ module_or_path: readFileSync(join(root, "web/pkg/meshcodec_bg.wasm")) });
 
@@ -31,32 +31,7 @@ function nativeView(stream, camera, extra = []) {
     "--fov", String(camera.fov), "--size", `${camera.width}x${camera.height}`, ...extra,
   ]).toString();
   const units = Number(/(\d+) of \d+ meta-nodes/.exec(said)[1]);
-  const bytes = readFileSync(out);
-  const headerEnd = bytes.indexOf("end_header\n") + "end_header\n".length;
-  const header = bytes.subarray(0, headerEnd).toString("latin1");
-  const vertices = Number(/element vertex (\d+)/.exec(header)[1]);
-  const faces = Number(/element face (\d+)/.exec(header)[1]);
-  const view = new DataView(bytes.buffer, bytes.byteOffset + headerEnd);
-  const positions = new Float64Array(vertices * 3);
-  for (let i = 0; i < positions.length; i++) positions[i] = view.getFloat64(i * 8, true);
-  const indices = new Uint32Array(faces * 3);
-  for (let f = 0; f < faces; f++) {
-    for (let c = 0; c < 3; c++) indices[f * 3 + c] = view.getInt32(vertices * 24 + f * 13 + 1 + 4 * c, true);
-  }
-  return { positions, indices, units };
-}
-
-/** A mesh's triangles, each rotated to start at its least corner, sorted: the adapted mesh's
- * face order follows the order its splits were made in, which the native loader thread's timing
- * may change. */
-function triangleSet(indices) {
-  const out = [];
-  for (let f = 0; f < indices.length; f += 3) {
-    const t = Array.from(indices.subarray(f, f + 3));
-    const least = t.indexOf(Math.min(...t));
-    out.push([...t.slice(least), ...t.slice(0, least)].join(" "));
-  }
-  return out.sort();
+  return { ...readPly(out), units };
 }
 
 /** Bytes served by range, counting what was asked for. */

@@ -12,7 +12,13 @@ export const native = process.env.MESHCODEC_BIN ?? join(root, "target/release/me
 export function nativeLevel(stream, level, scratch) {
   const out = join(scratch, `level-${level}.ply`);
   execFileSync(native, ["decode", stream, out, "--level", String(level), "--drop-attributes"]);
-  const bytes = readFileSync(out);
+  return readPly(out);
+}
+
+/** A binary PLY as the native binary writes it (double x, y, z; faces of three int corners):
+ * {positions: Float64Array, indices: Uint32Array}. */
+export function readPly(path) {
+  const bytes = readFileSync(path);
   const headerEnd = bytes.indexOf("end_header\n") + "end_header\n".length;
   const header = bytes.subarray(0, headerEnd).toString("latin1");
   const vertices = Number(/element vertex (\d+)/.exec(header)[1]);
@@ -28,6 +34,18 @@ export function nativeLevel(stream, level, scratch) {
     at += 13;
   }
   return { positions, indices };
+}
+
+/** A mesh's triangles, each rotated to start at its least corner, sorted: the same triangles
+ * in any order (an adapted mesh's face order follows the order its splits were made in). */
+export function triangleSet(indices) {
+  const out = [];
+  for (let f = 0; f < indices.length; f += 3) {
+    const t = Array.from(indices.subarray(f, f + 3));
+    const least = t.indexOf(Math.min(...t));
+    out.push([...t.slice(least), ...t.slice(0, least)].join(" "));
+  }
+  return out.sort();
 }
 
 /** Positions compared bit for bit (NaN-safe, -0 apart from +0). */

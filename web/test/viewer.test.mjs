@@ -11,7 +11,7 @@ import { join } from "node:path";
 import { chromium } from "playwright-core";
 
 import { serve } from "../serve.mjs";
-import { assertSameBits, native, nativeLevel, root } from "./native.mjs";
+import { assertSameBits, native, nativeLevel, readPly, root, triangleSet } from "./native.mjs";
 
 const scratch = join(root, "target/web-test");
 const CHROMIUM_FLAGS = [
@@ -223,29 +223,13 @@ test("a came stream is refined to the viewer's camera from the meta-nodes it fet
   // The mesh it holds is the one meshcodec view makes for the same camera and viewport.
   const out = join(scratch, "viewer-came-native.ply");
   execFileSync(native, ["view", stream, out, "--eye", eye.join(","), "--target", target.join(","), "--fov", "50", "--size", "800x600"]);
-  const ply = readFileSync(out);
-  const headerEnd = ply.indexOf("end_header\n") + "end_header\n".length;
-  const vertices = Number(/element vertex (\d+)/.exec(ply.subarray(0, headerEnd).toString("latin1"))[1]);
-  const faces = Number(/element face (\d+)/.exec(ply.subarray(0, headerEnd).toString("latin1"))[1]);
-  const data = new DataView(ply.buffer, ply.byteOffset + headerEnd);
-  const theirs = new Float64Array(vertices * 3).map((_, i) => data.getFloat64(i * 8, true));
-  const theirFaces = [];
-  for (let f = 0; f < faces; f++) {
-    const at = vertices * 24 + f * 13 + 1;
-    theirFaces.push([0, 1, 2].map((c) => data.getInt32(at + 4 * c, true)));
-  }
+  const theirs = readPly(out);
   const ours = await page.evaluate(() => {
     const data = window.viewer.mesh.geometry.userData.meshcodec;
     return { positions: Array.from(data.positions), indices: Array.from(data.indices) };
   });
-  assertSameBits(new Float64Array(ours.positions), theirs, "the viewer's adapted mesh");
-  const key = (t) => {
-    const least = t.indexOf(Math.min(...t));
-    return [...t.slice(least), ...t.slice(0, least)].join(" ");
-  };
-  const ourFaces = [];
-  for (let f = 0; f < ours.indices.length; f += 3) ourFaces.push(key(ours.indices.slice(f, f + 3)));
-  assert.deepEqual(ourFaces.sort(), theirFaces.map(key).sort());
+  assertSameBits(new Float64Array(ours.positions), theirs.positions, "the viewer's adapted mesh");
+  assert.deepEqual(triangleSet(new Uint32Array(ours.indices)), triangleSet(theirs.indices));
   // Drawn: the flank fills much of the frame.
   await page.waitForFunction((frames) => window.viewer.state.frames > frames + 2, state.frames);
   await page.screenshot({ path: join(scratch, "viewer-came.png") });

@@ -49,6 +49,19 @@ impl<U: UnitDecoder + Send> DetachedUnits for CameDecoder<'static, U> {
     }
 }
 
+/// A decoder of `units`' syntax detached from the stream of `header` and `index`.
+fn detached_with<U: UnitDecoder + Send + 'static>(
+    header: &Header,
+    index: &Index,
+    payload_start: usize,
+    params: super::Params,
+    units: U,
+) -> Result<Box<dyn DetachedUnits>> {
+    let decoder =
+        CameDecoder::detached(header.clone(), index.clone(), payload_start, params, units);
+    Ok(Box::new(decoder?))
+}
+
 /// Decodes every unit of `reader` with `units`.
 fn whole<U: UnitDecoder>(
     reader: StreamReader<'_>,
@@ -67,13 +80,14 @@ impl SelectiveRefinement for modelled::Came {
         index: &Index,
         payload_start: usize,
     ) -> Result<Box<dyn DetachedUnits>> {
-        Ok(Box::new(CameDecoder::detached(
-            header.clone(),
-            index.clone(),
+        let params = modelled::params(header)?;
+        detached_with(
+            header,
+            index,
             payload_start,
-            modelled::params(header)?,
+            params,
             modelled::ModelledUnits,
-        )?))
+        )
     }
 
     fn decode_tree(&self, reader: StreamReader<'_>) -> Result<DecodedTree> {
@@ -89,13 +103,14 @@ impl SelectiveRefinement for paper::CamePaper {
         index: &Index,
         payload_start: usize,
     ) -> Result<Box<dyn DetachedUnits>> {
-        Ok(Box::new(CameDecoder::detached(
-            header.clone(),
-            index.clone(),
+        let params = paper::params(header)?;
+        detached_with(
+            header,
+            index,
             payload_start,
-            paper::params(header)?,
+            params,
             paper::PaperUnits::default(),
-        )?))
+        )
     }
 
     fn decode_tree(&self, reader: StreamReader<'_>) -> Result<DecodedTree> {
