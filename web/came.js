@@ -30,7 +30,8 @@ export function bytesReader(bytes) {
   return async (start, end) => all.subarray(start, Math.min(end, all.length));
 }
 
-function concat(a, b) {
+/** `a` then `b`, in one array. */
+export function concat(a, b) {
   const out = new Uint8Array(a.length + b.length);
   out.set(a);
   out.set(b, a.length);

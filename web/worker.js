@@ -11,7 +11,7 @@
 // indices, faces, bytesRead, adaptMs, settled, ...} and fetches the meta-nodes the view asked
 // for by Range requests, adapting again as they arrive, to the newest camera.
 import init, { ProgressiveDecoder, info } from "./pkg/meshcodec.js";
-import { CameStream, rangeReader } from "./came.js";
+import { CameStream, concat, rangeReader } from "./came.js";
 
 const ready = init({ module_or_path: new URL("./pkg/meshcodec_bg.wasm", import.meta.url) });
 
@@ -58,10 +58,7 @@ async function headOf(url) {
       if (!/truncated/.test(e.message) || (total && head.length >= total)) throw e;
       const more = await read(head.length, head.length * 4);
       if (more.length === 0) throw e;
-      const longer = new Uint8Array(head.length + more.length);
-      longer.set(head);
-      longer.set(more, head.length);
-      head = longer;
+      head = concat(head, more);
     }
   }
 }

@@ -43,13 +43,13 @@ impl<'a> StreamReader<'a> {
             payload_start,
             next_level: 0,
         };
-        reader.check_length()?;
+        reader.check_length(reader.bytes.len())?;
         Ok(reader)
     }
 
-    /// Refuses bytes past the payload's end.
-    fn check_length(&self) -> Result<()> {
-        let present = (self.bytes.len() - self.payload_start) as u64;
+    /// Refuses a stream of `len` bytes that runs past the payload's end.
+    fn check_length(&self, len: usize) -> Result<()> {
+        let present = (len - self.payload_start) as u64;
         if present > self.index.payload_bytes {
             return Err(Error::malformed(
                 self.index.len(),
@@ -157,15 +157,7 @@ impl StreamReader<'_> {
     /// Takes the stream's next bytes (as they arrive): the levels they complete can be read
     /// next. Bytes past the payload's end are refused, and not taken.
     pub fn extend(&mut self, more: &[u8]) -> Result<()> {
-        let room = (self.payload_start as u64 + self.index.payload_bytes)
-            .saturating_sub(self.bytes.len() as u64);
-        if more.len() as u64 > room {
-            return Err(Error::malformed(
-                self.index.len(),
-                self.payload_start + self.index.payload_bytes as usize,
-                format!("{} bytes after the last unit", more.len() as u64 - room),
-            ));
-        }
+        self.check_length(self.bytes.len() + more.len())?;
         self.bytes.to_mut().extend_from_slice(more);
         Ok(())
     }

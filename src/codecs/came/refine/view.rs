@@ -220,39 +220,49 @@ impl View {
     /// reaching the eye's plane, 0 for one out of the frustum or of no deviation). What the
     /// meta-nodes a view waits for are fetched by, largest first.
     pub fn screen_error(&self, center: DVec3, radius: f64, deviation: f64, scale: f64) -> f64 {
-        let k = self.kappa * scale;
-        if deviation <= 0.0 || !k.is_finite() || !self.sees(center, radius) {
-            return 0.0;
+        match self.split_test(center, radius, deviation, scale) {
+            SplitTest::Exact => 0.0,
+            SplitTest::AtEye => f64::INFINITY,
+            SplitTest::Sides(reach, bound) => reach / bound,
         }
-        let d = center - self.eye;
-        let depth = d.dot(self.forward);
-        let nearest = depth - radius;
-        if nearest <= 0.0 || k == 0.0 {
-            return f64::INFINITY;
-        }
-        let lateral = (d - self.forward * depth).length() + radius;
-        let tangent = lateral / nearest;
-        deviation * (1.0 + tangent * tangent).sqrt() / (k * nearest)
     }
 
     fn deviates(&self, center: DVec3, radius: f64, deviation: f64, scale: f64) -> bool {
+        match self.split_test(center, radius, deviation, scale) {
+            SplitTest::Exact => false,
+            SplitTest::AtEye => true,
+            SplitTest::Sides(reach, bound) => reach >= bound,
+        }
+    }
+
+    /// The split test of [`View::wants_split`] for a node, before its comparison.
+    #[inline]
+    fn split_test(&self, center: DVec3, radius: f64, deviation: f64, scale: f64) -> SplitTest {
         let k = self.kappa * scale;
         if deviation <= 0.0 || !k.is_finite() || !self.sees(center, radius) {
-            return false;
+            return SplitTest::Exact;
         }
         if k == 0.0 {
-            return true;
+            return SplitTest::AtEye;
         }
         let d = center - self.eye;
         let depth = d.dot(self.forward);
         let nearest = depth - radius;
         if nearest <= 0.0 {
-            return true;
+            return SplitTest::AtEye;
         }
         let lateral = (d - self.forward * depth).length() + radius;
         let tangent = lateral / nearest;
-        deviation * (1.0 + tangent * tangent).sqrt() >= k * nearest
+        SplitTest::Sides(deviation * (1.0 + tangent * tangent).sqrt(), k * nearest)
     }
+}
+
+/// A node's split test: out of view or of no deviation (never refined), reaching the eye's
+/// plane or at a tolerance of 0 (always refined), or its two sides, e·√(1 + t²) and κ·z_min.
+enum SplitTest {
+    Exact,
+    AtEye,
+    Sides(f64, f64),
 }
 
 #[cfg(test)]

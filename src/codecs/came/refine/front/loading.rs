@@ -104,7 +104,7 @@ impl ViewMesh {
                 self.loader.request(unit as usize, priority);
                 Ready::Waiting
             }
-            UnitState::Requested => Ready::Waiting,
+            UnitState::Requested | UnitState::Supplied => Ready::Waiting,
             UnitState::Loaded | UnitState::Refused => Ready::Never,
         }
     }

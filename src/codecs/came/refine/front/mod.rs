@@ -94,6 +94,8 @@ enum UnitState {
     Idle,
     /// Asked for, not arrived.
     Requested,
+    /// Its bytes handed over by the caller ([`Fetch::External`]), not yet taken in.
+    Supplied,
     Loaded,
     /// Corrupt or cut: its branch stays as coarse as its parent unit leaves it.
     Refused,
@@ -285,8 +287,6 @@ pub struct ViewMesh {
     /// The view of the adaptation under way: the meta-nodes it asks for go to the loader with
     /// the screen error of the node waiting for them ([`View::screen_error`]).
     view_now: View,
-    /// Per meta-node: its bytes were handed over ([`Fetch::External`]).
-    supplied: Vec<bool>,
     refusals: Vec<(usize, String)>,
     bytes_read: u64,
     stream_bytes: u64,
@@ -340,7 +340,6 @@ impl ViewMesh {
             units,
             outstanding: 1,
             view_now: View::nothing(),
-            supplied: vec![false; opened.index.len()],
             refusals: Vec::new(),
             bytes_read: opened.head_bytes,
             stream_bytes: opened.stream_bytes,
@@ -386,14 +385,14 @@ impl ViewMesh {
                     self.units.len()
                 )))
             }
-            Some(UnitState::Requested) if !self.supplied[unit] => {}
+            Some(UnitState::Requested) => {}
             Some(_) => {
                 return Err(Error::Unsupported(format!(
                     "unit {unit} supplied, but it is not waited for"
                 )))
             }
         }
-        self.supplied[unit] = true;
+        self.units[unit] = UnitState::Supplied;
         self.loader.supply(unit, bytes);
         Ok(())
     }
