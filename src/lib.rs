@@ -14,10 +14,11 @@
 //! | `came-paper` | the same as published (lossy) | reproducing the paper |
 //!
 //! Layers (see ARCHITECTURE.md): [`mesh`] knows no bits, [`coding`] knows no meshes, [`codecs`]
-//! joins them through the stream [`container`]. With the default `lab` feature, `metrics`,
-//! `harness`, `plot`, `tables` and the binaries measure; without it
-//! (`default-features = false`) the crate is the codec core alone. The contract the codecs keep
-//! is docs/CONTRACT.md; the bytes they write are docs/FORMAT.md.
+//! joins them through the stream [`container`]. This crate is the codec core; the `metrics`
+//! feature adds distances between meshes (sampling, point-to-surface). What measures the codecs
+//! (the harness, the papers' experiments and tables, plots, the `experiment` and `meshcodec`
+//! programs) is the lab, the workspace crate `meshcodec-lab` in lab/. The contract the codecs
+//! keep is docs/CONTRACT.md; the bytes they write are docs/FORMAT.md.
 //!
 //! ```
 //! use meshcodec::codecs::{self, Stop};
@@ -33,8 +34,8 @@
 //! ```
 
 // Unsafe code is allowed only where it is needed, each block with its SAFETY reason: the raw
-// views of `emc`'s slab lanes (`codecs::emc::clusters`, `codecs::emc::modelled::walk`), the
-// prefetch hint, and the lab's allocator trim (`emc_scale`).
+// views of `emc`'s slab lanes (`codecs::emc::clusters`, `codecs::emc::modelled::walk`) and the
+// prefetch hint.
 #![deny(unsafe_code)]
 #![warn(clippy::undocumented_unsafe_blocks)]
 
@@ -47,33 +48,7 @@ pub mod limits;
 pub mod mesh;
 mod prefetch;
 
-#[cfg(feature = "lab")]
-pub mod came_extras;
-#[cfg(feature = "lab")]
-pub mod came_flythrough;
-#[cfg(feature = "lab")]
-pub mod came_vd;
-#[cfg(feature = "lab")]
-pub mod cli;
-#[cfg(feature = "lab")]
-pub mod emc_scale;
-#[cfg(feature = "lab")]
-pub mod harness;
 #[cfg(feature = "metrics")]
 pub mod metrics;
-#[cfg(feature = "lab")]
-pub mod plot;
-#[cfg(feature = "lab")]
-pub mod progress;
-#[cfg(feature = "lab")]
-pub mod render;
-#[cfg(feature = "lab")]
-pub mod results;
-#[cfg(feature = "lab")]
-pub mod screen_error;
-#[cfg(feature = "lab")]
-pub mod sweep;
-#[cfg(feature = "lab")]
-pub mod tables;
 
 pub use error::{Error, Result};

@@ -90,7 +90,7 @@ pub enum Fetch {
 /// What the front takes a coded deviation for, times: the deviations are measured on the level
 /// meshes (`hierarchy::came::deviation`), and a front that mixes depths joins fans no level
 /// mesh has. Measured on dragon-50k's middle view of `experiment came-vd` (1.5 diagonals,
-/// 1 px, `examples/came_vd_probe.rs`): at 1.0 the adapted mesh strays up to 1.09 px from the
+/// 1 px, `lab/examples/came_vd_probe.rs`): at 1.0 the adapted mesh strays up to 1.09 px from the
 /// full one (20,500 faces), at 1.5 up to 1.15 px (29,422), at 1.75 up to 0.84 px (38,098), at
 /// 2.0 up to 0.74 px (41,066). Measuring each node also among neighbours two levels coarser
 /// brought 1.5 to 0.68 px but cost more faces (45,098; the far view 2,700 against 1,810).

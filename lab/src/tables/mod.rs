@@ -1,0 +1,248 @@
+//! The papers' tables and figures, regenerated from the result files in results/ beside the
+//! papers' own figures. Nothing here encodes: tables read `RunResult`s, and the rendered figures
+//! decode the streams that the experiments kept: EMC's in `emc.rs`, Hoppe's in `hoppe.rs`, `emc`
+//! against the other coders in `anchors.rs`, Grabner's CAME in `came.rs` and `came_vd.rs`,
+//! appearance in `attributes.rs`; here, what they share.
+
+use crate::plot;
+use crate::render::View;
+use crate::results::{self, read_result, RunResult};
+use meshcodec::codecs::stats::Stat;
+use meshcodec::codecs::EncodeOptions;
+use meshcodec::error::{Error, Result};
+use meshcodec::mesh::quantize::GridShape;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+mod anchors;
+mod attributes;
+
+use crate::came;
+pub use crate::emc::tables::{emc_fig4, emc_fig5, emc_table1, EMC_TABLE1_COMMAND};
+pub use crate::pm::tables::{hoppe_tables, HOPPE_COMMAND};
+pub(crate) use anchors::ANCHORS_COMMAND;
+pub use anchors::{emc_rate_distortion, emc_vs_anchors};
+pub use attributes::{ATTRIBUTES_COMMAND, ATTRIBUTE_MESHES};
+
+/// A statistic a table reads; one the result lacks is an error naming the file's codec and mesh.
+pub(crate) fn stat(result: &RunResult, stat: Stat) -> Result<f64> {
+    result
+        .codec_stats
+        .require(stat)
+        .map_err(|e| Error::Unsupported(format!("{} on {}: {e}", result.codec, result.mesh)))
+}
+
+pub(crate) fn load(results: &Path, codec: &str, stem: &str) -> Result<RunResult> {
+    let path = results::path(results, codec, stem, ".json");
+    read_result(&path).map_err(|e| {
+        Error::Unsupported(format!(
+            "{}: {e} (make it with: {EMC_TABLE1_COMMAND})",
+            path.display()
+        ))
+    })
+}
+
+/// Where the mesh a result was measured on is now: its `source` as recorded (relative to where
+/// the experiment ran), else the file of that name among the shared meshes, so that tables made
+/// from another folder (the lab's tests run in lab/) find it.
+pub(crate) fn source_path(result: &RunResult) -> Result<PathBuf> {
+    let recorded = Path::new(&result.source);
+    if recorded.is_file() {
+        return Ok(recorded.to_path_buf());
+    }
+    recorded
+        .file_name()
+        .and_then(|name| {
+            meshcodec::mesh::io::data_dirs()
+                .into_iter()
+                .map(|dir| dir.join(name))
+                .find(|path| path.is_file())
+        })
+        .ok_or_else(|| {
+            Error::Io(std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                format!(
+                    "{}: not found, nor among the shared meshes (the mesh of the {} result on {})",
+                    result.source, result.codec, result.mesh
+                ),
+            ))
+        })
+}
+
+/// Views that show each model from the front, as the paper's Fig. 5.
+pub(crate) fn view_of(mesh: &str) -> View {
+    match mesh {
+        "beethoven" => View {
+            up: 1,
+            yaw: 0.0,
+            pitch: 0.0,
+        },
+        "bunny-3k-closed" => View {
+            up: 1,
+            yaw: 0.0,
+            pitch: 0.0,
+        },
+        _ => View {
+            up: 1,
+            yaw: 30.0,
+            pitch: 20.0,
+        },
+    }
+}
+
+/// Draws `text` in black at `origin` (its top left), `size` pixels high.
+pub(crate) fn draw_caption<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    text: &str,
+    size: u32,
+    (x, y): (u32, u32),
+) -> Result<()> {
+    root.draw_text(
+        text,
+        &("sans-serif", size).into_font().color(&BLACK),
+        (x as i32, y as i32),
+    )
+    .map_err(|e| Error::Io(std::io::Error::other(format!("plot: {e}"))))
+}
+
+/// Draws a rendered panel of `width`-pixel rows at `origin`, its white background left out.
+pub(crate) fn draw_panel<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    pixels: &[[u8; 3]],
+    width: u32,
+    (x0, y0): (u32, u32),
+) -> Result<()> {
+    for (i, px) in pixels.iter().enumerate() {
+        if *px == [255, 255, 255] {
+            continue;
+        }
+        let (x, y) = (x0 + i as u32 % width, y0 + i as u32 / width);
+        root.draw_pixel((x as i32, y as i32), &RGBColor(px[0], px[1], px[2]))
+            .map_err(|e| Error::Io(std::io::Error::other(format!("plot: {e}"))))?;
+    }
+    Ok(())
+}
+
+pub(crate) fn refused(results: &Path, codec: &str, mesh: &str) -> Option<String> {
+    std::fs::read_to_string(results::refusal_path(results, codec, mesh))
+        .ok()
+        .map(|s| {
+            s.trim()
+                .rsplit("unsupported: ")
+                .next()
+                .unwrap_or("")
+                .to_string()
+        })
+}
+
+/// The result of `codec` on `mesh` at `quant` bits (cubic grid), by the harness's file naming.
+pub(crate) fn load_at(results: &Path, codec: &str, mesh: &str, quant: u8) -> Result<RunResult> {
+    // Other coders' results (Draco's) have no default quantization: their stems always name it.
+    let defaults = meshcodec::codecs::by_name(codec)
+        .map(|c| c.default_options())
+        .unwrap_or(EncodeOptions {
+            quant_bits: 0,
+            grid: GridShape::Cubic,
+        });
+    let quantization = EncodeOptions {
+        quant_bits: quant,
+        grid: defaults.grid,
+    };
+    let stem = results::stem(&defaults, mesh, &quantization);
+    let path = results::path(results, codec, &stem, ".json");
+    read_result(&path).map_err(|e| {
+        Error::Unsupported(format!(
+            "{}: {e} (make it with: {ANCHORS_COMMAND})",
+            path.display()
+        ))
+    })
+}
+
+/// Regenerates every paper table and figure whose results are present; returns what it wrote
+/// and, for each table it could not make, why.
+pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
+    let mut written = Vec::new();
+    let mut missing = Vec::new();
+    plot::ensure_font().ok();
+    match emc_table1(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("emc-table1: {e}")),
+    }
+    match emc_fig4(results, out) {
+        Ok(p) => written.extend(p),
+        Err(e) => missing.push(format!("emc-fig4: {e}")),
+    }
+    match emc_fig5(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("emc-fig5: {e}")),
+    }
+    match hoppe_tables(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("hoppe-pm: {e}")),
+    }
+    match emc_vs_anchors(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("emc-vs-anchors: {e}")),
+    }
+    match emc_rate_distortion(results, out) {
+        Ok(p) => written.extend(p),
+        Err(e) => missing.push(format!("emc-rate-distortion: {e}")),
+    }
+    match came::tables::tables(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("came: {e}")),
+    }
+    match came::tables::fig4(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("came-fig4: {e}")),
+    }
+    match came::tables::rate_distortion(results, out) {
+        Ok(p) => written.extend(p),
+        Err(e) => missing.push(format!("came-rate-distortion: {e}")),
+    }
+    match came::vd_table::table(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("came-vd: {e}")),
+    }
+    match attributes::attributes_table(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("attributes: {e}")),
+    }
+    match attributes::attributes_checker(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("attributes-checker: {e}")),
+    }
+    match attributes::attributes_levels(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("attributes-levels: {e}")),
+    }
+    (written, missing)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every table and figure of paper-tables/ is made from the committed results: none is
+    /// skipped for a statistic, a result file or a stream it cannot find.
+    #[test]
+    fn every_paper_table_regenerates_from_the_committed_results() {
+        let results = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results");
+        let out = tempfile::tempdir().unwrap();
+        let (written, skipped) = regenerate(&results, out.path());
+        assert!(skipped.is_empty(), "skipped: {skipped:?}");
+        for name in [
+            "emc-table1.md",
+            "emc-vs-anchors.md",
+            "hoppe-pm.md",
+            "came.md",
+            "came-fig4.png",
+        ] {
+            assert!(
+                written.iter().any(|p| p.ends_with(name)),
+                "{name} not written"
+            );
+        }
+    }
+}
