@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Fuzzes the targets one after another, each for SECONDS (default 60), with the limits the
 # decoders promise (2 s and 1 GiB an input), and prints each target's executions and findings.
-# Runs without a sanitizer: meshcodec has no unsafe code, and libFuzzer runs several times as
-# many inputs a second without AddressSanitizer. The working corpus grows in fuzz/corpus/
+# Runs without a sanitizer (FUZZING.md: the little unsafe code, emc's slab lanes, checks every
+# access in this build), and libFuzzer runs several times as many inputs a second without
+# AddressSanitizer. The working corpus grows in fuzz/corpus/
 # (not committed); crashes land in fuzz/artifacts/<target>/.
 # Usage: bash fuzz/run.sh [SECONDS] [TARGET...]
 set -uo pipefail

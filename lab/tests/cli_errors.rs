@@ -267,8 +267,13 @@ fn emc_commands_work_on_every_shared_mesh() {
         assert!(info.status.success());
         let json: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
         assert_eq!(json["codec"], codec);
-        assert_eq!(json["levels_present"], bits, "{f}");
-        assert_eq!(json["bits"], bits);
+        assert_eq!(json["levels"], bits, "{f}");
+        assert_eq!(
+            json["level_sizes"].as_array().unwrap().len(),
+            bits as usize,
+            "{f}"
+        );
+        assert_eq!(json["quant_bits"], bits);
         assert_eq!(json["cell"].as_array().unwrap().len(), 3);
         assert!(json["vertex_copies"].is_null(), "{f}: only pm cuts");
         ok(&["decode", "m.mc", "full.ply"]);
@@ -384,8 +389,9 @@ fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
         .output()
         .unwrap();
     let report: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
-    let metas = report["meta_nodes"].as_array().unwrap();
-    assert_eq!(metas.len() as u64, report["units"].as_u64().unwrap());
+    assert_eq!(report["layered"], false);
+    let metas = report["units"].as_array().unwrap();
+    assert!(metas.len() > 1 && metas.iter().all(|m| m["present"] == true));
     assert_eq!(metas.last().unwrap()["end_byte"], report["bytes"]);
     assert!(metas
         .windows(2)
@@ -517,7 +523,7 @@ fn pm_encodes_a_mesh_that_is_no_manifold_and_info_says_it_was_cut() {
         let json: serde_json::Value = serde_json::from_str(&json.stdout).unwrap();
         assert_eq!(json["vertex_copies"], 175);
         // A level before the last holds the copies; the last is the mesh itself.
-        let levels = json["levels"].as_array().unwrap();
+        let levels = json["level_sizes"].as_array().unwrap();
         assert_eq!(levels.last().unwrap()["vertices"], json["vertices"]);
         assert!(levels
             .iter()

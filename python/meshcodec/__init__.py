@@ -24,6 +24,7 @@ decoded, read, written or measured, so threads run codecs in parallel.
 from __future__ import annotations
 
 import bisect
+import json
 import os
 from dataclasses import dataclass, field
 from typing import IO, Any, Dict, Iterator, List, Optional, Union
@@ -431,12 +432,16 @@ def level_ends(stream: Bytes) -> List[int]:
 
 
 def info(stream: Bytes) -> Dict[str, Any]:
-    """What a stream's header and index say, without decoding it: codec, format version,
-    quantization grid, vertex and triangle counts, levels and the bytes each needs, every unit
-    (for CAME: every meta-node) with its parent and byte range, and ``appearance``: None, or
-    what the stream carries (normal_bits, normals "coded", "predicted" from geometry or
-    "derived" from it, uv_bits, colours, materials, in_levels)."""
-    return _core.info(_stream(stream))
+    """What a stream's header and index say, without decoding it, in the keys ``meshcodec info
+    --json`` prints: codec, format_version, bytes, stream_bytes, truncated, the quantization
+    grid (quant_bits, origin, cell), vertices and triangles of the full mesh, levels and
+    level_ends (the bytes each level needs), payload_start, layered, every unit (for CAME: every
+    meta-node) with its parent and byte range, ``appearance``: None, or what the stream carries
+    (normal_bits, normals "coded", "predicted" from geometry or "derived" from it, uv_bits,
+    uv_origin, uv_cell, colours, materials, material_library, in_levels, and its unit), and what
+    the codec reads of its header (vertex_copies for ``pm`` streams cut to a manifold,
+    normal_cones for CAME streams; None otherwise)."""
+    return json.loads(_core.info(_stream(stream)))
 
 
 def load(path: PathLike, drop_attributes: bool = False) -> Mesh:

@@ -9,7 +9,7 @@
 //! decoded, read, written or measured.
 
 use meshcodec::codecs::{self, Capability, Codec, EncodeOptions, LevelDecoder, LevelMesh, Stop};
-use meshcodec::container::{StreamReader, APPEARANCE_UNIT_VERSION, FORMAT_VERSION};
+use meshcodec::container::{APPEARANCE_UNIT_VERSION, FORMAT_VERSION};
 use meshcodec::mesh::attribute_quantization::AttributeBits;
 use meshcodec::mesh::attributes::{AttributedMesh, Attributes, Materials};
 use meshcodec::mesh::io;
@@ -576,62 +576,15 @@ fn level_ends(stream: &[u8]) -> PyResult<Vec<u64>> {
     codecs::level_ends(stream).map_err(to_py)
 }
 
-/// What a stream's header and index say, without decoding it.
+/// What a stream's header and index say, without decoding it: the JSON of the library's
+/// `StreamInfo`, which `meshcodec.info` loads.
 #[pyfunction]
-fn info<'py>(py: Python<'py>, stream: &[u8]) -> PyResult<Bound<'py, PyDict>> {
-    let reader = StreamReader::open(stream).map_err(to_py)?;
-    let header = reader.header();
-    let codec = codecs::by_id(header.codec_id).map_err(to_py)?;
-    let index = reader.index();
-    let start = reader.payload_start() as u64;
-    let units = PyList::empty(py);
-    for (i, u) in index.units.iter().enumerate() {
-        let unit = PyDict::new(py);
-        unit.set_item("unit", i)?;
-        unit.set_item("parent", u.parent)?;
-        unit.set_item("first_byte", start + u.offset)?;
-        unit.set_item("end_byte", start + u.end())?;
-        unit.set_item("bytes", u.length)?;
-        unit.set_item("present", reader.unit(i).is_some())?;
-        units.append(unit)?;
-    }
-    let d = PyDict::new(py);
-    d.set_item("codec", codec.name())?;
-    d.set_item("format_version", header.version())?;
-    d.set_item("bytes", stream.len())?;
-    d.set_item("stream_bytes", start + index.payload_bytes)?;
-    d.set_item("truncated", reader.truncated())?;
-    d.set_item("quant_bits", header.grid.bits)?;
-    d.set_item("origin", header.grid.origin.to_vec())?;
-    d.set_item("cell", header.grid.cell.to_vec())?;
-    d.set_item("vertices", header.vertices)?;
-    d.set_item("triangles", header.triangles)?;
-    // One end a level: the count without opening a decoder.
-    let ends = codec.level_ends(&reader).map_err(to_py)?;
-    d.set_item("levels", ends.len())?;
-    d.set_item("level_ends", ends)?;
-    d.set_item("payload_start", start)?;
-    d.set_item("layered", index.is_layered())?;
-    d.set_item("units", units)?;
-    // What appearance the stream carries, and how its normals travel.
-    let appearance = match &header.appearance {
-        None => None,
-        Some(spec) => {
-            let a = PyDict::new(py);
-            a.set_item("normal_bits", spec.normal_bits)?;
-            a.set_item("normals", spec.normal_mode())?;
-            a.set_item("uv_bits", spec.uv_grid.map(|g| g.bits))?;
-            a.set_item("colours", spec.colours)?;
-            a.set_item(
-                "materials",
-                spec.materials.as_ref().map(|m| m.names.clone()),
-            )?;
-            a.set_item("in_levels", spec.in_levels)?;
-            Some(a)
-        }
-    };
-    d.set_item("appearance", appearance)?;
-    Ok(d)
+fn info(py: Python<'_>, stream: &[u8]) -> PyResult<String> {
+    // The library's one description of a stream, in the keys `meshcodec info --json` prints.
+    py.detach(|| {
+        let info = codecs::StreamInfo::of(stream).map_err(to_py)?;
+        serde_json::to_string(&info).map_err(|e| PyValueError::new_err(e.to_string()))
+    })
 }
 
 /// A library error about the file at `path`, its name first as the command line prints it.
@@ -794,6 +747,7 @@ fn codec_list(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
                 Capability::PartialLevels => "partial_levels",
                 Capability::SelectiveRefinement => "selective_refinement",
                 Capability::Attributes => "attributes",
+                Capability::AppearanceInLevels => "appearance_in_levels",
             })
             .collect();
         d.set_item("capabilities", capabilities)?;

@@ -8,7 +8,9 @@
 
 pub mod appearance;
 pub mod came;
+mod descriptor;
 pub mod emc;
+pub mod info;
 pub mod names;
 pub mod pm;
 mod progressive;
@@ -22,6 +24,8 @@ use crate::mesh::attributes::Attributes;
 use crate::mesh::canonical_attributes::CanonicalAttributes;
 use crate::mesh::quantize::GridShape;
 use crate::mesh::{CanonicalMesh, Grid, TriMesh, VertexId};
+pub use descriptor::Descriptor;
+pub use info::{CodecFacts, StreamInfo};
 pub use stats::{CameField, Stat, Stats};
 
 /// How a mesh is quantized before it is encoded: the grid of its canonical mesh
@@ -77,6 +81,9 @@ pub enum Capability {
     /// an appearance unit decoded with the full level ([`encode_attributed`]; every codec whose
     /// full decode is the canonical mesh).
     Attributes,
+    /// Also carries appearance inside its levels, so that every level has it
+    /// ([`Codec::encode_with_appearance`]; `pm`).
+    AppearanceInLevels,
 }
 
 /// How a codec that refines appearance level by level gives a collapsed wedge its values
@@ -114,32 +121,45 @@ impl AttributeFit {
 
 /// A progressive mesh codec.
 pub trait Codec: Send + Sync {
+    /// What the codec is: name, id, summary, defaults, capabilities ([`Descriptor`]).
+    fn descriptor(&self) -> &'static Descriptor;
     /// Name on the command line and in results/ ([`names`]).
-    fn name(&self) -> &'static str;
+    fn name(&self) -> &'static str {
+        self.descriptor().naming.name
+    }
     /// Identifier in the stream header ([`names`]).
-    fn id(&self) -> u8;
+    fn id(&self) -> u8 {
+        self.descriptor().naming.id
+    }
     /// One line on what the codec is.
-    fn summary(&self) -> &'static str;
+    fn summary(&self) -> &'static str {
+        self.descriptor().summary
+    }
     /// The quantization used when the user gives none.
-    fn default_options(&self) -> EncodeOptions;
+    fn default_options(&self) -> EncodeOptions {
+        self.descriptor().default_options
+    }
     /// What this codec does beyond decoding level by level.
-    fn capabilities(&self) -> &'static [Capability];
+    fn capabilities(&self) -> &'static [Capability] {
+        self.descriptor().capabilities
+    }
+    /// Whether the full decode is the canonical mesh (docs/CONTRACT.md §3). A lossy codec's full
+    /// level is reported with its error, never called lossless.
+    fn lossless(&self) -> bool {
+        self.descriptor().lossless
+    }
     /// Encodes the canonical mesh (on its own grid); refuses with [`Error::Unsupported`] a mesh
     /// it cannot code.
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded>;
     /// A decoder positioned before the first level of `stream` (whose header names this codec).
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>>;
-    /// Whether the full decode is the canonical mesh (docs/CONTRACT.md §3). A lossy codec's full
-    /// level is reported with its error, never called lossless.
-    fn lossless(&self) -> bool {
-        true
-    }
     /// Codec-specific measurements of an encoded stream (PM: iteration rates), stored with the
     /// run's results; codecs with none return an empty set.
     fn measure(&self, stream: &[u8]) -> Result<Stats>;
     /// Encodes the canonical mesh with its appearance coded inside the levels, so that every
-    /// level carries it; `None` for codecs that carry appearance in an appearance unit after
-    /// their last level ([`encode_attributed`]).
+    /// level carries it, for codecs with [`Capability::AppearanceInLevels`]; `None` for the
+    /// others, which carry appearance in an appearance unit after their last level
+    /// ([`encode_attributed`]).
     fn encode_with_appearance(
         &self,
         _mesh: &CanonicalMesh,
@@ -153,9 +173,15 @@ pub trait Codec: Send + Sync {
     fn selective_refinement(&self) -> Option<&dyn came::selective::SelectiveRefinement> {
         None
     }
-    /// Whether this codec's streams carry appearance inside their levels.
-    fn appearance_in_levels(&self) -> bool {
-        false
+    /// What a stream's header says that only this codec knows how to read, for
+    /// [`StreamInfo`]; nothing by default.
+    fn facts(&self, _header: &Header) -> CodecFacts {
+        CodecFacts::default()
+    }
+    /// The most vertices any level of a stream with `header` may decode to: the header's by
+    /// default (`pm` streams cut to a manifold hold copies before their last level).
+    fn most_level_vertices(&self, header: &Header) -> u64 {
+        header.vertices
     }
     /// How many bytes of the stream, from its first, decoding each level needs (entry k for
     /// level k + 1): where a reader of a stream still arriving can decode the next level. From
@@ -398,7 +424,11 @@ fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
         .appearance
         .as_ref()
         .is_some_and(|a| a.in_levels);
-    if in_levels && !codec.appearance_in_levels() {
+    if in_levels
+        && !codec
+            .capabilities()
+            .contains(&Capability::AppearanceInLevels)
+    {
         return Err(Error::malformed(
             0,
             5,
@@ -412,14 +442,10 @@ fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
     })
 }
 
-/// The most vertices any level of a stream with `header` may decode to: the header's, but for
-/// the meshes of a `pm` stream cut to a manifold before its last level, which hold the copies
-/// too (docs/FORMAT.md §6.2).
+/// The most vertices any level of a stream with `header` may decode to
+/// ([`Codec::most_level_vertices`]; an unknown codec: the header's).
 pub fn most_level_vertices(header: &Header) -> u64 {
-    if header.codec_id == names::PM.id || header.codec_id == names::PM_REORDERED.id {
-        return pm::most_vertices(header);
-    }
-    header.vertices
+    by_id(header.codec_id).map_or(header.vertices, |codec| codec.most_level_vertices(header))
 }
 
 /// The bytes each level of a stream needs ([`Codec::level_ends`]), from a prefix holding at

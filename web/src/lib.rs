@@ -11,7 +11,7 @@ use glam::DVec3;
 use js_sys::{Array, Float64Array, Object, Reflect, Uint32Array};
 use meshcodec::codecs::came::refine::{head_length, Budget, Camera, Fetch, View, ViewMesh};
 use meshcodec::codecs::{self, LevelMesh, Progressive, Stop};
-use meshcodec::container::{Header, StreamReader};
+use meshcodec::container::Header;
 use meshcodec::mesh::attributes::Attributes;
 use wasm_bindgen::prelude::*;
 
@@ -133,51 +133,58 @@ pub fn level_ends(bytes: &[u8]) -> Result<Vec<f64>, JsError> {
         .collect())
 }
 
-/// What a stream's header and index say, without decoding it: `codec`, `formatVersion`,
-/// `quantBits`, `origin`, `cell`, `vertices`, `triangles`, `levels`, `levelEnds`,
-/// `payloadStart`, `truncated`, `appearance`, and `units` with each one's byte range.
+/// What a stream's header and index say, without decoding it: the library's `StreamInfo`
+/// (`codec`, `formatVersion`, `bytes`, `streamBytes`, `truncated`, `quantBits`, `origin`, `cell`,
+/// `vertices`, `triangles`, `levels`, `levelEnds`, `payloadStart`, `layered`, `units` with each
+/// one's byte range, `appearance` or null, `vertexCopies`, `normalCones`): the keys of
+/// `meshcodec info --json` and of the Python package's `info`, in camelCase.
 #[wasm_bindgen]
-pub fn info(bytes: &[u8]) -> Result<Object, JsError> {
-    let reader = StreamReader::open(bytes).map_err(to_js)?;
-    let header = reader.header();
-    let codec = codecs::by_id(header.codec_id).map_err(to_js)?;
-    let index = reader.index();
-    let start = reader.payload_start() as u64;
-    let units = Array::new();
-    for (i, u) in index.units.iter().enumerate() {
-        let unit = Object::new();
-        set(&unit, "unit", i as u32)?;
-        set(&unit, "parent", u.parent.map(|p| p as f64))?;
-        set(&unit, "firstByte", (start + u.offset) as f64)?;
-        set(&unit, "endByte", (start + u.end()) as f64)?;
-        set(&unit, "bytes", u.length as f64)?;
-        set(&unit, "present", reader.unit(i).is_some())?;
-        units.push(&unit);
+pub fn info(bytes: &[u8]) -> Result<JsValue, JsError> {
+    let info = codecs::StreamInfo::of(bytes).map_err(to_js)?;
+    let value = serde_json::to_value(&info).map_err(|e| JsError::new(&e.to_string()))?;
+    js_value(&value)
+}
+
+/// A JSON value as a JavaScript one, its objects' keys in camelCase.
+fn js_value(value: &serde_json::Value) -> Result<JsValue, JsError> {
+    use serde_json::Value;
+    Ok(match value {
+        Value::Null => JsValue::NULL,
+        Value::Bool(b) => JsValue::from_bool(*b),
+        Value::Number(n) => JsValue::from_f64(n.as_f64().unwrap_or(f64::NAN)),
+        Value::String(s) => JsValue::from_str(s),
+        Value::Array(items) => {
+            let array = Array::new();
+            for item in items {
+                array.push(&js_value(item)?);
+            }
+            array.into()
+        }
+        Value::Object(map) => {
+            let object = Object::new();
+            for (key, item) in map {
+                set(&object, &camel_case(key), js_value(item)?)?;
+            }
+            object.into()
+        }
+    })
+}
+
+/// `snake_case` as `camelCase`.
+fn camel_case(key: &str) -> String {
+    let mut out = String::with_capacity(key.len());
+    let mut upper = false;
+    for c in key.chars() {
+        if c == '_' {
+            upper = true;
+        } else if upper {
+            out.extend(c.to_uppercase());
+            upper = false;
+        } else {
+            out.push(c);
+        }
     }
-    // As `levelEnds` says them: the full level of a stream with appearance ends with its unit.
-    let ends = codecs::level_ends(bytes).map_err(to_js)?;
-    let object = Object::new();
-    set(&object, "codec", codec.name())?;
-    set(&object, "formatVersion", header.version())?;
-    set(&object, "bytes", bytes.len() as f64)?;
-    set(&object, "streamBytes", (start + index.payload_bytes) as f64)?;
-    set(&object, "truncated", reader.truncated())?;
-    set(&object, "quantBits", header.grid.bits)?;
-    set(
-        &object,
-        "origin",
-        Float64Array::from(&header.grid.origin[..]),
-    )?;
-    set(&object, "cell", Float64Array::from(&header.grid.cell[..]))?;
-    set(&object, "vertices", header.vertices as f64)?;
-    set(&object, "triangles", header.triangles as f64)?;
-    set(&object, "levels", ends.len() as u32)?;
-    let ends: Vec<f64> = ends.into_iter().map(|e| e as f64).collect();
-    set(&object, "levelEnds", Float64Array::from(ends.as_slice()))?;
-    set(&object, "payloadStart", start as f64)?;
-    set(&object, "units", units)?;
-    set(&object, "appearance", header.appearance.is_some())?;
-    Ok(object)
+    out
 }
 
 /// A decoder fed a stream's bytes as they arrive (the chunks of `fetch()`'s `ReadableStream`):

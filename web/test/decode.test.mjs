@@ -53,7 +53,7 @@ for (const stream of streams) {
       }
       const full = decode(bytes);
       assert.equal(full.level, described.levels);
-      assert.equal(full.appearance !== null, described.appearance, `${name}: appearance`);
+      assert.equal(full.appearance !== null, described.appearance !== null, `${name}: appearance`);
       if (full.appearance) {
         const a = full.appearance;
         const theirs = nativeAppearance(stream, scratch);

@@ -185,7 +185,7 @@ fn our_rows(results: &Path, extras: &Extras, codec: &str) -> Result<Vec<OurRow>>
         stats: large.stats.clone(),
         full_level: if large.lossless {
             "lossless".into()
-        } else if codec == "came" {
+        } else if codecs::by_name(codec).is_ok_and(|c| c.lossless()) {
             "NOT lossless".into()
         } else {
             "lossy (not measured)".into()

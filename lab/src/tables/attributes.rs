@@ -138,7 +138,7 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             let _ = writeln!(
                 md,
                 "| {label} | {} | {:.2} | {:.2} | {} | {:+.1}% | {} | {} | {:.1} |",
-                if *codec == "raw" { "no" } else { "yes" },
+                if r.levels.len() > 1 { "yes" } else { "no" },
                 (r.bytes as f64 * 8.0 - appearance.bits as f64) / v,
                 appearance.bits as f64 / appearance.wedges.max(1) as f64,
                 if total < draco_total {

@@ -17,7 +17,9 @@ use super::decoded::{CameDecoder, DecodedTree, Triangle, UnitDecoder};
 use super::frame::Frame;
 use super::partition::{Partition, Tails};
 use super::{born_triangles, cut_at, encode_stream, BornTriangle, Layout, Params};
-use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
+use crate::codecs::descriptor::cubic;
+use crate::codecs::{names, Capability, Codec, Encoded, LevelDecoder, Stats};
+use crate::codecs::{CodecFacts, Descriptor};
 use crate::coding::huffman::{get_gamma, Huffman, LENGTH_FIELD_BITS};
 use crate::coding::{BitSink, BitSource, SyntaxClass};
 use crate::container::{Header, StreamReader};
@@ -26,7 +28,6 @@ use crate::hierarchy::came::cones::CodedCone;
 use crate::hierarchy::came::deviation::round_up;
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
 use crate::hierarchy::came::{NodeId, VertexTree, MAX_DEPTH};
-use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
 use glam::DVec3;
 use std::cell::OnceCell;
@@ -156,36 +157,30 @@ pub struct CamePaper {
     pub component_bits: u8,
 }
 
+/// What `CamePaper` is.
+const DESCRIPTOR: Descriptor = Descriptor {
+    naming: names::CAME_PAPER,
+    summary: "Grabner's compressed vertex hierarchy of any mesh as published: Huffman-coded paths, 5-bit PCA components (lossy)",
+    default_options: cubic(12),
+    capabilities: &[Capability::SelectiveRefinement],
+    lossless: false,
+};
+
 impl Codec for CamePaper {
-    fn name(&self) -> &'static str {
-        names::CAME_PAPER.name
+    fn descriptor(&self) -> &'static Descriptor {
+        &DESCRIPTOR
     }
 
-    fn id(&self) -> u8 {
-        names::CAME_PAPER.id
-    }
-
-    fn summary(&self) -> &'static str {
-        "Grabner's compressed vertex hierarchy of any mesh as published: Huffman-coded paths, 5-bit PCA components (lossy)"
-    }
-
-    fn default_options(&self) -> EncodeOptions {
-        EncodeOptions {
-            quant_bits: 12,
-            grid: GridShape::Cubic,
+    /// The paper's hierarchy has no normal cones.
+    fn facts(&self, _header: &Header) -> CodecFacts {
+        CodecFacts {
+            normal_cones: Some(false),
+            ..CodecFacts::default()
         }
-    }
-
-    fn capabilities(&self) -> &'static [Capability] {
-        &[Capability::SelectiveRefinement]
     }
 
     fn selective_refinement(&self) -> Option<&dyn super::selective::SelectiveRefinement> {
         Some(self)
-    }
-
-    fn lossless(&self) -> bool {
-        false
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {

@@ -52,9 +52,10 @@ pub mod weld;
 
 use super::stats::{PmField, WedgeField};
 use super::{
-    names, AttributeFit, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, Stat,
-    Stats,
+    names, AttributeFit, Capability, Codec, Encoded, LevelDecoder, LevelMesh, Stat, Stats,
 };
+use crate::codecs::descriptor::cubic;
+use crate::codecs::{CodecFacts, Descriptor};
 use crate::coding::arith::{ArithDecoder, ArithEncoder};
 use crate::coding::bits::index_bits;
 use crate::coding::SyntaxClass;
@@ -64,7 +65,6 @@ use crate::hierarchy::pmesh::PmMesh;
 use crate::hierarchy::simplify::{self, Placement};
 use crate::mesh::canonical_attributes::{CanonicalAttributes, CornerCode};
 use crate::mesh::manifold::ManifoldCut;
-use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
 use iter::PMeshIter;
 
@@ -169,15 +169,6 @@ impl PmParams {
 pub struct Pm {
     /// Which ordering this registry entry uses.
     pub ordering: Ordering,
-}
-
-impl Pm {
-    fn naming(&self) -> names::Naming {
-        match self.ordering {
-            Ordering::Natural => names::PM,
-            Ordering::Reordered => names::PM_REORDERED,
-        }
-    }
 }
 
 /// The oriented 2-manifold pm builds its progressive mesh on: the canonical mesh itself when it
@@ -570,31 +561,41 @@ impl Pm {
     }
 }
 
+/// What `pm` is.
+const PM_DESCRIPTOR: Descriptor = Descriptor {
+    naming: names::PM,
+    summary: "Hoppe's progressive meshes: QEM collapses, arithmetic-coded vsplits in collapse order (Table 3)",
+    default_options: cubic(16),
+    capabilities: &[Capability::Attributes, Capability::AppearanceInLevels],
+    lossless: true,
+};
+
+/// What `pm-reordered` is.
+const PM_REORDERED_DESCRIPTOR: Descriptor = Descriptor {
+    naming: names::PM_REORDERED,
+    summary: "Hoppe's progressive meshes, vsplits reordered for small Δflclw, vad_s = 0 (Table 4)",
+    default_options: cubic(16),
+    capabilities: &[Capability::Attributes, Capability::AppearanceInLevels],
+    lossless: true,
+};
+
 impl Codec for Pm {
-    fn name(&self) -> &'static str {
-        self.naming().name
-    }
-
-    fn id(&self) -> u8 {
-        self.naming().id
-    }
-
-    fn summary(&self) -> &'static str {
+    fn descriptor(&self) -> &'static Descriptor {
         match self.ordering {
-            Ordering::Natural => "Hoppe's progressive meshes: QEM collapses, arithmetic-coded vsplits in collapse order (Table 3)",
-            Ordering::Reordered => "Hoppe's progressive meshes, vsplits reordered for small Δflclw, vad_s = 0 (Table 4)",
+            Ordering::Natural => &PM_DESCRIPTOR,
+            Ordering::Reordered => &PM_REORDERED_DESCRIPTOR,
         }
     }
 
-    fn default_options(&self) -> EncodeOptions {
-        EncodeOptions {
-            quant_bits: 16,
-            grid: GridShape::Cubic,
+    fn facts(&self, header: &Header) -> CodecFacts {
+        CodecFacts {
+            vertex_copies: vertex_copies(header),
+            ..CodecFacts::default()
         }
     }
 
-    fn capabilities(&self) -> &'static [Capability] {
-        &[Capability::Attributes]
+    fn most_level_vertices(&self, header: &Header) -> u64 {
+        most_vertices(header)
     }
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
@@ -615,10 +616,6 @@ impl Codec for Pm {
         fit: AttributeFit,
     ) -> Option<Result<Encoded>> {
         Some(self.encode_appearance(mesh, appearance, fit))
-    }
-
-    fn appearance_in_levels(&self) -> bool {
-        true
     }
 
     fn measure(&self, stream: &[u8]) -> Result<Stats> {

@@ -5,39 +5,30 @@
 //!
 //! Glossary: Q = quantization bits per axis, V = vertices, T = triangles.
 
-use super::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, LevelMesh, Stats};
+use super::{names, Capability, Codec, Encoded, LevelDecoder, LevelMesh, Stats};
+use crate::codecs::descriptor::cubic;
+use crate::codecs::Descriptor;
 use crate::coding::bits::index_bits;
 use crate::coding::{BitSink, BitSource, SyntaxClass};
 use crate::container::{Header, LevelCost, StreamReader, StreamWriter};
 use crate::error::{Error, Result};
-use crate::mesh::quantize::GridShape;
 use crate::mesh::{CanonicalMesh, TriMesh};
 
 /// The `raw` codec.
 pub struct Raw;
 
+/// What `Raw` is.
+const DESCRIPTOR: Descriptor = Descriptor {
+    naming: names::RAW,
+    summary: "uncompressed baseline: 3·Q bits per vertex, 3·⌈log2 V⌉ bits per triangle, one level",
+    default_options: cubic(12),
+    capabilities: &[Capability::Attributes],
+    lossless: true,
+};
+
 impl Codec for Raw {
-    fn name(&self) -> &'static str {
-        names::RAW.name
-    }
-
-    fn id(&self) -> u8 {
-        names::RAW.id
-    }
-
-    fn summary(&self) -> &'static str {
-        "uncompressed baseline: 3·Q bits per vertex, 3·⌈log2 V⌉ bits per triangle, one level"
-    }
-
-    fn default_options(&self) -> EncodeOptions {
-        EncodeOptions {
-            quant_bits: 12,
-            grid: GridShape::Cubic,
-        }
-    }
-
-    fn capabilities(&self) -> &'static [Capability] {
-        &[Capability::Attributes]
+    fn descriptor(&self) -> &'static Descriptor {
+        &DESCRIPTOR
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {

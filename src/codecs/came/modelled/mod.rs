@@ -14,6 +14,8 @@ mod encoder;
 #[cfg(test)]
 mod tests;
 
+use crate::codecs::descriptor::cubic;
+use crate::codecs::{CodecFacts, Descriptor};
 use contexts::RADIUS_BITS;
 pub use decoder::ModelledUnits;
 use encoder::Encoder;
@@ -21,39 +23,35 @@ use encoder::Encoder;
 use super::decoded::CameDecoder;
 use super::partition::Tails;
 use super::{encode_stream, Layout, Params};
-use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
+use crate::codecs::{names, Capability, Codec, Encoded, LevelDecoder, Stats};
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self};
 use crate::hierarchy::came::deviation::DEVIATION_BITS;
-use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
 
 /// The `came` codec.
 pub struct Came;
 
+/// What `Came` is.
+const DESCRIPTOR: Descriptor = Descriptor {
+    naming: names::CAME,
+    summary: "Grabner's compressed vertex hierarchy of any mesh, context-modelled and lossless",
+    default_options: cubic(12),
+    capabilities: &[Capability::Attributes, Capability::SelectiveRefinement],
+    lossless: true,
+};
+
 impl Codec for Came {
-    fn name(&self) -> &'static str {
-        names::CAME.name
+    fn descriptor(&self) -> &'static Descriptor {
+        &DESCRIPTOR
     }
 
-    fn id(&self) -> u8 {
-        names::CAME.id
-    }
-
-    fn summary(&self) -> &'static str {
-        "Grabner's compressed vertex hierarchy of any mesh, context-modelled and lossless"
-    }
-
-    fn default_options(&self) -> EncodeOptions {
-        EncodeOptions {
-            quant_bits: 12,
-            grid: GridShape::Cubic,
+    fn facts(&self, header: &Header) -> CodecFacts {
+        CodecFacts {
+            normal_cones: params(header).ok().map(|p| p.cone_bits > 0),
+            ..CodecFacts::default()
         }
-    }
-
-    fn capabilities(&self) -> &'static [Capability] {
-        &[Capability::Attributes, Capability::SelectiveRefinement]
     }
 
     fn selective_refinement(&self) -> Option<&dyn super::selective::SelectiveRefinement> {

@@ -125,37 +125,28 @@ mod placement;
 pub mod walk;
 
 use super::{EmcParams, Syntax};
-use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
+use crate::codecs::descriptor::cubic;
+use crate::codecs::Descriptor;
+use crate::codecs::{names, Capability, Codec, Encoded, LevelDecoder, Stats};
 use crate::container::StreamReader;
 use crate::error::Result;
-use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
 
 /// The `emc` codec.
 pub struct Emc;
 
+/// What `Emc` is.
+const DESCRIPTOR: Descriptor = Descriptor {
+    naming: names::EMC,
+    summary: "embedded mesh coding with context-modelled arithmetic coding: octree splits whose positions and edges are predicted from decoded neighbours",
+    default_options: cubic(12),
+    capabilities: &[Capability::PassStops, Capability::Attributes],
+    lossless: true,
+};
+
 impl Codec for Emc {
-    fn name(&self) -> &'static str {
-        names::EMC.name
-    }
-
-    fn id(&self) -> u8 {
-        names::EMC.id
-    }
-
-    fn summary(&self) -> &'static str {
-        "embedded mesh coding with context-modelled arithmetic coding: octree splits whose positions and edges are predicted from decoded neighbours"
-    }
-
-    fn default_options(&self) -> EncodeOptions {
-        EncodeOptions {
-            quant_bits: 12,
-            grid: GridShape::Cubic,
-        }
-    }
-
-    fn capabilities(&self) -> &'static [Capability] {
-        &[Capability::PassStops, Capability::Attributes]
+    fn descriptor(&self) -> &'static Descriptor {
+        &DESCRIPTOR
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {

@@ -51,41 +51,32 @@ mod encoder;
 pub mod syntax;
 
 use super::{EmcParams, Syntax};
-use crate::codecs::{names, Capability, Codec, EncodeOptions, Encoded, LevelDecoder, Stats};
+use crate::codecs::descriptor::cubic;
+use crate::codecs::Descriptor;
+use crate::codecs::{names, Capability, Codec, Encoded, LevelDecoder, Stats};
 use crate::container::StreamReader;
 use crate::error::Result;
-use crate::mesh::quantize::GridShape;
 use crate::mesh::CanonicalMesh;
 
 /// The `emc-paper` codec.
 pub struct EmcPaper;
 
+/// What `EmcPaper` is.
+const DESCRIPTOR: Descriptor = Descriptor {
+    naming: names::EMC_PAPER,
+    summary: "Magnor & Girod's embedded mesh coding as published: octree splits with STAY/MOVE/DUPLICATE edges, fixed Huffman split distances, exact face corrections",
+    default_options: cubic(24),
+    capabilities: &[
+        Capability::PassStops,
+        Capability::PartialLevels,
+        Capability::Attributes,
+    ],
+    lossless: true,
+};
+
 impl Codec for EmcPaper {
-    fn name(&self) -> &'static str {
-        names::EMC_PAPER.name
-    }
-
-    fn id(&self) -> u8 {
-        names::EMC_PAPER.id
-    }
-
-    fn summary(&self) -> &'static str {
-        "Magnor & Girod's embedded mesh coding as published: octree splits with STAY/MOVE/DUPLICATE edges, fixed Huffman split distances, exact face corrections"
-    }
-
-    fn default_options(&self) -> EncodeOptions {
-        EncodeOptions {
-            quant_bits: 24,
-            grid: GridShape::Cubic,
-        }
-    }
-
-    fn capabilities(&self) -> &'static [Capability] {
-        &[
-            Capability::PassStops,
-            Capability::PartialLevels,
-            Capability::Attributes,
-        ]
+    fn descriptor(&self) -> &'static Descriptor {
+        &DESCRIPTOR
     }
 
     fn measure(&self, _stream: &[u8]) -> Result<Stats> {

@@ -47,25 +47,73 @@ unsafe impl Sync for Lanes {}
 #[allow(unsafe_code)]
 unsafe impl Send for Lanes {}
 
-/// One vertex's entry in an array of [`Lanes`], bounds-checked, to read.
+/// One vertex's entry in an array of [`Lanes`], to read, through a `$run` that checks the
+/// vertex is in bounds and (debug builds, tests) its own: see [`check`].
 macro_rules! lane {
-    ($lanes:expr, $field:ident, $v:expr) => {{
+    ($run:expr, $field:ident, $v:expr) => {{
         let v: usize = $v;
-        assert!(v < $lanes.len, "vertex {v} outside the lanes");
-        // SAFETY: in bounds; the run owns vertex v (see `Lanes`).
-        unsafe { &*$lanes.$field.add(v) }
+        $run.check(v);
+        // SAFETY: in bounds, and the run owns vertex v (checked above; see `Lanes`).
+        unsafe { &*$run.lanes.$field.add(v) }
     }};
 }
 
-/// One vertex's entry in an array of [`Lanes`], bounds-checked, to write.
+/// One vertex's entry in an array of [`Lanes`], to write, checked as [`lane!`] checks it.
 macro_rules! lane_mut {
-    ($lanes:expr, $field:ident, $v:expr) => {{
+    ($run:expr, $field:ident, $v:expr) => {{
         let v: usize = $v;
-        assert!(v < $lanes.len, "vertex {v} outside the lanes");
-        // SAFETY: in bounds; the run owns vertex v (see `Lanes`), and no other reference to
-        // the entry is alive.
-        unsafe { &mut *$lanes.$field.add(v) }
+        $run.check(v);
+        // SAFETY: in bounds, the run owns vertex v (checked above; see `Lanes`), and no other
+        // reference to the entry is alive.
+        unsafe { &mut *$run.lanes.$field.add(v) }
     }};
+}
+
+/// One vertex's mark, which any slab may read or write (atomic; see `Lanes`), bounds-checked.
+macro_rules! mark {
+    ($run:expr, $v:expr) => {{
+        let v: usize = $v;
+        assert!(v < $run.lanes.len, "vertex {v} outside the lanes");
+        // SAFETY: in bounds; the marks are atomics, shared by the slabs.
+        unsafe { &*$run.lanes.marks.add(v) }
+    }};
+}
+
+/// Whether a run may touch vertex `v`: outside a slab, every vertex; in a slab, its own
+/// vertices (`slab_of`, taken at the pass's start) and those its splits created
+/// (`first_id..next_id`).
+fn owns(slab: Option<(&[u8], u8)>, first_id: usize, next_id: usize, v: usize) -> bool {
+    match slab {
+        None => true,
+        Some((slab_of, slab)) => match slab_of.get(v) {
+            Some(&s) => s == slab,
+            None => (first_id..next_id).contains(&v),
+        },
+    }
+}
+
+/// Panics unless `v` is in the lanes and, in debug builds and the crate's tests, unless `owns`
+/// it: the check before every raw access. The ownership check costs `emc`'s decoder about 5%
+/// (BENCHMARKS.md, "Slab ownership"), so a release build leaves it to the argument in
+/// [`Lanes`]'s docs, which the tests that feed hostile slab streams exercise with it on.
+#[inline(always)]
+pub(super) fn check(lanes: &Lanes, v: usize, owns: impl FnOnce() -> bool) {
+    if v >= lanes.len {
+        outside(lanes, v);
+    }
+    #[cfg(any(debug_assertions, test))]
+    if !owns() {
+        panic!("vertex {v} touched outside its slab");
+    }
+    #[cfg(not(any(debug_assertions, test)))]
+    let _ = owns;
+}
+
+/// The panic of an access out of bounds, out of the hot path.
+#[cold]
+#[inline(never)]
+fn outside(lanes: &Lanes, v: usize) -> ! {
+    panic!("vertex {v} outside the lanes ({})", lanes.len);
 }
 
 /// One run of a pass over some of its visits: the whole pass, or one slab of a sliced pass, or
@@ -97,50 +145,43 @@ pub(super) struct Run<'a> {
 #[allow(unsafe_code)]
 impl Run<'_> {
     pub(super) fn adjacency(&self, v: usize) -> &Neighbours {
-        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
-        lane!(self.lanes, adjacency, v)
+        lane!(self, adjacency, v)
     }
 
     pub(super) fn centre(&self, v: usize) -> [i32; 3] {
-        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
-        *lane!(self.lanes, centres, v)
+        *lane!(self, centres, v)
     }
 
     pub(super) fn leaf(&self, v: usize) -> bool {
-        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
-        *lane!(self.lanes, leaf, v)
+        *lane!(self, leaf, v)
     }
 
     pub(super) fn depth(&self, v: usize) -> usize {
-        debug_assert!(self.owns(v), "vertex {v} read outside its slab");
-        *lane!(self.lanes, depth, v) as usize
+        *lane!(self, depth, v) as usize
     }
 
-    /// Whether `v` is this run's to read: every vertex outside a slab; in a slab, its own
-    /// vertices and those its splits created.
+    /// Whether `v` is this run's to touch (see [`owns`]).
     pub(super) fn owns(&self, v: usize) -> bool {
-        match self.slab {
-            None => true,
-            Some((slab_of, slab)) => match slab_of.get(v) {
-                Some(&s) => s == slab,
-                None => (self.first_id..self.next_id).contains(&v),
-            },
-        }
+        owns(self.slab, self.first_id, self.next_id, v)
+    }
+
+    fn check(&self, v: usize) {
+        check(self.lanes, v, || self.owns(v));
     }
 
     /// Recomputes the cached centre of `v` from its cell.
     pub(super) fn refresh(&mut self, v: usize) {
         let shifts = self.shifts[self.depth(v)];
-        let cell = *lane!(self.lanes, cells, v);
-        *lane_mut!(self.lanes, centres, v) = cell_centre(cell, shifts);
+        let cell = *lane!(self, cells, v);
+        *lane_mut!(self, centres, v) = cell_centre(cell, shifts);
     }
 
     /// RF: `v` takes `bit` at `step`.
     pub(super) fn refine(&mut self, v: usize, step: usize, bit: u32) {
         let axis = self.order.axis(step);
-        let cell = lane_mut!(self.lanes, cells, v);
+        let cell = lane_mut!(self, cells, v);
         cell[axis] = (cell[axis] << 1) | bit;
-        *lane_mut!(self.lanes, depth, v) += 1;
+        *lane_mut!(self, depth, v) += 1;
     }
 
     pub(super) fn work<S: Side>(
@@ -297,7 +338,7 @@ impl Run<'_> {
     pub(super) fn coded_ring(&self, n: usize) -> usize {
         let mut seen = 0;
         for &m in self.adjacency(n) {
-            let mark = lane!(self.lanes, marks, m as usize).load(Ordering::Relaxed);
+            let mark = mark!(self, m as usize).load(Ordering::Relaxed);
             seen |= if mark >> 3 == self.serial {
                 mark & 7
             } else {
@@ -376,27 +417,38 @@ impl Run<'_> {
                     EdgeCode::Move => 2,
                     EdgeCode::Duplicate => 4,
                 };
-            lane!(self.lanes, marks, n).store(mark, Ordering::Relaxed);
+            mark!(self, n).store(mark, Ordering::Relaxed);
         }
         // VS: `v` keeps the lower half, `r` takes the upper.
         self.next_id += 1;
-        let mut cell = *lane!(self.lanes, cells, v);
-        lane_mut!(self.lanes, cells, v)[axis] = cell[axis] << 1;
+        let mut cell = *lane!(self, cells, v);
+        lane_mut!(self, cells, v)[axis] = cell[axis] << 1;
         cell[axis] = (cell[axis] << 1) | 1;
-        *lane_mut!(self.lanes, cells, r) = cell;
-        let depth = lane_mut!(self.lanes, depth, v);
+        *lane_mut!(self, cells, r) = cell;
+        let depth = lane_mut!(self, depth, v);
         *depth += 1;
         let depth = *depth;
-        *lane_mut!(self.lanes, depth, r) = depth;
-        *lane_mut!(self.lanes, next_split, v) = NO_SPLIT;
-        *lane_mut!(self.lanes, next_split, r) = NO_SPLIT;
-        *lane_mut!(self.lanes, adjacency, r) = Neighbours::new();
-        self.edges += split_edges(&mut LaneLists(self.lanes), v, r, connecting, &codes);
+        *lane_mut!(self, depth, r) = depth;
+        *lane_mut!(self, next_split, v) = NO_SPLIT;
+        *lane_mut!(self, next_split, r) = NO_SPLIT;
+        *lane_mut!(self, adjacency, r) = Neighbours::new();
+        self.edges += split_edges(
+            &mut LaneLists {
+                lanes: self.lanes,
+                slab: self.slab,
+                first_id: self.first_id,
+                next_id: self.next_id,
+            },
+            v,
+            r,
+            connecting,
+            &codes,
+        );
         check_edge_count(self.edges, self.max_triangles).map_err(Stop::Fault)?;
         self.refresh(v);
         self.refresh(r);
         self.codes = codes;
-        *lane_mut!(self.lanes, leaf, r) = false;
+        *lane_mut!(self, leaf, r) = false;
         for (half, vertex) in [(0, v), (1, r)] {
             let valence = self.adjacency(vertex).len();
             // The upper half's question knows the lower half's answer.
@@ -406,7 +458,7 @@ impl Run<'_> {
                 1 + self.leaf(v) as usize
             };
             let c = contexts::leaf(kind, valence, remaining);
-            *lane_mut!(self.lanes, leaf, vertex) = side.code(
+            *lane_mut!(self, leaf, vertex) = side.code(
                 &mut self.contexts.leaf[c],
                 Question::Leaf(half),
                 false,
@@ -419,14 +471,28 @@ impl Run<'_> {
     }
 }
 
-/// The neighbour lists of [`Lanes`], for [`split_edges`].
-pub(super) struct LaneLists<'a>(&'a Lanes);
+/// The neighbour lists of [`Lanes`], for [`split_edges`], checked as the [`Run`] that makes
+/// them would check them.
+pub(super) struct LaneLists<'a> {
+    lanes: &'a Lanes,
+    slab: Option<(&'a [u8], u8)>,
+    first_id: usize,
+    next_id: usize,
+}
+
+impl LaneLists<'_> {
+    fn check(&self, v: usize) {
+        check(self.lanes, v, || {
+            owns(self.slab, self.first_id, self.next_id, v)
+        });
+    }
+}
 
 // A lane's list, through `lane_mut!`.
 
 #[allow(unsafe_code)]
 impl NeighbourLists for LaneLists<'_> {
     fn list(&mut self, v: usize) -> &mut Neighbours {
-        lane_mut!(self.0, adjacency, v)
+        lane_mut!(self, adjacency, v)
     }
 }

@@ -4,6 +4,8 @@
 //! already knows.
 
 mod estimates;
+#[cfg(test)]
+mod hostile_slabs;
 mod lanes;
 
 use super::contexts::Contexts;
