@@ -5,7 +5,7 @@
 use crate::plot;
 use crate::progress::Progress;
 use crate::results::{self, levels_csv, AppearanceRun, LevelRow, RunResult};
-use meshcodec::codecs::{self, Codec, EncodeOptions, LevelDecoder};
+use meshcodec::codecs::{self, Codec, EncodeOptions, EncodeRequest, LevelDecoder};
 use meshcodec::error::{Error, Result};
 use meshcodec::mesh::attribute_quantization::AttributeBits;
 use meshcodec::mesh::attributes::AttributedMesh;
@@ -70,32 +70,25 @@ struct Input {
     appearance: Option<CanonicalAttributes>,
 }
 
-fn read_input(
-    codec: &dyn Codec,
-    path: &Path,
-    options: &RunOptions,
-    encode: &EncodeOptions,
-) -> Result<Input> {
-    let carries = codec
-        .capabilities()
-        .contains(&codecs::Capability::Attributes);
-    if let (Some(bits), true) = (options.appearance, carries) {
+fn read_input(path: &Path, request: &EncodeRequest) -> Result<Input> {
+    if request.appearance.is_some() {
         let original = read_attributed(path)?;
-        let (canonical, appearance) = codecs::canonical_attributed_for(&original, encode, bits)?;
+        let (canonical, appearance) = request.canonical(&original)?;
         return Ok(Input {
             original,
             uncoded: Appearance::default(),
             canonical,
-            appearance: Some(appearance).filter(|a| !a.is_empty()),
+            appearance,
         });
     }
     let (mesh, uncoded) = read_mesh_and_appearance(path)?;
-    let canonical = codecs::canonical_for(&mesh, encode)?;
+    let original = AttributedMesh {
+        mesh,
+        attributes: Default::default(),
+    };
+    let (canonical, _) = request.canonical(&original)?;
     Ok(Input {
-        original: AttributedMesh {
-            mesh,
-            attributes: Default::default(),
-        },
+        original,
         uncoded,
         canonical,
         appearance: None,
@@ -105,6 +98,16 @@ fn read_input(
 /// Runs `codec` on the mesh file at `path`.
 pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOutput> {
     let encode = encode_options(codec, options);
+    // Appearance is read and coded when asked for and the codec carries it.
+    let carries = codec
+        .capabilities()
+        .contains(&codecs::Capability::Attributes);
+    let request = EncodeRequest {
+        codec,
+        options: encode,
+        appearance: options.appearance.filter(|_| carries),
+        in_levels: options.appearance_in_levels,
+    };
     let progress = Progress::new(options.progress);
     let label = format!("{} {}", codec.name(), mesh_name(path));
     progress.step(format!("{label}: reading"));
@@ -113,16 +116,11 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
         uncoded,
         canonical,
         appearance,
-    } = read_input(codec, path, options, &encode)?;
+    } = read_input(path, &request)?;
 
     progress.step(format!("{label}: encoding"));
     let started = Instant::now();
-    let encoded = codecs::encode_attributed_with(
-        codec,
-        &canonical,
-        appearance.as_ref(),
-        options.appearance_in_levels,
-    )?;
+    let encoded = request.encode_canonical(&canonical, appearance.as_ref())?;
     let encode_seconds = started.elapsed().as_secs_f64();
 
     // Time the bare decode (no metrics); repeat short ones so the figure is not timer noise.

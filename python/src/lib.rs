@@ -8,7 +8,9 @@
 //! for the operating system's failures — and the GIL is released while meshes are encoded,
 //! decoded, read, written or measured.
 
-use meshcodec::codecs::{self, Capability, Codec, EncodeOptions, LevelDecoder, LevelMesh, Stop};
+use meshcodec::codecs::{
+    self, Capability, Codec, EncodeOptions, EncodeRequest, LevelDecoder, LevelMesh, Stop,
+};
 use meshcodec::container::{APPEARANCE_UNIT_VERSION, FORMAT_VERSION};
 use meshcodec::mesh::attribute_quantization::AttributeBits;
 use meshcodec::mesh::attributes::{AttributedMesh, Attributes, Materials};
@@ -356,21 +358,18 @@ fn encode<'py>(
         normal: normal_bits,
         derive_normals,
     };
+    let request = EncodeRequest {
+        codec,
+        options,
+        appearance: attributes.is_some().then_some(bits),
+        in_levels,
+    };
+    let mesh = AttributedMesh {
+        mesh,
+        attributes: attributes.unwrap_or_default(),
+    };
     let bytes = py
-        .detach(|| match attributes {
-            None => {
-                let canonical = codecs::canonical_for(&mesh, &options)?;
-                codec.encode(&canonical).map(|e| e.bytes)
-            }
-            Some(attributes) => {
-                bits.check()?;
-                let attributed = AttributedMesh { mesh, attributes };
-                let (canonical, appearance) =
-                    codecs::canonical_attributed_for(&attributed, &options, bits)?;
-                codecs::encode_attributed_with(codec, &canonical, Some(&appearance), in_levels)
-                    .map(|e| e.bytes)
-            }
-        })
+        .detach(|| request.encode(mesh).map(|made| made.encoded.bytes))
         .map_err(to_py)?;
     Ok(PyBytes::new(py, &bytes))
 }

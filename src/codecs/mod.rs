@@ -15,6 +15,7 @@ pub mod names;
 pub mod pm;
 mod progressive;
 pub mod raw;
+mod request;
 pub mod stats;
 
 use crate::container::{Header, StreamReader};
@@ -26,6 +27,7 @@ use crate::mesh::quantize::GridShape;
 use crate::mesh::{CanonicalMesh, Grid, TriMesh, VertexId};
 pub use descriptor::Descriptor;
 pub use info::{CodecFacts, StreamInfo};
+pub use request::{EncodeRequest, EncodedMesh};
 pub use stats::{CameField, Stat, Stats};
 
 /// How a mesh is quantized before it is encoded: the grid of its canonical mesh

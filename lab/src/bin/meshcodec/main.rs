@@ -5,7 +5,7 @@ mod info;
 
 use anyhow::{Context, Result};
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
-use meshcodec::codecs::{self, Capability, LevelMesh, Stop};
+use meshcodec::codecs::{self, Capability, EncodeRequest, EncodedMesh, LevelMesh, Stop};
 use meshcodec::mesh::attribute_quantization::AttributeBits;
 use meshcodec::mesh::attributes::AttributedMesh;
 use meshcodec::mesh::io::{
@@ -460,32 +460,18 @@ fn encode(
             ..RunOptions::default()
         },
     );
-    // The mesh as read is dropped once canonical: on a large mesh it is a tenth of the peak.
-    let geometry = |mesh: meshcodec::mesh::TriMesh| -> Result<_> {
-        let canonical = codecs::canonical_for(&mesh, &options).with_context(context)?;
-        drop(mesh);
-        let encoded = codec.encode(&canonical).with_context(context)?;
-        Ok((canonical, encoded))
-    };
-    // The file is read once: with its appearance when the codec carries it.
+    // The file is read once: with its appearance when the codec carries it. The mesh as read
+    // is handed over and dropped once canonical: on a large mesh it is a tenth of the peak.
+    let mut request = EncodeRequest::geometry(codec);
+    request.options = options;
     let mut dropped = None;
-    let (canonical, encoded) = match attributes {
+    let mesh = match attributes {
         Attributes::Carry(bits, in_levels)
             if codec.capabilities().contains(&Capability::Attributes) =>
         {
-            let attributed = read_attributed(&path).with_context(context)?;
-            if attributed.attributes.is_empty() {
-                geometry(attributed.mesh)?
-            } else {
-                let (canonical, appearance) =
-                    codecs::canonical_attributed_for(&attributed, &options, bits)
-                        .with_context(context)?;
-                drop(attributed);
-                let encoded =
-                    codecs::encode_attributed_with(codec, &canonical, Some(&appearance), in_levels)
-                        .with_context(context)?;
-                (canonical, encoded)
-            }
+            request.appearance = Some(bits);
+            request.in_levels = in_levels;
+            read_attributed(&path).with_context(context)?
         }
         _ => {
             let (mesh, appearance) =
@@ -500,9 +486,15 @@ fn encode(
                 }
                 dropped = Some(appearance);
             }
-            geometry(mesh)?
+            AttributedMesh {
+                mesh,
+                attributes: Default::default(),
+            }
         }
     };
+    let EncodedMesh {
+        canonical, encoded, ..
+    } = request.encode(mesh).with_context(context)?;
     write_atomically(output, &encoded.bytes).with_context(|| output.display().to_string())?;
     // Said once the stream is written, so that a failure stays one line.
     if let Some(appearance) = dropped {
