@@ -346,27 +346,6 @@ pub fn encode_attributed_with(
     let mut encoded = codec.encode(canonical)?;
     let (full, _) = decode(&encoded.bytes, Stop::All)?;
     let (unit, fields) = appearance::encode(&full.mesh, canonical, appearance)?;
-    let (mut header, mut index, start) = crate::container::read_header_and_index(&encoded.bytes)?;
-    header.appearance = Some(appearance::spec_of(appearance));
-    index.appearance = Some(crate::container::UnitEntry {
-        offset: index.payload_bytes,
-        length: unit.len() as u64,
-        parent: index.units.len().checked_sub(1),
-    });
-    index.payload_bytes += unit.len() as u64;
-    let mut bytes = Vec::with_capacity(encoded.bytes.len() + unit.len() + 256);
-    header.write(&mut bytes);
-    index.write(&mut bytes);
-    let shift = bytes.len() as isize - start as isize;
-    bytes.extend_from_slice(&encoded.bytes[start..]);
-    bytes.extend_from_slice(&unit);
-    for level in &mut encoded.levels {
-        level.end_byte = (level.end_byte as isize + shift) as usize;
-    }
-    // The full level is what a reader needs for the mesh and its appearance.
-    if let Some(last) = encoded.levels.last_mut() {
-        last.end_byte = bytes.len();
-    }
     encoded
         .stats
         .add_named("appearance_bytes", unit.len() as f64);
@@ -375,7 +354,9 @@ pub fn encode_attributed_with(
             .stats
             .add_named(&format!("appearance_bits_{field}"), bits);
     }
-    encoded.bytes = bytes;
+    let mut writer = crate::container::StreamWriter::reopen(&encoded.bytes, &encoded.levels)?;
+    writer.set_appearance(appearance::spec_of(appearance), unit);
+    (encoded.bytes, encoded.levels) = writer.finish();
     Ok(encoded)
 }
 

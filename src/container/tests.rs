@@ -194,3 +194,45 @@ fn levels_read_from_an_input_stream_match() {
     assert_eq!(source.next_owned_level().unwrap().unwrap().bytes.len(), 300);
     assert!(source.next_owned_level().unwrap().is_none());
 }
+
+/// A finished stream reopened takes the appearance unit after its last unit: the header says
+/// what it carries, the index where the unit lies, the full level ends with it, and the levels'
+/// costs are those first recorded; a stream that already carries appearance is refused.
+#[test]
+fn a_reopened_stream_takes_the_appearance_unit_before_it_finishes() {
+    let (bytes, records) = two_levels();
+    let mut writer = StreamWriter::reopen(&bytes, &records).unwrap();
+    let spec = AppearanceSpec {
+        colours: true,
+        ..AppearanceSpec::default()
+    };
+    writer.set_appearance(spec.clone(), vec![7; 11]);
+    let (with, levels) = writer.finish();
+    let reader = StreamReader::open(&with).unwrap();
+    assert_eq!(reader.header().appearance.as_ref(), Some(&spec));
+    assert_eq!(reader.appearance_unit().unwrap().0, &[7; 11][..]);
+    assert_eq!(reader.unit(1).unwrap().bytes, &[8; 300][..]);
+    assert_eq!(levels.last().unwrap().end_byte, with.len());
+    assert_eq!(levels[0].end_byte - reader.payload_start(), 5);
+    for (a, b) in levels.iter().zip(&records) {
+        assert_eq!(
+            (
+                a.connectivity_bits,
+                a.geometry_bits,
+                a.vertices,
+                a.triangles
+            ),
+            (
+                b.connectivity_bits,
+                b.geometry_bits,
+                b.vertices,
+                b.triangles
+            )
+        );
+    }
+    let refused = StreamWriter::reopen(&with, &levels).err().unwrap();
+    assert!(
+        refused.to_string().contains("already carries appearance"),
+        "{refused}"
+    );
+}

@@ -33,13 +33,17 @@ pub struct LevelRecord {
 /// Builds a stream unit by unit: the header and index are written when it finishes. A layered
 /// codec pushes one unit per level ([`StreamWriter::push_level`]); a hierarchical one pushes its
 /// units with their parents ([`StreamWriter::push_unit`]) and marks where each level ends
-/// ([`StreamWriter::mark_level`]).
+/// ([`StreamWriter::mark_level`]). The appearance unit, which follows the last level and is
+/// coded over the full level's mesh as decoded, is handed to a writer [`reopen`](Self::reopen)ed
+/// on the codec's stream ([`StreamWriter::set_appearance`]) before it finishes.
 pub struct StreamWriter {
     header: Header,
     payload: Vec<u8>,
     units: Vec<(u64, Option<usize>)>,
     /// Per level: payload bytes up to its end, and its cost.
     marks: Vec<(u64, LevelCost)>,
+    /// The appearance unit, after every other.
+    appearance: Option<Vec<u8>>,
 }
 
 impl StreamWriter {
@@ -50,7 +54,66 @@ impl StreamWriter {
             payload: Vec::new(),
             units: Vec::new(),
             marks: Vec::new(),
+            appearance: None,
         }
+    }
+
+    /// A finished stream without appearance opened again, with the levels its encoder
+    /// recorded: its header, units and levels, so that it can take an appearance unit.
+    pub fn reopen(bytes: &[u8], levels: &[LevelRecord]) -> Result<Self> {
+        let (header, index, start) = read_header_and_index(bytes)?;
+        if header.appearance.is_some() || index.appearance.is_some() {
+            return Err(Error::Unsupported(
+                "the stream already carries appearance".into(),
+            ));
+        }
+        let laid_out = Index::back_to_back(index.units.iter().map(|u| (u.length, u.parent)));
+        if laid_out.units != index.units || start + index.payload_bytes as usize != bytes.len() {
+            return Err(Error::malformed(
+                start,
+                bytes.len(),
+                "a stream whose units are not laid out back to back cannot be reopened",
+            ));
+        }
+        let mut before = LevelRecord {
+            end_byte: start,
+            connectivity_bits: 0,
+            geometry_bits: 0,
+            vertices: 0,
+            triangles: 0,
+        };
+        let mut marks = Vec::with_capacity(levels.len());
+        for level in levels {
+            if level.end_byte < before.end_byte || level.end_byte > bytes.len() {
+                return Err(Error::malformed(
+                    start,
+                    bytes.len(),
+                    "level records outside the stream",
+                ));
+            }
+            let cost = LevelCost {
+                connectivity_bits: level.connectivity_bits - before.connectivity_bits,
+                geometry_bits: level.geometry_bits - before.geometry_bits,
+                vertices: level.vertices,
+                triangles: level.triangles,
+            };
+            marks.push(((level.end_byte - start) as u64, cost));
+            before = *level;
+        }
+        Ok(StreamWriter {
+            header,
+            payload: bytes[start..].to_vec(),
+            units: index.units.iter().map(|u| (u.length, u.parent)).collect(),
+            marks,
+            appearance: None,
+        })
+    }
+
+    /// The appearance unit, described by `spec` in the header: it follows the last unit, and
+    /// the full level, which a reader needs for the mesh and its appearance, ends with it.
+    pub fn set_appearance(&mut self, spec: AppearanceSpec, unit: Vec<u8>) {
+        self.header.appearance = Some(spec);
+        self.appearance = Some(unit);
     }
 
     /// Appends one level's payload and what it cost: a unit whose parent is the level before.
@@ -76,11 +139,25 @@ impl StreamWriter {
 
     /// The stream and, for each level, where it ends and what the stream cost up to there.
     pub fn finish(self) -> (Vec<u8>, Vec<LevelRecord>) {
-        let mut bytes = Vec::with_capacity(self.payload.len() + 64 + 12 * self.units.len());
+        let appearance_bytes = self.appearance.as_ref().map_or(0, Vec::len);
+        let mut bytes =
+            Vec::with_capacity(self.payload.len() + appearance_bytes + 64 + 12 * self.units.len());
         self.header.write(&mut bytes);
-        Index::back_to_back(self.units.iter().copied()).write(&mut bytes);
+        let mut index = Index::back_to_back(self.units.iter().copied());
+        if let Some(unit) = &self.appearance {
+            index.appearance = Some(UnitEntry {
+                offset: index.payload_bytes,
+                length: unit.len() as u64,
+                parent: index.units.len().checked_sub(1),
+            });
+            index.payload_bytes += unit.len() as u64;
+        }
+        index.write(&mut bytes);
         let start = bytes.len();
         bytes.extend_from_slice(&self.payload);
+        if let Some(unit) = &self.appearance {
+            bytes.extend_from_slice(unit);
+        }
         let (mut connectivity, mut geometry) = (0, 0);
         let records = self
             .marks
@@ -96,7 +173,12 @@ impl StreamWriter {
                     triangles: cost.triangles,
                 }
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let mut records = records;
+        // The full level is what a reader needs for the mesh and its appearance.
+        if let (Some(_), Some(last)) = (&self.appearance, records.last_mut()) {
+            last.end_byte = bytes.len();
+        }
         (bytes, records)
     }
 }
