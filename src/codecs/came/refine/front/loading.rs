@@ -9,73 +9,75 @@ impl ViewMesh {
     /// Takes in a fetched meta-node: its nodes, triangles and dependencies join the hierarchy
     /// (under the front: nothing present changes).
     pub(super) fn take_in(&mut self, loaded: Loaded) {
-        self.outstanding -= 1;
-        self.bytes_read += loaded.bytes;
+        self.loading.outstanding -= 1;
+        self.loading.bytes_read += loaded.bytes;
         match loaded.outcome {
             Ok(delta) => {
-                self.units[loaded.unit] = UnitState::Loaded;
+                self.loading.units[loaded.unit] = UnitState::Loaded;
                 self.grow(delta);
                 // The orientation certificates read the deepest loaded nodes: a collapse
                 // refused before may be allowed now.
-                for p in std::mem::take(&mut self.refused) {
-                    if !self.in_retry[p as usize] {
-                        self.in_retry[p as usize] = true;
-                        self.retry.push(p);
+                for p in std::mem::take(&mut self.guard.refused) {
+                    if !self.guard.in_retry[p as usize] {
+                        self.guard.in_retry[p as usize] = true;
+                        self.guard.retry.push(p);
                     }
                 }
             }
             Err(e) => {
-                self.units[loaded.unit] = UnitState::Refused;
-                self.refusals.push((loaded.unit, e.to_string()));
+                self.loading.units[loaded.unit] = UnitState::Refused;
+                self.loading.refusals.push((loaded.unit, e.to_string()));
             }
         }
     }
 
     pub(super) fn grow(&mut self, delta: UnitDelta) {
         for n in delta.nodes {
-            let v = self.ids.len() as u32;
+            let v = self.nodes.ids.len() as u32;
             if n.parent != NONE {
                 let p = n.parent as usize;
-                self.children[p][n.id.bit(n.id.len() - 1) as usize] = v;
-                self.opens[p] = NONE;
+                self.nodes.children[p][n.id.bit(n.id.len() - 1) as usize] = v;
+                self.nodes.opens[p] = NONE;
             }
-            self.ids.push(n.id);
-            self.parent.push(n.parent);
-            self.children.push([NONE; 2]);
-            self.opens.push(NONE);
-            self.spheres.push((n.center, n.radius));
-            self.deviations.push(n.deviation);
-            self.cones.push(n.cone);
-            self.state.push(State::Below);
-            self.born.push(SmallVec::new());
-            self.depends_on.push(SmallVec::new());
-            self.split_dependants.push(0);
-            self.held_by.push(NONE);
-            self.refused_listed.push(false);
-            self.in_retry.push(false);
-            self.faces_at.push(SmallVec::new());
-            self.active_slot.push(NONE);
-            self.planned.push(false);
+            self.nodes.ids.push(n.id);
+            self.nodes.parent.push(n.parent);
+            self.nodes.children.push([NONE; 2]);
+            self.nodes.opens.push(NONE);
+            self.nodes.spheres.push((n.center, n.radius));
+            self.nodes.deviations.push(n.deviation);
+            self.nodes.cones.push(n.cone);
+            self.front.state.push(State::Below);
+            self.nodes.born.push(SmallVec::new());
+            self.nodes.depends_on.push(SmallVec::new());
+            self.front.split_dependants.push(0);
+            self.guard.held_by.push(NONE);
+            self.guard.refused_listed.push(false);
+            self.guard.in_retry.push(false);
+            self.faces.faces_at.push(SmallVec::new());
+            self.front.active_slot.push(NONE);
+            self.scratch.planned.push(false);
         }
-        self.active_bits.resize(self.ids.len().div_ceil(64), 0);
+        self.front
+            .active_bits
+            .resize(self.nodes.ids.len().div_ceil(64), 0);
         for (birth, corners) in delta.triangles {
-            self.born[birth as usize].push(self.leaf_corners.len() as u32);
-            self.leaf_corners.push(corners);
-            self.corners.push([NONE; 3]);
-            self.present.push(false);
-            self.suspected.push(Suspicion::None);
+            self.nodes.born[birth as usize].push(self.faces.leaf_corners.len() as u32);
+            self.faces.leaf_corners.push(corners);
+            self.faces.corners.push([NONE; 3]);
+            self.faces.present.push(false);
+            self.guard.suspected.push(Suspicion::None);
         }
         for (s, deps) in delta.splits {
-            self.depends_on[s as usize] = deps;
+            self.nodes.depends_on[s as usize] = deps;
         }
         for (unit, root) in delta.opens {
-            self.opens[root as usize] = unit as u32;
+            self.nodes.opens[root as usize] = unit as u32;
         }
     }
 
     /// Takes in the meta-nodes that have arrived (all those asked for when `block`).
     pub(super) fn take_arrivals(&mut self, block: bool) -> usize {
-        let arrived = self.loader.collect(self.outstanding, block);
+        let arrived = self.loading.loader.collect(self.loading.outstanding, block);
         let count = arrived.len();
         for loaded in arrived {
             self.take_in(loaded);
@@ -86,22 +88,25 @@ impl ViewMesh {
     /// Whether active node `v` can be split now; asks for its meta-node if that is missing.
     pub(super) fn ready(&mut self, v: u32) -> Ready {
         let vu = v as usize;
-        if self.children[vu][0] != NONE {
+        if self.nodes.children[vu][0] != NONE {
             return Ready::Now;
         }
-        let unit = self.opens[vu];
+        let unit = self.nodes.opens[vu];
         if unit == NONE {
             return Ready::Never;
         }
-        match self.units[unit as usize] {
+        match self.loading.units[unit as usize] {
             UnitState::Idle => {
-                self.units[unit as usize] = UnitState::Requested;
-                self.outstanding += 1;
-                let (center, radius) = self.spheres[vu];
-                let priority =
-                    self.view_now
-                        .screen_error(center, radius, self.deviations[vu], self.scale);
-                self.loader.request(unit as usize, priority);
+                self.loading.units[unit as usize] = UnitState::Requested;
+                self.loading.outstanding += 1;
+                let (center, radius) = self.nodes.spheres[vu];
+                let priority = self.loading.view_now.screen_error(
+                    center,
+                    radius,
+                    self.nodes.deviations[vu],
+                    self.scale,
+                );
+                self.loading.loader.request(unit as usize, priority);
                 Ready::Waiting
             }
             UnitState::Requested | UnitState::Supplied => Ready::Waiting,

@@ -62,18 +62,17 @@
 mod loading;
 mod orientation;
 mod output;
+mod parts;
 mod passes;
 #[cfg(test)]
 mod tests;
 mod topology;
 
-use super::loader::{ByteSource, Dependency, Fetch, Loader, SeekSource};
+use super::loader::{ByteSource, Fetch, Loader, SeekSource};
 use super::view::View;
 use crate::error::{Error, Result};
-use crate::hierarchy::came::cones::NormalCone;
-use crate::hierarchy::came::NodeId;
 use glam::DVec3;
-use smallvec::SmallVec;
+use parts::{Faces, Front, Guard, Loading, Nodes, Scratch};
 use std::ops::Range;
 use std::path::Path;
 
@@ -207,89 +206,19 @@ pub struct Pick {
     pub point: DVec3,
 }
 
-/// The front of a hierarchy and the triangles it holds.
+/// The front of a hierarchy and the triangles it holds, in parts that each keep their own
+/// lists ([`parts`]): the decoded tree's records, the front over them, the triangles it holds,
+/// the orientation guard's lists, the scratch lists of passes and forced splits, and the
+/// meta-nodes' loading.
 pub struct ViewMesh {
-    // Per node, in the loader's decoding order.
-    ids: Vec<NodeId>,
-    parent: Vec<u32>,
-    /// Children, `[NONE; 2]` for leaves and nodes whose split is not loaded.
-    children: Vec<[u32; 2]>,
-    /// The meta-node that splits the node, while it is not loaded (else `NONE`).
-    opens: Vec<u32>,
-    /// Position and error-sphere radius, in world units.
-    /// (One array: the view test of every active node, every pass, reads both.)
-    spheres: Vec<(DVec3, f64)>,
-    /// Deviation, in world units: the error the view test projects.
-    deviations: Vec<f64>,
-    /// Normal cone, for back-face culling.
-    cones: Vec<NormalCone>,
-    state: Vec<State>,
-    /// Triangles born at the node's split.
-    born: Vec<SmallVec<[u32; 2]>>,
-    /// Nodes whose splits the node's split needs.
-    depends_on: Vec<SmallVec<[Dependency; 2]>>,
-    /// Split nodes depending on the node.
-    split_dependants: Vec<u32>,
-    /// The face that last kept the node split (a face in view its collapse would leave not
-    /// certain of its orientation, or that the guard split it for): checked first.
-    held_by: Vec<u32>,
-    /// Whether the node is in `refused`.
-    refused_listed: Vec<bool>,
-    /// Split nodes whose collapse was refused for a face's orientation: tried again after the
-    /// passes of every adaptation (not by the passes themselves, which would check the same
-    /// faces again and again while a view lasts).
-    refused: Vec<u32>,
-    /// Split nodes whose collapse to try again after the passes, a face it would move having
-    /// moved (`in_retry`: whether listed).
-    retry: Vec<u32>,
-    in_retry: Vec<bool>,
-    /// Present triangles with a corner at the node (active nodes only).
-    faces_at: Vec<SmallVec<[u32; 6]>>,
-    /// The active nodes, and each node's place among them.
-    active: Vec<u32>,
-    active_slot: Vec<u32>,
-    /// The active nodes again, a bit a node (bit v % 64 of word v / 64): a pass lists them
-    /// in node order from it.
-    active_bits: Vec<u64>,
-    // Per triangle.
-    leaf_corners: Vec<[NodeId; 3]>,
-    corners: Vec<[u32; 3]>,
-    present: Vec<bool>,
-    /// Where the triangle stands in `suspects`.
-    suspected: Vec<Suspicion>,
-    faces: usize,
-    /// Present triangles whose orientation is to be made certain: those splits moved or made
-    /// since the last adaptation's guard, and those it could not yet make certain.
-    suspects: Vec<u32>,
-    /// Where an interrupted pass resumes: the node it stopped at (passes go in node order).
-    cursor: u32,
+    nodes: Nodes,
+    front: Front,
+    faces: Faces,
+    guard: Guard,
+    scratch: Scratch,
+    loading: Loading,
     /// κ's scale, regulated to a face budget.
     scale: f64,
-    /// The active nodes a pass visits (kept to save allocating one a pass).
-    pass: Vec<u32>,
-    /// Split nodes a collapse left with no split dependant: they may collapse now.
-    freed: Vec<u32>,
-    /// The view of the last adaptation, if its last pass changed nothing but splits waited
-    /// for meta-nodes; the nodes those splits start from (and the list being made).
-    waited_for: Option<View>,
-    waiting_nodes: Vec<u32>,
-    waited_now: Vec<u32>,
-    /// Splits planned by a forced split, in order, and each node's mark of being planned;
-    /// the nodes it works through (both kept to save allocating them a split).
-    plan: Vec<u32>,
-    stack: Vec<u32>,
-    planned: Vec<bool>,
-    // Meta-nodes.
-    loader: Loader,
-    units: Vec<UnitState>,
-    /// Asked for and not arrived.
-    outstanding: usize,
-    /// The view of the adaptation under way: the meta-nodes it asks for go to the loader with
-    /// the screen error of the node waiting for them ([`View::screen_error`]).
-    view_now: View,
-    refusals: Vec<(usize, String)>,
-    bytes_read: u64,
-    stream_bytes: u64,
 }
 
 impl ViewMesh {
@@ -300,49 +229,24 @@ impl ViewMesh {
         let mut units = vec![UnitState::Idle; opened.index.len()];
         units[0] = UnitState::Requested;
         let mut vm = ViewMesh {
-            ids: Vec::new(),
-            parent: Vec::new(),
-            children: Vec::new(),
-            opens: Vec::new(),
-            spheres: Vec::new(),
-            deviations: Vec::new(),
-            cones: Vec::new(),
-            state: Vec::new(),
-            born: Vec::new(),
-            depends_on: Vec::new(),
-            split_dependants: Vec::new(),
-            held_by: Vec::new(),
-            refused_listed: Vec::new(),
-            refused: Vec::new(),
-            retry: Vec::new(),
-            in_retry: Vec::new(),
-            faces_at: Vec::new(),
-            active: Vec::new(),
-            active_slot: Vec::new(),
-            active_bits: Vec::new(),
-            leaf_corners: Vec::new(),
-            corners: Vec::new(),
-            present: Vec::new(),
-            suspected: Vec::new(),
-            faces: 0,
-            suspects: Vec::new(),
-            cursor: 0,
+            nodes: Nodes::default(),
+            front: Front::default(),
+            faces: Faces::default(),
+            guard: Guard::default(),
+            scratch: Scratch::default(),
+            loading: Loading {
+                loader,
+                units,
+                outstanding: 1,
+                view_now: View::nothing(),
+                refusals: Vec::new(),
+                bytes_read: opened.head_bytes,
+                stream_bytes: opened.stream_bytes,
+                waited_for: None,
+                waiting_nodes: Vec::new(),
+                waited_now: Vec::new(),
+            },
             scale: 1.0,
-            pass: Vec::new(),
-            freed: Vec::new(),
-            waited_for: None,
-            waiting_nodes: Vec::new(),
-            waited_now: Vec::new(),
-            plan: Vec::new(),
-            stack: Vec::new(),
-            planned: Vec::new(),
-            loader,
-            units,
-            outstanding: 1,
-            view_now: View::nothing(),
-            refusals: Vec::new(),
-            bytes_read: opened.head_bytes,
-            stream_bytes: opened.stream_bytes,
         };
         let root = opened.root;
         if let Err(e) = &root.outcome {
@@ -370,7 +274,7 @@ impl ViewMesh {
     /// [`Fetch::External`] (none otherwise): fetch them and hand their bytes to
     /// [`ViewMesh::supply`].
     pub fn wanted(&mut self) -> Vec<(usize, Range<u64>)> {
-        self.loader.take_wanted()
+        self.loading.loader.take_wanted()
     }
 
     /// Hands over the bytes of meta-node `unit`, fetched as [`ViewMesh::wanted`] asked: the
@@ -378,11 +282,11 @@ impl ViewMesh {
     /// coarse, if the bytes are cut or corrupt). An error if the unit was not asked for or was
     /// handed over already.
     pub fn supply(&mut self, unit: usize, bytes: &[u8]) -> Result<()> {
-        match self.units.get(unit) {
+        match self.loading.units.get(unit) {
             None => {
                 return Err(Error::Unsupported(format!(
                     "unit {unit} supplied; the stream has {} units",
-                    self.units.len()
+                    self.loading.units.len()
                 )))
             }
             Some(UnitState::Requested) => {}
@@ -392,19 +296,19 @@ impl ViewMesh {
                 )))
             }
         }
-        self.units[unit] = UnitState::Supplied;
-        self.loader.supply(unit, bytes);
+        self.loading.units[unit] = UnitState::Supplied;
+        self.loading.loader.supply(unit, bytes);
         Ok(())
     }
 
     /// Faces present.
     pub fn face_count(&self) -> usize {
-        self.faces
+        self.faces.count
     }
 
     /// Active nodes (the vertices of the adapted mesh).
     pub fn vertex_count(&self) -> usize {
-        self.active.len()
+        self.front.active.len()
     }
 
     /// κ's scale now (1 unless a face budget raised it).
@@ -416,26 +320,27 @@ impl ViewMesh {
     pub fn fetched(&self) -> Fetched {
         Fetched {
             units_loaded: self
+                .loading
                 .units
                 .iter()
                 .filter(|&&u| u == UnitState::Loaded)
                 .count(),
-            units_refused: self.refusals.len(),
-            units: self.units.len(),
-            bytes_read: self.bytes_read,
-            stream_bytes: self.stream_bytes,
+            units_refused: self.loading.refusals.len(),
+            units: self.loading.units.len(),
+            bytes_read: self.loading.bytes_read,
+            stream_bytes: self.loading.stream_bytes,
         }
     }
 
     /// Whether a node loaded so far has a normal cone (a `came` stream with cones), so that
     /// back faces can be culled.
     pub fn has_normal_cones(&self) -> bool {
-        self.cones.iter().any(|c| c.is_some())
+        self.nodes.cones.iter().any(|c| c.is_some())
     }
 
     /// The meta-nodes refused, and why.
     pub fn refusals(&self) -> &[(usize, String)] {
-        &self.refusals
+        &self.loading.refusals
     }
 
     /// Waits until every meta-node asked for has arrived, and takes them in.
@@ -449,17 +354,17 @@ impl ViewMesh {
     /// while the view does not want them, until a pass changes nothing or the budget is spent.
     /// Splits that need a meta-node not loaded ask for it and wait.
     pub fn adapt(&mut self, view: &View, budget: Budget) -> Adapted {
-        if self.view_now != *view {
-            self.view_now = view.clone();
+        if self.loading.view_now != *view {
+            self.loading.view_now = view.clone();
         }
         let mut done = Adapted {
             loaded: self.take_arrivals(false),
             ..Adapted::default()
         };
-        let mut pass = std::mem::take(&mut self.pass);
+        let mut pass = std::mem::take(&mut self.scratch.pass);
         let new_view = self.adapt_passes(view, budget, &mut done, &mut pass);
         self.settle_orientation(view, budget, &mut done, &mut pass, new_view);
-        self.pass = pass;
+        self.scratch.pass = pass;
         self.regulate(budget.faces, done.capped);
         done
     }

@@ -34,21 +34,21 @@ fn spheres_hold_orientation(p: [DVec3; 3], r: [f64; 3]) -> Option<f64> {
 impl ViewMesh {
     /// Lists triangle `f` to have its orientation checked.
     pub(super) fn suspect(&mut self, f: u32) {
-        if self.suspected[f as usize] == Suspicion::None {
-            self.suspects.push(f);
+        if self.guard.suspected[f as usize] == Suspicion::None {
+            self.guard.suspects.push(f);
         }
-        self.suspected[f as usize] = Suspicion::Moved;
+        self.guard.suspected[f as usize] = Suspicion::Moved;
         self.retry_around(f);
     }
 
     /// Lists the collapses that moving, making or removing present triangle `f` may have made
     /// possible for its orientation (those of its corners' parents) to be tried again.
     pub(super) fn retry_around(&mut self, f: u32) {
-        for c in self.corners[f as usize] {
-            let p = self.parent[c as usize];
-            if p != NONE && !self.in_retry[p as usize] {
-                self.in_retry[p as usize] = true;
-                self.retry.push(p);
+        for c in self.faces.corners[f as usize] {
+            let p = self.nodes.parent[c as usize];
+            if p != NONE && !self.guard.in_retry[p as usize] {
+                self.guard.in_retry[p as usize] = true;
+                self.guard.retry.push(p);
             }
         }
     }
@@ -56,7 +56,7 @@ impl ViewMesh {
     /// Whether the face on active nodes `corners` shows in the view: it meets the frustum and
     /// spans the tolerance on the screen ([`View::shows_triangle`]).
     pub(super) fn in_view(&self, view: &View, corners: [u32; 3]) -> bool {
-        view.shows_triangle(corners.map(|v| self.spheres[v as usize].0))
+        view.shows_triangle(corners.map(|v| self.nodes.spheres[v as usize].0))
     }
 
     /// Whether triangle `f`, on active nodes `corners`, surely turns the way of its counterpart
@@ -66,8 +66,8 @@ impl ViewMesh {
         if corners.iter().all(|&v| self.is_leaf(v)) {
             return true;
         }
-        let p = corners.map(|v| self.spheres[v as usize].0);
-        let r = corners.map(|v| self.spheres[v as usize].1);
+        let p = corners.map(|v| self.nodes.spheres[v as usize].0);
+        let r = corners.map(|v| self.nodes.spheres[v as usize].1);
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let area = n.length();
         if !(area > 0.0 && area.is_finite()) {
@@ -77,7 +77,7 @@ impl ViewMesh {
             return true;
         }
         let cones = corners.iter().any(|&v| {
-            let cone = &self.cones[v as usize];
+            let cone = &self.nodes.cones[v as usize];
             let axis = DVec3::new(
                 cone.axis[0] as f64,
                 cone.axis[1] as f64,
@@ -103,16 +103,16 @@ impl ViewMesh {
         corners: [u32; 3],
         f: u32,
     ) -> bool {
-        let leaves = self.leaf_corners[f as usize];
+        let leaves = self.faces.leaf_corners[f as usize];
         let deepest = leaves.map(|leaf| {
             let above = corners
                 .into_iter()
-                .find(|&c| self.ids[c as usize].is_ancestor_of(leaf))
+                .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
                 .unwrap_or(0);
             self.toward_from(above, leaf).0
         });
-        let q = deepest.map(|v| self.spheres[v as usize].0);
-        let r = deepest.map(|v| self.spheres[v as usize].1);
+        let q = deepest.map(|v| self.nodes.spheres[v as usize].0);
+        let r = deepest.map(|v| self.nodes.spheres[v as usize].1);
         let Some(cos_gamma) = spheres_hold_orientation(q, r) else {
             return false;
         };
@@ -150,17 +150,17 @@ impl ViewMesh {
             return true;
         }
         // (Not when trying again after the guard, which would undo its splits over and over.)
-        if !retry && budget.faces.is_some_and(|target| self.faces > target) {
+        if !retry && budget.faces.is_some_and(|target| self.faces.count > target) {
             return true;
         }
-        if self.refused_listed[su] && !retry {
+        if self.guard.refused_listed[su] && !retry {
             return false;
         }
-        let [t, u] = self.children[su];
+        let [t, u] = self.nodes.children[su];
         // Face `f` once `s` is collapsed: in view and not certain?
         let spoilt = |f: u32| {
-            let corners = self.corners[f as usize];
-            if !self.present[f as usize] || corners.contains(&t) && corners.contains(&u) {
+            let corners = self.faces.corners[f as usize];
+            if !self.faces.present[f as usize] || corners.contains(&t) && corners.contains(&u) {
                 return false;
             }
             if !corners.contains(&t) && !corners.contains(&u) {
@@ -169,12 +169,12 @@ impl ViewMesh {
             let moved = corners.map(|v| if v == t || v == u { s } else { v });
             self.in_view(view, moved) && !self.orientation_certain(moved, f)
         };
-        let held = self.held_by[su];
+        let held = self.guard.held_by[su];
         let culprit = if held != NONE && spoilt(held) {
             Some(held)
         } else {
             [t, u].iter().find_map(|&c| {
-                self.faces_at[c as usize]
+                self.faces.faces_at[c as usize]
                     .iter()
                     .copied()
                     .find(|&f| spoilt(f))
@@ -182,10 +182,10 @@ impl ViewMesh {
         };
         match culprit {
             Some(f) => {
-                self.held_by[su] = f;
-                if !self.refused_listed[su] {
-                    self.refused_listed[su] = true;
-                    self.refused.push(s);
+                self.guard.held_by[su] = f;
+                if !self.guard.refused_listed[su] {
+                    self.guard.refused_listed[su] = true;
+                    self.guard.refused.push(s);
                 }
                 false
             }
@@ -213,26 +213,26 @@ impl ViewMesh {
         let mut activated = Vec::new();
         let waiting_before = done.waiting;
         // The view's splits that wait, of the children the guard's splits activate.
-        self.waited_now.clear();
-        while let Some(f) = self.suspects.pop() {
+        self.loading.waited_now.clear();
+        while let Some(f) = self.guard.suspects.pop() {
             let fu = f as usize;
-            let corners = self.corners[fu];
-            let certain = match self.suspected[fu] {
-                _ if !self.present[fu] => true,
+            let corners = self.faces.corners[fu];
+            let certain = match self.guard.suspected[fu] {
+                _ if !self.faces.present[fu] => true,
                 Suspicion::Moved => self.orientation_certain(corners, f),
                 _ => false,
             };
             if certain {
-                self.suspected[fu] = Suspicion::None;
+                self.guard.suspected[fu] = Suspicion::None;
                 continue;
             }
-            self.suspected[fu] = Suspicion::Uncertain;
+            self.guard.suspected[fu] = Suspicion::Uncertain;
             if !self.in_view(view, corners) {
                 held.push(f);
                 continue;
             }
             if done.splits + done.collapses >= budget.operations
-                || self.faces >= budget.faces.unwrap_or(usize::MAX)
+                || self.faces.count >= budget.faces.unwrap_or(usize::MAX)
             {
                 held.push(f);
                 unsure += 1;
@@ -240,7 +240,7 @@ impl ViewMesh {
             }
             let mut corners = corners;
             corners.sort_by(|&a, &b| {
-                let radius = |v: u32| self.spheres[v as usize].1;
+                let radius = |v: u32| self.nodes.spheres[v as usize].1;
                 radius(b).total_cmp(&radius(a))
             });
             let mut outcome = Ready::Never;
@@ -250,11 +250,11 @@ impl ViewMesh {
                     continue;
                 }
                 activated.clear();
-                self.held_by[x as usize] = f;
+                self.guard.held_by[x as usize] = f;
                 // Within a face budget: a split that would take the front past it waits.
                 let room = budget
                     .faces
-                    .map_or(usize::MAX, |f| f.saturating_sub(self.faces));
+                    .map_or(usize::MAX, |f| f.saturating_sub(self.faces.count));
                 let (splits, stop) = self.force_split(x, &mut activated, room);
                 if splits == 0 && stop == Ready::Now {
                     no_room = true;
@@ -265,18 +265,18 @@ impl ViewMesh {
                 // after the guard and whenever a face they would move moves (the plan's own
                 // later splits may already have made them certain).
                 for i in 0..splits {
-                    let v = self.plan[i];
-                    if !self.refused_listed[v as usize] {
-                        self.refused_listed[v as usize] = true;
-                        self.refused.push(v);
+                    let v = self.scratch.plan[i];
+                    if !self.guard.refused_listed[v as usize] {
+                        self.guard.refused_listed[v as usize] = true;
+                        self.guard.refused.push(v);
                     }
-                    if !self.in_retry[v as usize] {
-                        self.in_retry[v as usize] = true;
-                        self.retry.push(v);
+                    if !self.guard.in_retry[v as usize] {
+                        self.guard.in_retry[v as usize] = true;
+                        self.guard.retry.push(v);
                     }
                 }
                 for &c in &activated {
-                    if self.state[c as usize] == State::Active && self.wants(view, c) {
+                    if self.front.state[c as usize] == State::Active && self.wants(view, c) {
                         self.refine_down(c, view, budget, done, below);
                     }
                 }
@@ -292,7 +292,7 @@ impl ViewMesh {
             }
             match outcome {
                 // Its corner moved: it is checked again.
-                Ready::Now => self.suspects.push(f),
+                Ready::Now => self.guard.suspects.push(f),
                 Ready::Waiting => {
                     done.waiting += 1;
                     held.push(f);
@@ -305,20 +305,20 @@ impl ViewMesh {
                 }
             }
         }
-        self.suspects = held;
+        self.guard.suspects = held;
         done.unsure = unsure;
         if done.waiting > waiting_before {
             // The next call with the same view revisits the view's splits that wait (as after
             // the passes) and then these faces.
-            let waited = std::mem::take(&mut self.waited_now);
-            self.waiting_nodes.extend_from_slice(&waited);
-            self.waited_now = waited;
-            if !done.capped && self.cursor == 0 {
-                self.waited_for = Some(view.clone());
+            let waited = std::mem::take(&mut self.loading.waited_now);
+            self.loading.waiting_nodes.extend_from_slice(&waited);
+            self.loading.waited_now = waited;
+            if !done.capped && self.scratch.cursor == 0 {
+                self.loading.waited_for = Some(view.clone());
             }
             done.settled = false;
         }
-        if done.splits + done.collapses >= budget.operations && !self.suspects.is_empty() {
+        if done.splits + done.collapses >= budget.operations && !self.guard.suspects.is_empty() {
             done.settled = false;
         }
     }
@@ -336,32 +336,32 @@ impl ViewMesh {
         below: &mut Vec<u32>,
         new_view: bool,
     ) {
-        let mut nodes = std::mem::take(&mut self.retry);
+        let mut nodes = std::mem::take(&mut self.guard.retry);
         if new_view {
-            nodes.append(&mut self.refused);
+            nodes.append(&mut self.guard.refused);
         }
         if !view.keeps_orientation() {
             // Nothing was refused for orientation: the faces' moves need no retrying.
             for &p in &nodes {
-                self.in_retry[p as usize] = false;
-                self.refused_listed[p as usize] = false;
+                self.guard.in_retry[p as usize] = false;
+                self.guard.refused_listed[p as usize] = false;
             }
             nodes.clear();
-            self.retry = nodes;
+            self.guard.retry = nodes;
             return;
         }
         loop {
             let before = (done.splits, done.collapses);
             for &p in &nodes {
-                self.refused_listed[p as usize] = false;
-                self.in_retry[p as usize] = false;
+                self.guard.refused_listed[p as usize] = false;
+                self.guard.in_retry[p as usize] = false;
             }
             for &p in &nodes {
                 if done.splits + done.collapses >= budget.operations {
                     // Kept for the next call.
-                    if !self.in_retry[p as usize] {
-                        self.in_retry[p as usize] = true;
-                        self.retry.push(p);
+                    if !self.guard.in_retry[p as usize] {
+                        self.guard.in_retry[p as usize] = true;
+                        self.guard.retry.push(p);
                     }
                     continue;
                 }
@@ -369,18 +369,18 @@ impl ViewMesh {
             }
             self.guard(view, budget, done, below);
             nodes.clear();
-            std::mem::swap(&mut nodes, &mut self.retry);
+            std::mem::swap(&mut nodes, &mut self.guard.retry);
             let spent = done.splits + done.collapses >= budget.operations;
             if spent || (done.splits, done.collapses) == before && nodes.is_empty() {
                 break;
             }
         }
         // Empty, or (the budget having run out) those left for the next call.
-        self.retry = nodes;
+        self.guard.retry = nodes;
         if done.splits + done.collapses >= budget.operations {
             // The budget ran out here, after the passes: a collapse chain may have stopped
             // short, so the next call makes whole passes rather than revisiting what waited.
-            self.waited_for = None;
+            self.loading.waited_for = None;
         }
     }
 }

@@ -11,32 +11,34 @@ impl ViewMesh {
     /// Where the vertex with leaf path `leaf` stands in the adapted mesh: the position of the
     /// active node on its path (`None` if the path leaves the hierarchy above the front).
     pub fn position_of(&self, leaf: NodeId) -> Option<DVec3> {
-        self.active_on(leaf).map(|v| self.spheres[v as usize].0)
+        self.active_on(leaf)
+            .map(|v| self.nodes.spheres[v as usize].0)
     }
 
     /// The present triangles: each one's corners' leaf paths (which name the full mesh's
     /// triangle it stands for) and its corners' positions in the adapted mesh.
     pub fn present_triangles(&self) -> impl Iterator<Item = ([NodeId; 3], [DVec3; 3])> + '_ {
-        (0..self.present.len())
-            .filter(|&t| self.present[t])
+        (0..self.faces.present.len())
+            .filter(|&t| self.faces.present[t])
             .map(|t| {
-                let at = self.corners[t].map(|v| self.spheres[v as usize].0);
-                (self.leaf_corners[t], at)
+                let at = self.faces.corners[t].map(|v| self.nodes.spheres[v as usize].0);
+                (self.faces.leaf_corners[t], at)
             })
     }
 
     /// The adapted mesh: the active nodes' positions, the present triangles.
     pub fn mesh(&self) -> TriMesh {
-        let mut index = vec![NONE; self.ids.len()];
-        let mut positions = Vec::with_capacity(self.active.len());
-        for &v in &self.active {
+        let mut index = vec![NONE; self.nodes.ids.len()];
+        let mut positions = Vec::with_capacity(self.front.active.len());
+        for &v in &self.front.active {
             index[v as usize] = positions.len() as u32;
-            positions.push(self.spheres[v as usize].0);
+            positions.push(self.nodes.spheres[v as usize].0);
         }
         let faces = self
+            .faces
             .present
             .iter()
-            .zip(&self.corners)
+            .zip(&self.faces.corners)
             .filter(|(&p, _)| p)
             .map(|(_, c)| c.map(|v| index[v as usize]))
             .collect();
@@ -46,11 +48,11 @@ impl ViewMesh {
     /// The nearest present triangle the ray from `origin` along `direction` hits.
     pub fn pick(&self, origin: DVec3, direction: DVec3) -> Option<Pick> {
         let mut best: Option<Pick> = None;
-        for (t, &present) in self.present.iter().enumerate() {
+        for (t, &present) in self.faces.present.iter().enumerate() {
             if !present {
                 continue;
             }
-            let [a, b, c] = self.corners[t].map(|v| self.spheres[v as usize].0);
+            let [a, b, c] = self.faces.corners[t].map(|v| self.nodes.spheres[v as usize].0);
             if let Some(d) = ray_triangle(origin, direction, a, b, c) {
                 if best.is_none_or(|p| d < p.distance) {
                     best = Some(Pick {
@@ -66,15 +68,19 @@ impl ViewMesh {
 
     /// Checks every invariant of the module docs; the first broken one, described.
     pub fn check_invariants(&self) -> std::result::Result<(), String> {
-        let n = self.ids.len();
-        if self.state[0] == State::Below {
+        let n = self.nodes.ids.len();
+        self.nodes.check()?;
+        self.front.check(n)?;
+        self.faces.check()?;
+        self.guard.check()?;
+        if self.front.state[0] == State::Below {
             return Err("the root is below the front".into());
         }
         for v in 0..n {
-            let st = self.state[v];
-            let inner = self.children[v][0] != NONE;
-            for c in self.children[v].into_iter().filter(|&c| c != NONE) {
-                let cs = self.state[c as usize];
+            let st = self.front.state[v];
+            let inner = self.nodes.children[v][0] != NONE;
+            for c in self.nodes.children[v].into_iter().filter(|&c| c != NONE) {
+                let cs = self.front.state[c as usize];
                 let fine = match st {
                     State::Split => cs != State::Below,
                     _ => cs == State::Below,
@@ -86,16 +92,16 @@ impl ViewMesh {
             if st == State::Split && !inner {
                 return Err(format!("leaf {v} is split"));
             }
-            let bit = self.active_bits[v / 64] >> (v % 64) & 1 == 1;
-            if (st == State::Active) != (self.active_slot[v] != NONE)
+            let bit = self.front.active_bits[v / 64] >> (v % 64) & 1 == 1;
+            if (st == State::Active) != (self.front.active_slot[v] != NONE)
                 || (st == State::Active) != bit
             {
                 return Err(format!("node {v} is {st:?} but listed otherwise"));
             }
             if st == State::Split {
-                if let Some(d) = self.depends_on[v]
+                if let Some(d) = self.nodes.depends_on[v]
                     .iter()
-                    .find(|d| d.node == NONE || self.state[d.node as usize] != State::Split)
+                    .find(|d| d.node == NONE || self.front.state[d.node as usize] != State::Split)
                 {
                     return Err(format!(
                         "split node {v} depends on {:?}, which is not split",
@@ -105,33 +111,36 @@ impl ViewMesh {
             }
         }
         let mut dependants = vec![0u32; n];
-        for v in (0..n).filter(|&v| self.state[v] == State::Split) {
-            for d in &self.depends_on[v] {
+        for v in (0..n).filter(|&v| self.front.state[v] == State::Split) {
+            for d in &self.nodes.depends_on[v] {
                 dependants[d.node as usize] += 1;
             }
         }
-        if dependants != self.split_dependants {
+        if dependants != self.front.split_dependants {
             return Err("the counts of split dependants are off".into());
         }
         let mut listed = vec![0usize; n];
         let mut faces = 0;
         for v in 0..n {
-            for &t in &self.born[v] {
+            for &t in &self.nodes.born[v] {
                 let tu = t as usize;
-                if self.present[tu] != (self.state[v] == State::Split) {
+                if self.faces.present[tu] != (self.front.state[v] == State::Split) {
                     return Err(format!(
                         "triangle {t} present {} at a {:?} birth node",
-                        self.present[tu], self.state[v]
+                        self.faces.present[tu], self.front.state[v]
                     ));
                 }
-                if !self.present[tu] {
+                if !self.faces.present[tu] {
                     continue;
                 }
                 faces += 1;
-                let c = self.corners[tu];
-                for (k, (&corner, &leaf)) in c.iter().zip(&self.leaf_corners[tu]).enumerate() {
+                let c = self.faces.corners[tu];
+                for (k, (&corner, &leaf)) in c.iter().zip(&self.faces.leaf_corners[tu]).enumerate()
+                {
                     let cu = corner as usize;
-                    if self.state[cu] != State::Active || !self.ids[cu].is_ancestor_of(leaf) {
+                    if self.front.state[cu] != State::Active
+                        || !self.nodes.ids[cu].is_ancestor_of(leaf)
+                    {
                         return Err(format!(
                             "triangle {t}'s corner {k} is not its leaf's active node"
                         ));
@@ -143,35 +152,27 @@ impl ViewMesh {
                 }
             }
         }
-        if faces != self.faces {
-            return Err(format!("{faces} triangles present, {} counted", self.faces));
+        if faces != self.faces.count {
+            return Err(format!(
+                "{faces} triangles present, {} counted",
+                self.faces.count
+            ));
         }
-        if let Some(t) = (0..self.present.len()).find(|&t| {
-            self.present[t]
-                && self.suspected[t] == Suspicion::None
-                && !self.orientation_certain(self.corners[t], t as u32)
+        if let Some(t) = (0..self.faces.present.len()).find(|&t| {
+            self.faces.present[t]
+                && self.guard.suspected[t] == Suspicion::None
+                && !self.orientation_certain(self.faces.corners[t], t as u32)
         }) {
             return Err(format!(
                 "triangle {t} is not certain of its orientation and not listed"
             ));
         }
-        let marked = self
-            .suspected
-            .iter()
-            .filter(|&&m| m != Suspicion::None)
-            .count();
-        if marked != self.suspects.len()
-            || self
-                .suspects
-                .iter()
-                .any(|&t| self.suspected[t as usize] == Suspicion::None)
-        {
-            return Err("the listed triangles and their marks disagree".into());
-        }
-        for &v in &self.active {
-            let list = &self.faces_at[v as usize];
+        for &v in &self.front.active {
+            let list = &self.faces.faces_at[v as usize];
             if list.len() != listed[v as usize]
-                || list.iter().any(|&t| !self.corners[t as usize].contains(&v))
+                || list
+                    .iter()
+                    .any(|&t| !self.faces.corners[t as usize].contains(&v))
             {
                 return Err(format!("node {v}'s triangle list is off"));
             }

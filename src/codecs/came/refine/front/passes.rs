@@ -9,13 +9,13 @@ use crate::prefetch::prefetch;
 
 impl ViewMesh {
     pub(super) fn wants(&self, view: &View, v: u32) -> bool {
-        let (center, radius) = self.spheres[v as usize];
-        let deviation = self.deviations[v as usize];
+        let (center, radius) = self.nodes.spheres[v as usize];
+        let deviation = self.nodes.deviations[v as usize];
         view.wants_split(
             center,
             radius,
             deviation,
-            &self.cones[v as usize],
+            &self.nodes.cones[v as usize],
             self.scale,
         )
     }
@@ -33,25 +33,25 @@ impl ViewMesh {
         // The same view again, its last pass having changed nothing, with splits waiting for
         // meta-nodes: only those splits can go further (the rest of the front is where that
         // pass left it), so only their nodes are visited.
-        let revisit = self.waited_for.as_ref() == Some(view)
+        let revisit = self.loading.waited_for.as_ref() == Some(view)
             && budget == Budget::UNLIMITED
-            && self.cursor == 0;
-        self.waited_for = None;
+            && self.scratch.cursor == 0;
+        self.loading.waited_for = None;
         if revisit {
             done.passes += 1;
-            self.waited_now.clear();
-            let waiting = std::mem::take(&mut self.waiting_nodes);
+            self.loading.waited_now.clear();
+            let waiting = std::mem::take(&mut self.loading.waiting_nodes);
             for &v in &waiting {
-                if self.state[v as usize] == State::Active && self.wants(view, v) {
+                if self.front.state[v as usize] == State::Active && self.wants(view, v) {
                     self.refine_down(v, view, budget, done, &mut below);
                 }
             }
             // The splits still waiting are the next list; the old one's buffer is reused.
-            self.waiting_nodes = std::mem::replace(&mut self.waited_now, waiting);
+            self.loading.waiting_nodes = std::mem::replace(&mut self.loading.waited_now, waiting);
             if done.waiting == 0 {
                 done.settled = !done.capped;
             } else {
-                self.waited_for = Some(view.clone());
+                self.loading.waited_for = Some(view.clone());
             }
             return false;
         }
@@ -60,40 +60,40 @@ impl ViewMesh {
             done.passes += 1;
             done.waiting = 0;
             done.blocked = 0;
-            self.waited_now.clear();
+            self.loading.waited_now.clear();
             // In node order (the loader's, which keeps a meta-node's nodes together) rather
             // than the list's: the nodes' records are then read nearly in memory order. The
             // bits list them so (sorting the list cost more), from the cursor on.
             pass.clear();
-            for (k, &word) in self.active_bits.iter().enumerate() {
+            for (k, &word) in self.front.active_bits.iter().enumerate() {
                 let mut word = word;
                 while word != 0 {
                     pass.push((64 * k) as u32 + word.trailing_zeros());
                     word &= word - 1;
                 }
             }
-            let start = pass.partition_point(|&v| v < self.cursor);
+            let start = pass.partition_point(|&v| v < self.scratch.cursor);
             pass.rotate_left(start);
-            self.cursor = 0;
+            self.scratch.cursor = 0;
             for (i, &v) in pass.iter().enumerate() {
                 // The records the visit of a node a few visits on reads first: its sphere and
                 // its parent's (the active nodes are sparse among all, too far apart for the
                 // processor to foresee).
                 if let Some(&ahead) = pass.get(i + 8) {
-                    prefetch(self.spheres.as_ptr().wrapping_add(ahead as usize));
-                    prefetch(self.parent.as_ptr().wrapping_add(ahead as usize));
+                    prefetch(self.nodes.spheres.as_ptr().wrapping_add(ahead as usize));
+                    prefetch(self.nodes.parent.as_ptr().wrapping_add(ahead as usize));
                 }
                 if let Some(&ahead) = pass.get(i + 4) {
-                    let p = self.parent[ahead as usize] as usize;
-                    prefetch(self.spheres.as_ptr().wrapping_add(p));
-                    prefetch(self.children.as_ptr().wrapping_add(p));
-                    prefetch(self.split_dependants.as_ptr().wrapping_add(p));
+                    let p = self.nodes.parent[ahead as usize] as usize;
+                    prefetch(self.nodes.spheres.as_ptr().wrapping_add(p));
+                    prefetch(self.nodes.children.as_ptr().wrapping_add(p));
+                    prefetch(self.front.split_dependants.as_ptr().wrapping_add(p));
                 }
                 if done.splits + done.collapses >= budget.operations {
-                    self.cursor = v;
+                    self.scratch.cursor = v;
                     return true;
                 }
-                if self.state[v as usize] != State::Active {
+                if self.front.state[v as usize] != State::Active {
                     continue;
                 }
                 if self.wants(view, v) && self.ready(v) != Ready::Never {
@@ -103,7 +103,7 @@ impl ViewMesh {
                 // Up the tree while the parent may and should go; then the same from each
                 // node those collapses freed of its last split dependant (so that a chain of
                 // dependencies unwinds in one pass, not one pass a link).
-                self.collapse_from(self.parent[v as usize], view, budget, done, false);
+                self.collapse_from(self.nodes.parent[v as usize], view, budget, done, false);
             }
             // Without limits, a pass leaves nothing for the next: a refined node goes down its
             // subtree at once, a collapse goes on up the tree and on from every node it frees of
@@ -114,9 +114,12 @@ impl ViewMesh {
             let complete = budget == Budget::UNLIMITED && !done.capped;
             if complete || (done.splits, done.collapses) == (before.splits, before.collapses) {
                 done.settled = !done.capped && done.waiting == 0;
-                std::mem::swap(&mut self.waiting_nodes, &mut self.waited_now);
+                std::mem::swap(
+                    &mut self.loading.waiting_nodes,
+                    &mut self.loading.waited_now,
+                );
                 if done.waiting > 0 && !done.capped {
-                    self.waited_for = Some(view.clone());
+                    self.loading.waited_for = Some(view.clone());
                 }
                 return true;
             }
@@ -144,9 +147,9 @@ impl ViewMesh {
             {
                 self.collapse(p);
                 done.collapses += 1;
-                p = self.parent[p as usize];
+                p = self.nodes.parent[p as usize];
             }
-            match self.freed.pop() {
+            match self.scratch.freed.pop() {
                 Some(d) if done.splits + done.collapses < budget.operations => p = d,
                 _ => break,
             }
@@ -167,7 +170,7 @@ impl ViewMesh {
         below.clear();
         below.push(v);
         while let Some(x) = below.pop() {
-            if self.state[x as usize] != State::Active
+            if self.front.state[x as usize] != State::Active
                 || done.splits + done.collapses >= budget.operations
                 || !self.wants(view, x)
             {
@@ -177,12 +180,12 @@ impl ViewMesh {
                 Ready::Now => {}
                 Ready::Waiting => {
                     done.waiting += 1;
-                    self.waited_now.push(x);
+                    self.loading.waited_now.push(x);
                     continue;
                 }
                 Ready::Never => continue,
             }
-            if self.faces >= limit {
+            if self.faces.count >= limit {
                 done.capped = true;
                 continue;
             }
@@ -192,7 +195,7 @@ impl ViewMesh {
                 Ready::Now => {}
                 Ready::Waiting => {
                     done.waiting += 1;
-                    self.waited_now.push(x);
+                    self.loading.waited_now.push(x);
                 }
                 Ready::Never => done.blocked += 1,
             }
@@ -206,9 +209,9 @@ impl ViewMesh {
             self.scale = 1.0;
             return;
         };
-        if self.faces > target || capped {
+        if self.faces.count > target || capped {
             self.scale *= 1.25;
-        } else if (self.faces as f64) < 0.8 * target as f64 {
+        } else if (self.faces.count as f64) < 0.8 * target as f64 {
             self.scale = (self.scale / 1.25).max(1.0);
         }
     }

@@ -7,6 +7,7 @@ use super::super::view::Camera;
 use super::*;
 use crate::codecs::{self, EncodeOptions, Stop};
 use crate::container::read_header_and_index;
+use crate::hierarchy::came::NodeId;
 use crate::mesh::quantize::GridShape;
 use crate::mesh::{generate, TriMesh};
 use proptest::prelude::*;
@@ -150,11 +151,11 @@ fn meta_nodes_are_asked_for_most_wanted_first() {
             let errors: Vec<f64> = wanted
                 .iter()
                 .map(|&(unit, _)| {
-                    let v = (0..front.opens.len())
-                        .find(|&v| front.opens[v] == unit as u32)
+                    let v = (0..front.nodes.opens.len())
+                        .find(|&v| front.nodes.opens[v] == unit as u32)
                         .expect("a node waits for each unit asked for");
-                    let (center, radius) = front.spheres[v];
-                    view.screen_error(center, radius, front.deviations[v], front.scale)
+                    let (center, radius) = front.nodes.spheres[v];
+                    view.screen_error(center, radius, front.nodes.deviations[v], front.scale)
                 })
                 .collect();
             assert!(
@@ -241,17 +242,18 @@ fn back_faces_stay_coarse_unless_the_view_is_two_sided() {
     );
     // Nodes the two-sided front splits stay on the one-sided front because they face away.
     let faces_away = |v: u32| {
-        let (c, r) = one.spheres[v as usize];
-        view.faces_away(c, r, &one.cones[v as usize])
+        let (c, r) = one.nodes.spheres[v as usize];
+        view.faces_away(c, r, &one.nodes.cones[v as usize])
     };
-    let split_in_two: std::collections::HashSet<NodeId> = (0..two.ids.len())
-        .filter(|&v| two.state[v] == State::Split)
-        .map(|v| two.ids[v])
+    let split_in_two: std::collections::HashSet<NodeId> = (0..two.nodes.ids.len())
+        .filter(|&v| two.front.state[v] == State::Split)
+        .map(|v| two.nodes.ids[v])
         .collect();
     let culled = one
+        .front
         .active
         .iter()
-        .filter(|&&v| split_in_two.contains(&one.ids[v as usize]) && faces_away(v))
+        .filter(|&&v| split_in_two.contains(&one.nodes.ids[v as usize]) && faces_away(v))
         .count();
     assert!(culled > 0);
 }
@@ -443,10 +445,10 @@ fn projection(vm: &ViewMesh, full: &crate::codecs::came::decoded::DecodedTree) -
 
 /// The present triangles' corners, as [`projection`] gives them.
 fn present_corners(vm: &ViewMesh) -> Vec<[u32; 3]> {
-    let mut out: Vec<[u32; 3]> = (0..vm.present.len())
-        .filter(|&t| vm.present[t])
+    let mut out: Vec<[u32; 3]> = (0..vm.faces.present.len())
+        .filter(|&t| vm.faces.present[t])
         .map(|t| {
-            let mut c = vm.corners[t];
+            let mut c = vm.faces.corners[t];
             let least = (0..3).min_by_key(|&k| c[k]).unwrap();
             c.rotate_left(least);
             c
@@ -482,13 +484,13 @@ fn the_adapted_mesh_is_the_full_mesh_projected_through_the_front_so_it_has_no_cr
 fn fold_overs_in_view(vm: &ViewMesh, full: &HashMap<u64, DVec3>, view: &View) -> (usize, usize) {
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
     let (mut folded, mut coarse) = (0, 0);
-    for t in (0..vm.present.len()).filter(|&t| vm.present[t]) {
-        let at = vm.corners[t].map(|v| vm.spheres[v as usize].0);
-        let counterpart = vm.leaf_corners[t].map(|l| full[&l.packed()]);
+    for t in (0..vm.faces.present.len()).filter(|&t| vm.faces.present[t]) {
+        let at = vm.faces.corners[t].map(|v| vm.nodes.spheres[v as usize].0);
+        let counterpart = vm.faces.leaf_corners[t].map(|l| full[&l.packed()]);
         if at != counterpart {
             coarse += 1;
         }
-        if vm.in_view(view, vm.corners[t]) && normal(at).dot(normal(counterpart)) <= 0.0 {
+        if vm.in_view(view, vm.faces.corners[t]) && normal(at).dot(normal(counterpart)) <= 0.0 {
             folded += 1;
         }
     }
@@ -530,9 +532,10 @@ fn no_face_in_view_turns_against_the_full_meshs_triangle() {
             assert_eq!(folded, 0, "eye {eye}, tolerance {tolerance}");
             // Every listed face is out of view once settled.
             assert!(vm
+                .guard
                 .suspects
                 .iter()
-                .all(|&t| !vm.in_view(&view, vm.corners[t as usize])));
+                .all(|&t| !vm.in_view(&view, vm.faces.corners[t as usize])));
             coarse += not_full;
         }
     }

@@ -8,33 +8,33 @@ use smallvec::SmallVec;
 
 impl ViewMesh {
     pub(super) fn activate(&mut self, v: u32) {
-        self.state[v as usize] = State::Active;
-        self.active_slot[v as usize] = self.active.len() as u32;
-        self.active.push(v);
-        self.active_bits[v as usize / 64] |= 1 << (v % 64);
+        self.front.state[v as usize] = State::Active;
+        self.front.active_slot[v as usize] = self.front.active.len() as u32;
+        self.front.active.push(v);
+        self.front.active_bits[v as usize / 64] |= 1 << (v % 64);
     }
 
     pub(super) fn deactivate(&mut self, v: u32, to: State) {
-        self.state[v as usize] = to;
-        let slot = self.active_slot[v as usize] as usize;
-        self.active.swap_remove(slot);
-        if let Some(&moved) = self.active.get(slot) {
-            self.active_slot[moved as usize] = slot as u32;
+        self.front.state[v as usize] = to;
+        let slot = self.front.active_slot[v as usize] as usize;
+        self.front.active.swap_remove(slot);
+        if let Some(&moved) = self.front.active.get(slot) {
+            self.front.active_slot[moved as usize] = slot as u32;
         }
-        self.active_slot[v as usize] = NONE;
-        self.active_bits[v as usize / 64] &= !(1 << (v % 64));
+        self.front.active_slot[v as usize] = NONE;
+        self.front.active_bits[v as usize / 64] &= !(1 << (v % 64));
     }
 
     /// The active node on leaf path `leaf`; `None` if the path ends at a split node (a
     /// corrupt stream's corner).
     pub(super) fn active_on(&self, leaf: NodeId) -> Option<u32> {
         let mut v = 0u32;
-        while self.state[v as usize] == State::Split {
-            let len = self.ids[v as usize].len();
+        while self.front.state[v as usize] == State::Split {
+            let len = self.nodes.ids[v as usize].len();
             if len >= leaf.len() {
                 return None;
             }
-            v = self.children[v as usize][leaf.bit(len) as usize];
+            v = self.nodes.children[v as usize][leaf.bit(len) as usize];
         }
         Some(v)
     }
@@ -48,11 +48,11 @@ impl ViewMesh {
     pub(super) fn toward_from(&self, start: u32, id: NodeId) -> (u32, bool) {
         let mut v = start;
         loop {
-            let len = self.ids[v as usize].len();
+            let len = self.nodes.ids[v as usize].len();
             if len >= id.len() {
-                return (v, self.ids[v as usize] == id);
+                return (v, self.nodes.ids[v as usize] == id);
             }
-            match self.children[v as usize][id.bit(len) as usize] {
+            match self.nodes.children[v as usize][id.bit(len) as usize] {
                 NONE => return (v, false),
                 c => v = c,
             }
@@ -62,14 +62,14 @@ impl ViewMesh {
     /// A node to split before `v` may be: its first dependency not split (or planned to be),
     /// or the deepest loaded node on the way to one not loaded yet.
     pub(super) fn unmet_dependency(&mut self, v: u32) -> Option<u32> {
-        for k in 0..self.depends_on[v as usize].len() {
-            let dep = self.depends_on[v as usize][k];
+        for k in 0..self.nodes.depends_on[v as usize].len() {
+            let dep = self.nodes.depends_on[v as usize][k];
             let node = if dep.node != NONE {
                 dep.node
             } else {
                 match self.toward(dep.id) {
                     (x, true) => {
-                        self.depends_on[v as usize][k].node = x;
+                        self.nodes.depends_on[v as usize][k].node = x;
                         x
                     }
                     (x, false) => return Some(x),
@@ -86,10 +86,10 @@ impl ViewMesh {
     /// (where a triangle born at `s` finds its third corner: a neighbour of `v_s`, Hoppe's
     /// v_l or v_r), without a walk from the root.
     pub(super) fn neighbour_on(&self, s: u32, leaf: NodeId) -> Option<u32> {
-        self.faces_at[s as usize].iter().find_map(|&f| {
-            self.corners[f as usize]
+        self.faces.faces_at[s as usize].iter().find_map(|&f| {
+            self.faces.corners[f as usize]
                 .into_iter()
-                .find(|&n| n != s && self.ids[n as usize].is_ancestor_of(leaf))
+                .find(|&n| n != s && self.nodes.ids[n as usize].is_ancestor_of(leaf))
         })
     }
 
@@ -98,12 +98,14 @@ impl ViewMesh {
     /// a corrupt stream).
     pub(super) fn split(&mut self, s: u32) -> bool {
         let su = s as usize;
-        let depth = self.ids[su].len();
-        let own = self.ids[su];
+        let depth = self.nodes.ids[su].len();
+        let own = self.nodes.ids[su];
         let deep = |c: NodeId| c.len() > depth;
-        for &f in &self.faces_at[su] {
+        for &f in &self.faces.faces_at[su] {
             for k in 0..3 {
-                if self.corners[f as usize][k] == s && !deep(self.leaf_corners[f as usize][k]) {
+                if self.faces.corners[f as usize][k] == s
+                    && !deep(self.faces.leaf_corners[f as usize][k])
+                {
                     return false;
                 }
             }
@@ -111,14 +113,14 @@ impl ViewMesh {
         // The born triangles' corners: two under v_s, at v_t and v_u once it is split; the
         // third a neighbour (an active node elsewhere, which this split does not move).
         let mut born: SmallVec<[[u32; 3]; 4]> = SmallVec::new();
-        for &f in &self.born[su] {
+        for &f in &self.nodes.born[su] {
             let mut corners = [NONE; 3];
-            for (k, &c) in self.leaf_corners[f as usize].iter().enumerate() {
+            for (k, &c) in self.faces.leaf_corners[f as usize].iter().enumerate() {
                 corners[k] = if own.is_ancestor_of(c) {
                     if !deep(c) {
                         return false;
                     }
-                    self.children[su][c.bit(depth) as usize]
+                    self.nodes.children[su][c.bit(depth) as usize]
                 } else {
                     match self.neighbour_on(s, c).or_else(|| self.active_on(c)) {
                         Some(v) => v,
@@ -128,86 +130,87 @@ impl ViewMesh {
             }
             born.push(corners);
         }
-        let [t, u] = self.children[su];
+        let [t, u] = self.nodes.children[su];
         self.deactivate(s, State::Split);
         self.activate(t);
         self.activate(u);
-        for f in std::mem::take(&mut self.faces_at[su]) {
+        for f in std::mem::take(&mut self.faces.faces_at[su]) {
             let fu = f as usize;
             for k in 0..3 {
-                if self.corners[fu][k] == s {
-                    let child = self.children[su][self.leaf_corners[fu][k].bit(depth) as usize];
-                    self.corners[fu][k] = child;
-                    self.faces_at[child as usize].push(f);
+                if self.faces.corners[fu][k] == s {
+                    let child =
+                        self.nodes.children[su][self.faces.leaf_corners[fu][k].bit(depth) as usize];
+                    self.faces.corners[fu][k] = child;
+                    self.faces.faces_at[child as usize].push(f);
                 }
             }
             self.suspect(f);
         }
         for (i, corners) in born.into_iter().enumerate() {
-            let f = self.born[su][i];
+            let f = self.nodes.born[su][i];
             for &c in &corners {
-                self.faces_at[c as usize].push(f);
+                self.faces.faces_at[c as usize].push(f);
             }
-            self.corners[f as usize] = corners;
-            self.present[f as usize] = true;
+            self.faces.corners[f as usize] = corners;
+            self.faces.present[f as usize] = true;
             self.suspect(f);
         }
-        self.faces += self.born[su].len();
-        for &d in &self.depends_on[su] {
-            self.split_dependants[d.node as usize] += 1;
+        self.faces.count += self.nodes.born[su].len();
+        for &d in &self.nodes.depends_on[su] {
+            self.front.split_dependants[d.node as usize] += 1;
         }
         true
     }
 
     /// Whether node `v` is a leaf of the hierarchy (not a node whose split is still to load).
     pub(super) fn is_leaf(&self, v: u32) -> bool {
-        self.children[v as usize][0] == NONE && self.opens[v as usize] == NONE
+        self.nodes.children[v as usize][0] == NONE && self.nodes.opens[v as usize] == NONE
     }
 
     /// Whether ecol of split node `s` is legal: both children active, no split dependant.
     pub(super) fn can_collapse(&self, s: u32) -> bool {
         let su = s as usize;
-        self.state[su] == State::Split
-            && self.split_dependants[su] == 0
-            && self.children[su]
+        self.front.state[su] == State::Split
+            && self.front.split_dependants[su] == 0
+            && self.nodes.children[su]
                 .iter()
-                .all(|&c| self.state[c as usize] == State::Active)
+                .all(|&c| self.front.state[c as usize] == State::Active)
     }
 
     /// ecol of `s` ([`Self::can_collapse`]).
     pub(super) fn collapse(&mut self, s: u32) {
         let su = s as usize;
-        for i in 0..self.born[su].len() {
-            let f = self.born[su][i];
+        for i in 0..self.nodes.born[su].len() {
+            let f = self.nodes.born[su][i];
             self.retry_around(f);
-            for c in self.corners[f as usize] {
-                let list = &mut self.faces_at[c as usize];
+            for c in self.faces.corners[f as usize] {
+                let list = &mut self.faces.faces_at[c as usize];
                 if let Some(at) = list.iter().position(|&g| g == f) {
                     list.swap_remove(at);
                 }
             }
-            self.corners[f as usize] = [NONE; 3];
-            self.present[f as usize] = false;
+            self.faces.corners[f as usize] = [NONE; 3];
+            self.faces.present[f as usize] = false;
         }
-        self.faces -= self.born[su].len();
-        for c in self.children[su] {
-            for f in std::mem::take(&mut self.faces_at[c as usize]) {
-                for corner in &mut self.corners[f as usize] {
+        self.faces.count -= self.nodes.born[su].len();
+        for c in self.nodes.children[su] {
+            for f in std::mem::take(&mut self.faces.faces_at[c as usize]) {
+                for corner in &mut self.faces.corners[f as usize] {
                     if *corner == c {
                         *corner = s;
                     }
                 }
-                self.faces_at[su].push(f);
+                self.faces.faces_at[su].push(f);
                 self.suspect(f);
             }
             self.deactivate(c, State::Below);
         }
         self.activate(s);
-        for &d in &self.depends_on[su] {
-            let count = &mut self.split_dependants[d.node as usize];
+        for &d in &self.nodes.depends_on[su] {
+            let count = &mut self.front.split_dependants[d.node as usize];
             *count -= 1;
             if *count == 0 {
-                self.freed.push(d.node);
+                self.scratch.freed.push(d.node);
             }
         }
     }
@@ -215,9 +218,9 @@ impl ViewMesh {
     /// The node's state once the splits planned so far are made.
     pub(super) fn planned_state(&self, v: u32) -> State {
         let vu = v as usize;
-        match self.state[vu] {
-            _ if self.planned[vu] => State::Split,
-            State::Below if self.planned[self.parent[vu] as usize] => State::Active,
+        match self.front.state[vu] {
+            _ if self.scratch.planned[vu] => State::Split,
+            State::Below if self.scratch.planned[self.nodes.parent[vu] as usize] => State::Active,
             state => state,
         }
     }
@@ -234,16 +237,16 @@ impl ViewMesh {
         activated: &mut Vec<u32>,
         room: usize,
     ) -> (usize, Ready) {
-        let mut plan = std::mem::take(&mut self.plan);
+        let mut plan = std::mem::take(&mut self.scratch.plan);
         plan.clear();
-        let mut stack = std::mem::take(&mut self.stack);
+        let mut stack = std::mem::take(&mut self.scratch.stack);
         stack.clear();
         stack.push(s);
         let outcome = loop {
             let Some(&v) = stack.last() else {
                 break Ready::Now;
             };
-            if stack.len() > self.ids.len() {
+            if stack.len() > self.nodes.ids.len() {
                 // The dependencies form a cycle: a corrupt stream.
                 break Ready::Never;
             }
@@ -251,12 +254,12 @@ impl ViewMesh {
                 State::Split => {
                     stack.pop();
                 }
-                State::Below => stack.push(self.parent[v as usize]),
+                State::Below => stack.push(self.nodes.parent[v as usize]),
                 State::Active => match self.ready(v) {
                     Ready::Now => match self.unmet_dependency(v) {
                         Some(d) => stack.push(d),
                         None => {
-                            self.planned[v as usize] = true;
+                            self.scratch.planned[v as usize] = true;
                             plan.push(v);
                             stack.pop();
                         }
@@ -266,23 +269,26 @@ impl ViewMesh {
             }
         };
         for &v in &plan {
-            self.planned[v as usize] = false;
+            self.scratch.planned[v as usize] = false;
         }
         let mut made = 0;
         let mut outcome = outcome;
-        let added: usize = plan.iter().map(|&v| self.born[v as usize].len()).sum();
+        let added: usize = plan
+            .iter()
+            .map(|&v| self.nodes.born[v as usize].len())
+            .sum();
         if outcome == Ready::Now && added <= room {
             for &v in &plan {
                 if !self.split(v) {
                     outcome = Ready::Never;
                     break;
                 }
-                activated.extend(self.children[v as usize]);
+                activated.extend(self.nodes.children[v as usize]);
                 made += 1;
             }
         }
-        self.plan = plan;
-        self.stack = stack;
+        self.scratch.plan = plan;
+        self.scratch.stack = stack;
         (made, outcome)
     }
 }

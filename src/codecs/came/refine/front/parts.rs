@@ -1,0 +1,219 @@
+//! The parts of a [`ViewMesh`](super::ViewMesh), each with the lists it keeps and what holds of
+//! them (`ViewMesh::check_invariants` checks them together): node records, the front, its
+//! triangles, the orientation guard, scratch, and the meta-nodes' loading.
+
+use super::super::loader::NONE;
+use super::super::loader::{Dependency, Loader};
+use super::super::view::View;
+use super::{State, Suspicion, UnitState};
+use crate::hierarchy::came::cones::NormalCone;
+use crate::hierarchy::came::NodeId;
+use glam::DVec3;
+use smallvec::SmallVec;
+
+/// The decoded tree's records, one entry a node in the loader's decoding order, every list as
+/// long as `ids`: what a meta-node brought. Only `children` and `opens` change after, when the
+/// meta-node that splits a node is taken in.
+#[derive(Default)]
+pub(super) struct Nodes {
+    pub(super) ids: Vec<NodeId>,
+    pub(super) parent: Vec<u32>,
+    /// Children, `[NONE; 2]` for leaves and nodes whose split is not loaded.
+    pub(super) children: Vec<[u32; 2]>,
+    /// The meta-node that splits the node, while it is not loaded (else `NONE`).
+    pub(super) opens: Vec<u32>,
+    /// Position and error-sphere radius, in world units.
+    /// (One array: the view test of every active node, every pass, reads both.)
+    pub(super) spheres: Vec<(DVec3, f64)>,
+    /// Deviation, in world units: the error the view test projects.
+    pub(super) deviations: Vec<f64>,
+    /// Normal cone, for back-face culling.
+    pub(super) cones: Vec<NormalCone>,
+    /// Triangles born at the node's split.
+    pub(super) born: Vec<SmallVec<[u32; 2]>>,
+    /// Nodes whose splits the node's split needs.
+    pub(super) depends_on: Vec<SmallVec<[Dependency; 2]>>,
+}
+
+/// Which nodes are on the front: each node's state, the active ones listed (each with its
+/// place in the list, and a bit each), and how many split nodes depend on each split node.
+#[derive(Default)]
+pub(super) struct Front {
+    pub(super) state: Vec<State>,
+    /// The active nodes, and each node's place among them.
+    pub(super) active: Vec<u32>,
+    pub(super) active_slot: Vec<u32>,
+    /// The active nodes again, a bit a node (bit v % 64 of word v / 64): a pass lists them
+    /// in node order from it.
+    pub(super) active_bits: Vec<u64>,
+    /// Split nodes depending on the node.
+    pub(super) split_dependants: Vec<u32>,
+}
+
+/// The triangles: each one's corners (as leaves, and as the active nodes on their paths),
+/// whether it is present, how many are, and each active node's present triangles.
+#[derive(Default)]
+pub(super) struct Faces {
+    // Per triangle.
+    pub(super) leaf_corners: Vec<[NodeId; 3]>,
+    pub(super) corners: Vec<[u32; 3]>,
+    pub(super) present: Vec<bool>,
+    /// Present triangles.
+    pub(super) count: usize,
+    /// Present triangles with a corner at the node (per node; active nodes only).
+    pub(super) faces_at: Vec<SmallVec<[u32; 6]>>,
+}
+
+/// The orientation guard's lists: faces whose orientation is to be made certain, and the
+/// collapses it refused or will try again.
+#[derive(Default)]
+pub(super) struct Guard {
+    /// The face that last kept the node split (a face in view its collapse would leave not
+    /// certain of its orientation, or that the guard split it for): checked first.
+    pub(super) held_by: Vec<u32>,
+    /// Whether the node is in `refused`.
+    pub(super) refused_listed: Vec<bool>,
+    /// Split nodes whose collapse was refused for a face's orientation: tried again after the
+    /// passes of every adaptation (not by the passes themselves, which would check the same
+    /// faces again and again while a view lasts).
+    pub(super) refused: Vec<u32>,
+    /// Split nodes whose collapse to try again after the passes, a face it would move having
+    /// moved (`in_retry`: whether listed).
+    pub(super) retry: Vec<u32>,
+    pub(super) in_retry: Vec<bool>,
+    /// Where the triangle stands in `suspects`.
+    pub(super) suspected: Vec<Suspicion>,
+    /// Present triangles whose orientation is to be made certain: those splits moved or made
+    /// since the last adaptation's guard, and those it could not yet make certain.
+    pub(super) suspects: Vec<u32>,
+}
+
+/// What passes and forced splits work through, kept to save allocating it each time.
+#[derive(Default)]
+pub(super) struct Scratch {
+    /// The active nodes a pass visits.
+    pub(super) pass: Vec<u32>,
+    /// Split nodes a collapse left with no split dependant: they may collapse now.
+    pub(super) freed: Vec<u32>,
+    /// Splits planned by a forced split, in order, and each node's mark of being planned;
+    /// the nodes it works through.
+    pub(super) plan: Vec<u32>,
+    pub(super) stack: Vec<u32>,
+    pub(super) planned: Vec<bool>,
+    /// Where an interrupted pass resumes: the node it stopped at (passes go in node order).
+    pub(super) cursor: u32,
+}
+
+/// The meta-nodes: the loader, each unit's state, what was read and refused, and the splits
+/// waiting for units.
+pub(super) struct Loading {
+    pub(super) loader: Loader,
+    pub(super) units: Vec<UnitState>,
+    /// Asked for and not arrived.
+    pub(super) outstanding: usize,
+    /// The view of the adaptation under way: the meta-nodes it asks for go to the loader with
+    /// the screen error of the node waiting for them ([`View::screen_error`]).
+    pub(super) view_now: View,
+    pub(super) refusals: Vec<(usize, String)>,
+    pub(super) bytes_read: u64,
+    pub(super) stream_bytes: u64,
+    /// The view of the last adaptation, if its last pass changed nothing but splits waited
+    /// for meta-nodes; the nodes those splits start from (and the list being made).
+    pub(super) waited_for: Option<View>,
+    pub(super) waiting_nodes: Vec<u32>,
+    pub(super) waited_now: Vec<u32>,
+}
+
+/// The result of a part's check: what is off, in one line.
+pub(super) type Checked = std::result::Result<(), String>;
+
+impl Nodes {
+    /// Every list one entry a node; a child's parent is the node it hangs from.
+    pub(super) fn check(&self) -> Checked {
+        let n = self.ids.len();
+        let lengths = [
+            self.parent.len(),
+            self.children.len(),
+            self.opens.len(),
+            self.spheres.len(),
+            self.deviations.len(),
+            self.cones.len(),
+            self.born.len(),
+            self.depends_on.len(),
+        ];
+        if lengths.iter().any(|&len| len != n) {
+            return Err(format!("node lists of lengths {lengths:?} for {n} nodes"));
+        }
+        for (v, children) in self.children.iter().enumerate() {
+            for &c in children.iter().filter(|&&c| c != NONE) {
+                if self.parent.get(c as usize) != Some(&(v as u32)) {
+                    return Err(format!("node {c} is a child of {v} but not its parent's"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Front {
+    /// A state a node of `n`; the active list, each active node's place in it and its bit agree.
+    pub(super) fn check(&self, n: usize) -> Checked {
+        if self.state.len() != n || self.active_slot.len() != n || self.split_dependants.len() != n
+        {
+            return Err(format!("front lists of other lengths than its {n} nodes"));
+        }
+        if self.active_bits.len() < n.div_ceil(64) {
+            return Err("the active bitmap is short".into());
+        }
+        for (slot, &v) in self.active.iter().enumerate() {
+            if self.active_slot.get(v as usize) != Some(&(slot as u32)) {
+                return Err(format!("active node {v} is not at its place {slot}"));
+            }
+        }
+        let listed = self.active_slot.iter().filter(|&&s| s != NONE).count();
+        let bits: u32 = self.active_bits.iter().map(|w| w.count_ones()).sum();
+        if listed != self.active.len() || bits as usize != self.active.len() {
+            return Err("the active list, places and bits disagree".into());
+        }
+        Ok(())
+    }
+}
+
+impl Faces {
+    /// A record a triangle in each list, and the count of those present.
+    pub(super) fn check(&self) -> Checked {
+        let t = self.leaf_corners.len();
+        if self.corners.len() != t || self.present.len() != t {
+            return Err("triangle lists of other lengths".into());
+        }
+        let present = self.present.iter().filter(|&&p| p).count();
+        if present != self.count {
+            return Err(format!(
+                "{present} triangles present, {} counted",
+                self.count
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl Guard {
+    /// The triangles listed as suspects are those marked, each once.
+    pub(super) fn check(&self) -> Checked {
+        let marked = self
+            .suspected
+            .iter()
+            .filter(|&&m| m != Suspicion::None)
+            .count();
+        if marked != self.suspects.len()
+            || self.suspects.iter().any(|&t| {
+                self.suspected
+                    .get(t as usize)
+                    .is_none_or(|&m| m == Suspicion::None)
+            })
+        {
+            return Err("the listed triangles and their marks disagree".into());
+        }
+        Ok(())
+    }
+}
