@@ -166,11 +166,7 @@ impl StreamInfo {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn golden(name: &str) -> Vec<u8> {
-        let path = format!("{}/tests/golden/{name}", env!("CARGO_MANIFEST_DIR"));
-        std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
-    }
+    use crate::codecs::golden;
 
     /// Every golden stream described: levels as `level_ends` says, units laid end to end up to
     /// the stream's last byte, what each codec reads of its header, and a prefix called

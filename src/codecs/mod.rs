@@ -443,6 +443,13 @@ pub fn level_ends(bytes: &[u8]) -> Result<Vec<u64>> {
     Ok(ends)
 }
 
+/// A golden stream of tests/golden/, for the crate's tests.
+#[cfg(test)]
+pub(crate) fn golden(name: &str) -> Vec<u8> {
+    let path = format!("{}/tests/golden/{name}", env!("CARGO_MANIFEST_DIR"));
+    std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
 /// Where to stop decoding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stop {

@@ -103,11 +103,7 @@ impl Progressive {
 mod tests {
     use super::*;
     use crate::codecs::decode;
-
-    fn golden(name: &str) -> Vec<u8> {
-        let path = format!("{}/tests/golden/{name}", env!("CARGO_MANIFEST_DIR"));
-        std::fs::read(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
-    }
+    use crate::codecs::golden;
 
     /// Every level handed over is the level `decode` makes of the same prefix, bit for bit,
     /// whatever the chunks; the last is the full mesh; incremental where the codec allows.
