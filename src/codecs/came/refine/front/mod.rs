@@ -207,7 +207,7 @@ pub struct Pick {
 }
 
 /// The front of a hierarchy and the triangles it holds, in parts that each keep their own
-/// lists ([`parts`]): the decoded tree's records, the front over them, the triangles it holds,
+/// lists (front/parts.rs): the decoded tree's records, the front over them, the triangles it holds,
 /// the orientation guard's lists, the scratch lists of passes and forced splits, and the
 /// meta-nodes' loading.
 pub struct ViewMesh {
