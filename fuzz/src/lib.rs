@@ -114,6 +114,7 @@ fn last_unit_alone<U: meshcodec::codecs::came::decoded::UnitDecoder>(
 /// next level gives; then stopped after a number of passes (EMC's partial levels) that the input's
 /// length picks; then through the PM iterator where the stream is PM's.
 pub fn decode_every_way(bytes: &[u8]) {
+    check_stream_info(bytes);
     let Ok(mut decoder) = codecs::open(bytes) else {
         return;
     };
@@ -144,6 +145,36 @@ pub fn decode_every_way(bytes: &[u8]) {
         walk_pm_iterator(bytes);
     }
     check_progressive(bytes);
+}
+
+/// What a stream says of itself ([`codecs::StreamInfo`], which `meshcodec info` and the Python
+/// and WebAssembly packages' `info` show, on any bytes a user hands them): made or refused,
+/// never a panic, and when made, true of the bytes: one end a level, each unit's range within
+/// the stream it declares and present exactly when the bytes hold it, truncated exactly when
+/// they end before the stream does.
+fn check_stream_info(bytes: &[u8]) {
+    let Ok(info) = codecs::StreamInfo::of(bytes) else {
+        return;
+    };
+    assert_eq!(info.levels, info.level_ends.len(), "one end a level");
+    assert_eq!(info.bytes, bytes.len() as u64);
+    assert_eq!(info.truncated, info.bytes < info.stream_bytes, "truncated");
+    let appearance_unit = info.appearance.iter().flat_map(|a| &a.unit);
+    for unit in info.units.iter().chain(appearance_unit) {
+        assert_eq!(
+            unit.first_byte + unit.bytes,
+            unit.end_byte,
+            "unit {}",
+            unit.unit
+        );
+        assert!(unit.first_byte >= info.payload_start && unit.end_byte <= info.stream_bytes);
+        assert_eq!(
+            unit.present,
+            unit.end_byte <= info.bytes,
+            "unit {}",
+            unit.unit
+        );
+    }
 }
 
 /// The stream fed to [`codecs::Progressive`] in a few chunks: every level handed over is the
