@@ -25,13 +25,6 @@ pub struct Descriptor {
     pub lossless: bool,
 }
 
-impl Descriptor {
-    /// Whether the codec has `capability`.
-    pub fn has(&self, capability: Capability) -> bool {
-        self.capabilities.contains(&capability)
-    }
-}
-
 /// `bits` per axis on a cubic grid: every codec's default shape.
 pub(crate) const fn cubic(bits: u8) -> EncodeOptions {
     EncodeOptions {

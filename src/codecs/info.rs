@@ -3,7 +3,7 @@
 //! package's `info` all render from its serde form, so each key means the same everywhere. What
 //! only a codec knows how to read of its header it says itself ([`Codec::facts`]).
 
-use super::{by_id, level_ends, Codec};
+use super::{by_id, level_ends_of, Codec};
 use crate::container::StreamReader;
 use crate::error::Result;
 use serde::Serialize;
@@ -33,7 +33,7 @@ pub struct StreamInfo {
     pub triangles: u64,
     /// Levels of the stream.
     pub levels: usize,
-    /// The bytes each level needs, from the stream's first ([`level_ends`]): the full level of a
+    /// The bytes each level needs, from the stream's first ([`level_ends`](super::level_ends)): the full level of a
     /// stream with an appearance unit ends with that unit.
     pub level_ends: Vec<u64>,
     /// Where the units start.
@@ -140,7 +140,7 @@ impl StreamInfo {
                 .appearance
                 .map(|entry| unit(index.len(), &entry, reader.appearance_unit().is_some())),
         });
-        let ends = level_ends(bytes)?;
+        let ends = level_ends_of(&reader)?;
         Ok(StreamInfo {
             codec: codec.name(),
             format_version: header.version(),
@@ -166,7 +166,7 @@ impl StreamInfo {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::codecs::golden;
+    use crate::codecs::{golden, level_ends};
 
     /// Every golden stream described: levels as `level_ends` says, units laid end to end up to
     /// the stream's last byte, what each codec reads of its header, and a prefix called

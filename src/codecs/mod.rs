@@ -354,7 +354,10 @@ pub fn encode_attributed_with(
             .stats
             .add_named(&format!("appearance_bits_{field}"), bits);
     }
-    let mut writer = crate::container::StreamWriter::reopen(&encoded.bytes, &encoded.levels)?;
+    let mut writer = crate::container::StreamWriter::reopen(
+        std::mem::take(&mut encoded.bytes),
+        &encoded.levels,
+    )?;
     writer.set_appearance(appearance::spec_of(appearance), unit);
     (encoded.bytes, encoded.levels) = writer.finish();
     Ok(encoded)
@@ -435,8 +438,12 @@ pub fn most_level_vertices(header: &Header) -> u64 {
 /// least its header and index ([`Error::Truncated`] when it does not yet). The full level of a
 /// stream with appearance ends with its appearance unit.
 pub fn level_ends(bytes: &[u8]) -> Result<Vec<u64>> {
-    let reader = StreamReader::open(bytes)?;
-    let mut ends = by_id(reader.header().codec_id)?.level_ends(&reader)?;
+    level_ends_of(&StreamReader::open(bytes)?)
+}
+
+/// [`level_ends`] of a stream already open.
+pub(crate) fn level_ends_of(reader: &StreamReader) -> Result<Vec<u64>> {
+    let mut ends = by_id(reader.header().codec_id)?.level_ends(reader)?;
     if let (Some(unit), Some(last)) = (reader.index().appearance, ends.last_mut()) {
         *last = reader.payload_start() as u64 + unit.end();
     }

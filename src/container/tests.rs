@@ -201,7 +201,7 @@ fn levels_read_from_an_input_stream_match() {
 #[test]
 fn a_reopened_stream_takes_the_appearance_unit_before_it_finishes() {
     let (bytes, records) = two_levels();
-    let mut writer = StreamWriter::reopen(&bytes, &records).unwrap();
+    let mut writer = StreamWriter::reopen(bytes, &records).unwrap();
     let spec = AppearanceSpec {
         colours: true,
         ..AppearanceSpec::default()
@@ -230,7 +230,7 @@ fn a_reopened_stream_takes_the_appearance_unit_before_it_finishes() {
             )
         );
     }
-    let refused = StreamWriter::reopen(&with, &levels).err().unwrap();
+    let refused = StreamWriter::reopen(with, &levels).err().unwrap();
     assert!(
         refused.to_string().contains("already carries appearance"),
         "{refused}"

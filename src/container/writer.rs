@@ -60,8 +60,8 @@ impl StreamWriter {
 
     /// A finished stream without appearance opened again, with the levels its encoder
     /// recorded: its header, units and levels, so that it can take an appearance unit.
-    pub fn reopen(bytes: &[u8], levels: &[LevelRecord]) -> Result<Self> {
-        let (header, index, start) = read_header_and_index(bytes)?;
+    pub fn reopen(mut bytes: Vec<u8>, levels: &[LevelRecord]) -> Result<Self> {
+        let (header, index, start) = read_header_and_index(&bytes)?;
         if header.appearance.is_some() || index.appearance.is_some() {
             return Err(Error::Unsupported(
                 "the stream already carries appearance".into(),
@@ -100,9 +100,10 @@ impl StreamWriter {
             marks.push(((level.end_byte - start) as u64, cost));
             before = *level;
         }
+        bytes.drain(..start);
         Ok(StreamWriter {
             header,
-            payload: bytes[start..].to_vec(),
+            payload: bytes,
             units: index.units.iter().map(|u| (u.length, u.parent)).collect(),
             marks,
             appearance: None,

@@ -570,13 +570,11 @@ const PM_DESCRIPTOR: Descriptor = Descriptor {
     lossless: true,
 };
 
-/// What `pm-reordered` is.
+/// What `pm-reordered` is: `pm` in another order.
 const PM_REORDERED_DESCRIPTOR: Descriptor = Descriptor {
     naming: names::PM_REORDERED,
     summary: "Hoppe's progressive meshes, vsplits reordered for small Δflclw, vad_s = 0 (Table 4)",
-    default_options: cubic(16),
-    capabilities: &[Capability::Attributes, Capability::AppearanceInLevels],
-    lossless: true,
+    ..PM_DESCRIPTOR
 };
 
 impl Codec for Pm {

@@ -160,13 +160,10 @@ impl Run<'_> {
         *lane!(self, depth, v) as usize
     }
 
-    /// Whether `v` is this run's to touch (see [`owns`]).
-    pub(super) fn owns(&self, v: usize) -> bool {
-        owns(self.slab, self.first_id, self.next_id, v)
-    }
-
     fn check(&self, v: usize) {
-        check(self.lanes, v, || self.owns(v));
+        check(self.lanes, v, || {
+            owns(self.slab, self.first_id, self.next_id, v)
+        });
     }
 
     /// Recomputes the cached centre of `v` from its cell.
