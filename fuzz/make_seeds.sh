@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Writes the seed corpus in fuzz/seeds/: small hand-shaped mesh files for each reader, then
-# streams of every codec made from them with the first six bytes (magic,
-# version, codec id) cut off, as the decode_* targets take them.
+# streams of every codec made from them with the first seven bytes (magic,
+# version, codec id, syntax) cut off, as the decode_* targets take them.
 # Run from the repository: bash fuzz/make_seeds.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -158,7 +158,7 @@ for codec in raw emc emc-paper pm pm-reordered came came-paper; do
   for mesh in $seeds/read_obj/torus.obj $seeds/read_off/colour.off $seeds/read_obj/bowtie-fin.obj $seeds/read_obj/torus-fin.obj; do
     name=$(basename "$mesh"); name=${name%.*}
     target/release/meshcodec encode --codec "$codec" --quant 10 --drop-attributes "$mesh" "$stream" >/dev/null 2>&1
-    tail -c +7 "$stream" > "$dir/$name.body"
+    tail -c +8 "$stream" > "$dir/$name.body"
   done
 done
 # emc streams with slabs, every pass of 4 visits or more sliced into 3 slabs (as `emc` writes
@@ -167,7 +167,7 @@ cargo build --release --example emc_slabs
 for mesh in $seeds/read_obj/torus.obj $seeds/read_obj/torus-fin.obj; do
   name=$(basename "$mesh"); name=${name%.*}
   target/release/examples/emc_slabs "$mesh" --write "$stream" 3 2
-  tail -c +7 "$stream" > "$seeds/decode_emc/$name-slabs.body"
+  tail -c +8 "$stream" > "$seeds/decode_emc/$name-slabs.body"
 done
 # Streams with appearance (every codec that carries it, on the seeds with uvs, normals,
 # materials or colours), with the magic and version cut off: decode_appearance's input.

@@ -1,25 +1,29 @@
 //! Golden streams and rate pins: an accidental change to the bytes a codec writes, or to how
 //! well it compresses, fails here.
 //!
-//! - `tests/golden/v<GEOMETRY_ONLY_VERSION>/<codec>-<mesh>.mc` is each codec's stream of a small shared
+//! - `tests/golden/v<FORMAT_VERSION>/<codec>-<mesh>.mc` is each codec's stream of a small shared
 //!   mesh at its default quantization, and `<mesh>-q<bits>.ply` the canonical mesh it decodes to.
 //!   The encoder must reproduce every stream byte for byte, and each stream must decode exactly
 //!   to that canonical mesh (docs/CONTRACT.md §3: same cells, same oriented faces).
 //! - `tests/golden/rates.txt` pins each codec's bits per vertex on three meshes; a codec that
 //!   codes any of them in more bits fails.
 //!
-//! - `tests/golden/v<APPEARANCE_UNIT_VERSION>/emc-spot-appearance.mc` is `emc`'s stream of spot.obj with
+//! - `tests/golden/v<FORMAT_VERSION>/emc-spot-appearance.mc` is `emc`'s stream of spot.obj with
 //!   its uvs (12-bit positions and uvs): the appearance unit's bytes are pinned too, and the
 //!   stream must decode to the canonical mesh with its appearance exactly.
 //!
-//! - `tests/golden/v<FORMAT_VERSION>/` pins `pm-reordered` with the appearance in its splits:
-//!   spot's uvs, vw-beetle's normals predicted from geometry, and spot's creased normals derived.
+//! - `tests/golden/v<FORMAT_VERSION>/pm-reordered-*` pin `pm-reordered` with the appearance in
+//!   its splits: spot's uvs, vw-beetle's normals predicted from geometry, and spot's creased
+//!   normals derived.
+//! - `*-before-*.mc` are streams of parameters today's encoders no longer choose (`emc` with its
+//!   face corrections after the last level, `came` without normal cones or deviations), kept
+//!   to show that those parameters still decode as they did.
 //!
-//! Both are regenerated on purpose with `UPDATE_GOLDEN=1 cargo test --release --test golden`,
+//! All are regenerated on purpose with `UPDATE_GOLDEN=1 cargo test --release --test golden`,
 //! which a change of syntax must come with (and a new format version: docs/FORMAT.md, History).
 
 use meshcodec::codecs::{self, Codec, Stop};
-use meshcodec::container::{APPEARANCE_UNIT_VERSION, FORMAT_VERSION, GEOMETRY_ONLY_VERSION};
+use meshcodec::container::FORMAT_VERSION;
 use meshcodec::mesh::io::{read_mesh, resolve, write_mesh};
 use meshcodec::mesh::{CanonicalMesh, TriMesh};
 use meshcodec::Error;
@@ -37,7 +41,7 @@ const RATE_MESHES: [&str; 3] = ["eight", "beethoven", "spot"];
 fn golden_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("tests/golden")
-        .join(format!("v{GEOMETRY_ONLY_VERSION}"))
+        .join(format!("v{FORMAT_VERSION}"))
 }
 
 fn rates_file() -> PathBuf {
@@ -138,10 +142,10 @@ fn encoders_reproduce_the_golden_streams_and_these_decode_exactly() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// `emc` streams written before the face corrections moved to the level that decodes the last
-/// vertex (4 bytes of parameters, corrections after the last level) still decode exactly, level
-/// by level as the new ones: `emc-eight-before-settled-faces.mc` is the golden stream of that
-/// build, kept.
+/// `emc` streams with the face corrections after the last level (the fourth parameter byte 0,
+/// as `emc` wrote before they moved to the level that decodes the last vertex) still decode
+/// exactly, level by level as the new ones: `emc-eight-before-settled-faces.mc` is the golden
+/// stream of that build, kept (its header in today's format).
 #[test]
 fn emc_streams_with_the_corrections_after_the_last_level_still_decode() {
     let old = std::fs::read(golden_dir().join("emc-eight-before-settled-faces.mc")).unwrap();
@@ -149,7 +153,18 @@ fn emc_streams_with_the_corrections_after_the_last_level_still_decode() {
     let [(_, eight)] = read_all(["eight"]);
     let canonical = canonical(codec, &eight);
     let new = codec.encode(&canonical).unwrap().bytes;
-    assert_eq!(old.len() + 1, new.len(), "one parameter byte more");
+    let params = |bytes: &[u8]| {
+        meshcodec::container::StreamReader::open(bytes)
+            .unwrap()
+            .header()
+            .params
+            .clone()
+    };
+    assert_eq!(
+        (params(&old)[3], params(&new)[3]),
+        (0, 1),
+        "where the corrections go"
+    );
     let (mut old_levels, mut new_levels) =
         (codecs::open(&old).unwrap(), codecs::open(&new).unwrap());
     let mut levels = 0;
@@ -184,9 +199,10 @@ fn kept_came_stream_and_todays(file: &str) -> (Vec<u8>, Vec<u8>) {
     (old, new)
 }
 
-/// `came` streams written before normal cones (4 bytes of parameters) still decode exactly, and
-/// refine view-dependently without culling: `came-eight-before-cones.mc` is the golden stream of
-/// that build, kept.
+/// `came` streams without normal cones (the fifth parameter byte 0, as `came` wrote before them)
+/// still decode exactly, and refine view-dependently without culling:
+/// `came-eight-before-cones.mc` is the golden stream of that build, kept (its header in today's
+/// format).
 #[test]
 fn came_streams_without_normal_cones_still_decode_and_refine() {
     use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
@@ -215,9 +231,10 @@ fn came_streams_without_normal_cones_still_decode_and_refine() {
     assert!(new_faces < two_sided, "{new_faces} of {two_sided}");
 }
 
-/// `came` streams written before deviations (5 bytes of parameters) still decode exactly, and
-/// refine by their spheres, the paper's test: `came-eight-before-deviations.mc` is the golden
-/// stream of that build, kept. The deviations leave a view's front coarser.
+/// `came` streams without deviations (the sixth parameter byte 0, as `came` wrote before them)
+/// still decode exactly, and refine by their spheres, the paper's test:
+/// `came-eight-before-deviations.mc` is the golden stream of that build, kept (its header in
+/// today's format). The deviations leave a view's front coarser.
 #[test]
 fn came_streams_without_deviations_still_decode_and_refine_by_their_spheres() {
     use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
@@ -226,10 +243,10 @@ fn came_streams_without_deviations_still_decode_and_refine_by_their_spheres() {
         meshcodec::container::StreamReader::open(bytes)
             .unwrap()
             .header()
-            .params
-            .len()
+            .params[5]
     };
-    assert_eq!((params(&old), params(&new)), (5, 6));
+    assert_eq!(params(&old), 0);
+    assert!(params(&new) > 0);
     let camera = Camera {
         eye: glam::DVec3::new(0.0, 0.0, 25.0),
         target: glam::DVec3::ZERO,
@@ -261,7 +278,7 @@ fn streams_of_another_format_version_are_refused_in_one_line() {
     let codec = codecs::by_name("raw").unwrap();
     let [(_, eight)] = read_all(["eight"]);
     let mut bytes = codec.encode(&canonical(codec, &eight)).unwrap().bytes;
-    for version in [0, GEOMETRY_ONLY_VERSION - 1, 3, FORMAT_VERSION + 1, 255] {
+    for version in [0, 1, 2, 3, 4, 5, FORMAT_VERSION + 1, 255] {
         bytes[4] = version;
         match codecs::decode(&bytes, Stop::All) {
             Err(e @ Error::Unsupported(_)) => {
@@ -275,18 +292,12 @@ fn streams_of_another_format_version_are_refused_in_one_line() {
 }
 
 /// Encodes `mesh` with its appearance by `codec` (inside the levels by `fit`, else in the
-/// appearance unit), checks the stream's version, compares it with the pinned stream `file` of
-/// that version and decodes the pinned stream losslessly, appearance included.
-fn appearance_golden(
-    codec: &str,
-    mesh: &str,
-    fit: Option<codecs::AttributeFit>,
-    version: u8,
-    file: &str,
-) {
+/// appearance unit), checks where the header says the appearance is, compares the stream with
+/// the pinned stream `file` and decodes the pinned stream losslessly, appearance included.
+fn appearance_golden(codec: &str, mesh: &str, fit: Option<codecs::AttributeFit>, file: &str) {
     let original = meshcodec::mesh::io::read_attributed(&resolve(mesh).unwrap()).unwrap();
     let bits = meshcodec::mesh::attribute_quantization::AttributeBits::default();
-    appearance_golden_of(codec, &original, bits, fit, version, file);
+    appearance_golden_of(codec, &original, bits, fit, file);
 }
 
 /// [`appearance_golden`] of a mesh in memory, its appearance quantized by `bits`.
@@ -295,7 +306,6 @@ fn appearance_golden_of(
     original: &meshcodec::mesh::attributes::AttributedMesh,
     bits: meshcodec::mesh::attribute_quantization::AttributeBits,
     fit: Option<codecs::AttributeFit>,
-    version: u8,
     file: &str,
 ) {
     let codec = codecs::by_name(codec).unwrap();
@@ -304,11 +314,17 @@ fn appearance_golden_of(
     let bytes = codecs::encode_attributed_with(codec, &canonical, Some(&appearance), fit)
         .unwrap()
         .bytes;
-    assert_eq!(bytes[4], version);
-    let golden = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/golden")
-        .join(format!("v{version}"))
-        .join(file);
+    assert_eq!(bytes[4], FORMAT_VERSION);
+    let header = meshcodec::container::StreamReader::open(&bytes)
+        .unwrap()
+        .header()
+        .clone();
+    assert_eq!(
+        header.appearance.map(|a| a.in_levels),
+        Some(fit.is_some()),
+        "where the appearance is"
+    );
+    let golden = golden_dir().join(file);
     if updating() {
         std::fs::create_dir_all(golden.parent().unwrap()).unwrap();
         std::fs::write(&golden, &bytes).unwrap();
@@ -337,13 +353,7 @@ fn appearance_golden_of(
 
 #[test]
 fn the_appearance_golden_stream_is_reproduced_and_decodes_exactly() {
-    appearance_golden(
-        "emc",
-        "spot",
-        None,
-        APPEARANCE_UNIT_VERSION,
-        "emc-spot-appearance.mc",
-    );
+    appearance_golden("emc", "spot", None, "emc-spot-appearance.mc");
 }
 
 #[test]
@@ -352,7 +362,6 @@ fn the_golden_stream_with_appearance_in_pm_splits_is_reproduced_and_decodes_exac
         "pm-reordered",
         "spot",
         Some(codecs::AttributeFit::Fit),
-        FORMAT_VERSION,
         "pm-reordered-spot-appearance-fit.mc",
     );
 }
@@ -369,7 +378,6 @@ fn the_golden_streams_with_normals_in_pm_splits_are_reproduced_and_decode_exactl
         &beetle,
         AttributeBits::default(),
         Some(codecs::AttributeFit::Keep),
-        FORMAT_VERSION,
         "pm-reordered-vw-beetle-normals-keep.mc",
     );
     let derived = AttributeBits {
@@ -381,7 +389,6 @@ fn the_golden_streams_with_normals_in_pm_splits_are_reproduced_and_decode_exactl
         &common::spot_with_creased_normals(),
         derived,
         Some(codecs::AttributeFit::Keep),
-        FORMAT_VERSION,
         "pm-reordered-spot-creased-derived-normals-keep.mc",
     );
 }
@@ -397,7 +404,7 @@ fn the_golden_streams_of_a_mesh_cut_to_a_manifold_are_reproduced_and_decode_exac
         let canonical = canonical(codec, &original);
         let bytes = codec.encode(&canonical).unwrap().bytes;
         assert!(
-            bytes.len() > 8 && bytes[6] > 1,
+            bytes.len() > 8 && bytes[7] > 1,
             "{name}: the stream says nothing of a cut"
         );
         let path = golden_dir().join(format!("{name}-{mesh}.mc"));

@@ -181,11 +181,11 @@ def test_random_bytes_fail_in_one_line(tmp_path):
     stream, mesh = tmp_path / "in.mc", tmp_path / "out.obj"
     decoded, slowest, largest = 0, 0.0, 0
     for case in range(CASES):
-        # Half of them start like a stream of format version 2 (docs/FORMAT.md §1), so that they
-        # reach the header's fields, the index and the levels.
+        # Half of them start like a stream of this format version, a codec and its syntax
+        # (docs/FORMAT.md §1), so that they reach the header's fields, the index and the levels.
         data = rng.randbytes(rng.randint(0, 4096))
         if case % 2:
-            data = b"MshC\x02" + bytes([case % 6]) + data
+            data = b"MshC\x06" + bytes([case % 7, 1]) + data
         stream.write_bytes(data)
         code, seconds, peak = check_outcome(
             f"random-case{case}", ["decode", stream, mesh], data, ".mc", tmp_path

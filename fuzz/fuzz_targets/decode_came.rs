@@ -1,3 +1,3 @@
-//! The `came` decoder on arbitrary bytes after a `came` stream's first six bytes.
+//! The `came` decoder on arbitrary bytes after a `came` stream's first seven bytes.
 #![no_main]
 libfuzzer_sys::fuzz_target!(|body: &[u8]| meshcodec_fuzz::decode_as("came", body));

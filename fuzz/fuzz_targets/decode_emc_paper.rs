@@ -1,3 +1,3 @@
-//! The `emc-paper` decoder on arbitrary bytes after a `emc-paper` stream's first six bytes.
+//! The `emc-paper` decoder on arbitrary bytes after a `emc-paper` stream's first seven bytes.
 #![no_main]
 libfuzzer_sys::fuzz_target!(|body: &[u8]| meshcodec_fuzz::decode_as("emc-paper", body));

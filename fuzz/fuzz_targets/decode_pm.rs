@@ -1,3 +1,3 @@
-//! The `pm` decoder on arbitrary bytes after a `pm` stream's first six bytes.
+//! The `pm` decoder on arbitrary bytes after a `pm` stream's first seven bytes.
 #![no_main]
 libfuzzer_sys::fuzz_target!(|body: &[u8]| meshcodec_fuzz::decode_as("pm", body));

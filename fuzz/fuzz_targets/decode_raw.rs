@@ -1,3 +1,3 @@
-//! The `raw` decoder on arbitrary bytes after a `raw` stream's first six bytes.
+//! The `raw` decoder on arbitrary bytes after a `raw` stream's first seven bytes.
 #![no_main]
 libfuzzer_sys::fuzz_target!(|body: &[u8]| meshcodec_fuzz::decode_as("raw", body));

@@ -8,9 +8,7 @@
 use arbitrary::{Arbitrary, Result as ArbitraryResult, Unstructured};
 use meshcodec::codecs::pm::iter::PMeshIter;
 use meshcodec::codecs::{self, EncodeOptions, LevelMesh, Stop};
-use meshcodec::container::{
-    Header, APPEARANCE_UNIT_VERSION, FORMAT_VERSION, GEOMETRY_ONLY_VERSION, MAGIC,
-};
+use meshcodec::container::{Header, FORMAT_VERSION, MAGIC};
 use meshcodec::limits;
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::{generate, io, TriMesh};
@@ -27,69 +25,72 @@ pub const CODECS: [&str; 7] = [
     "came-paper",
 ];
 
-/// Decodes `body` as everything after the first six bytes (magic, version, codec id) of a stream
-/// of codec `name`, so the fuzzer spends its effort on that codec's syntax.
+/// Decodes `body` as everything after the first seven bytes (magic, version, codec id, syntax)
+/// of a stream of codec `name`, so the fuzzer spends its effort on that codec's syntax.
 pub fn decode_as(name: &str, body: &[u8]) {
     decode_every_way(&stream_of(name, body));
 }
 
 /// Decodes `body` as everything after the first five bytes (magic, version) of a stream with
-/// appearance: its first byte picks the codec, then the header with its appearance block, the
-/// index with the appearance unit last, the levels and the unit.
+/// appearance: its first byte picks the codec, then its syntax, the header with its appearance
+/// block, the index with the appearance unit last, the levels and the unit. (Its seeds are
+/// streams with an appearance unit; [`decode_with_appearance_in_levels`]'s, streams whose
+/// levels carry the appearance.)
 pub fn decode_with_appearance(body: &[u8]) {
-    decode_in_version(APPEARANCE_UNIT_VERSION, body);
+    decode_in_this_version(body);
 }
 
 /// Decodes `body` as everything after the first five bytes of a stream whose levels carry the
-/// appearance (format version 5, `pm` and `pm-reordered`): the codec id, the header with its
-/// appearance block, the index, and levels whose vertex splits carry the corner values.
+/// appearance (appearance flag 16, `pm` and `pm-reordered`): the codec id, its syntax, the header
+/// with its appearance block, the index, and levels whose vertex splits carry the corner values.
 pub fn decode_with_appearance_in_levels(body: &[u8]) {
-    decode_in_version(FORMAT_VERSION, body);
+    decode_in_this_version(body);
 }
 
-fn decode_in_version(version: u8, body: &[u8]) {
+fn decode_in_this_version(body: &[u8]) {
     let mut bytes = Vec::with_capacity(body.len() + 5);
     bytes.extend_from_slice(&MAGIC);
-    bytes.push(version);
+    bytes.push(FORMAT_VERSION);
     bytes.extend_from_slice(body);
     decode_every_way(&bytes);
 }
 
-/// A geometry-only stream (format version 2) of codec `name` whose bytes after the first six
-/// (magic, version, codec id) are `body`.
+/// A stream of codec `name`, in the syntax this build writes, whose bytes after the first seven
+/// (magic, version, codec id, syntax) are `body`.
 fn stream_of(name: &str, body: &[u8]) -> Vec<u8> {
-    let id = codecs::by_name(name).expect("a registered codec").id();
-    let mut bytes = Vec::with_capacity(body.len() + 6);
+    let codec = codecs::by_name(name).expect("a registered codec");
+    let mut bytes = Vec::with_capacity(body.len() + 7);
     bytes.extend_from_slice(&MAGIC);
-    bytes.push(GEOMETRY_ONLY_VERSION);
-    bytes.push(id);
+    bytes.push(FORMAT_VERSION);
+    bytes.push(codec.id());
+    bytes.push(codec.syntax());
     bytes.extend_from_slice(body);
     bytes
 }
 
-/// Decodes `body` (after the first six bytes of a stream of CAME codec `name`) one meta-node
+/// Decodes `body` (after the first seven bytes of a stream of CAME codec `name`) one meta-node
 /// alone: the index's last unit after its ancestors only, as a view-dependent client fetches it.
 pub fn decode_unit_alone(name: &str, body: &[u8]) {
-    use meshcodec::codecs::came::{modelled::ModelledUnits, paper::PaperUnits};
+    use meshcodec::codecs::came::{modelled, paper};
     let bytes = stream_of(name, body);
     match name {
-        "came" => last_unit_alone(&bytes, 0..=0, ModelledUnits),
-        "came-paper" => last_unit_alone(&bytes, 1..=16, PaperUnits::default()),
+        "came" => last_unit_alone(&bytes, modelled::params, modelled::ModelledUnits),
+        "came-paper" => last_unit_alone(&bytes, paper::params, paper::PaperUnits::default()),
         _ => panic!("{name} has no meta-nodes"),
     }
 }
 
 fn last_unit_alone<U: meshcodec::codecs::came::decoded::UnitDecoder>(
     bytes: &[u8],
-    component_bits: std::ops::RangeInclusive<u8>,
+    params_of: fn(&Header) -> meshcodec::Result<meshcodec::codecs::came::Params>,
     units: U,
 ) {
-    use meshcodec::codecs::came::{decoded::CameDecoder, Params};
+    use meshcodec::codecs::came::decoded::CameDecoder;
     let Ok(reader) = meshcodec::container::StreamReader::open(bytes) else {
         return;
     };
     let index = reader.index().units.clone();
-    let Ok(params) = Params::from_bytes(&reader.header().params, component_bits) else {
+    let Ok(params) = params_of(reader.header()) else {
         return;
     };
     let Ok(mut decoder) = CameDecoder::new(reader, params, units) else {
@@ -579,7 +580,7 @@ pub fn round_trip(input: &GeneratedMesh) {
     }
 }
 
-/// Adapts the front of a `came` stream (the bytes after its first six, behind up to 16 bytes
+/// Adapts the front of a `came` stream (the bytes after its first seven, behind up to 16 bytes
 /// that pick four views) to those views, a face budget and the full mesh, its meta-nodes
 /// fetched on demand (inline), checking every invariant after each adaptation: a corrupt or cut
 /// meta-node is refused for its branch while the rest adapts.

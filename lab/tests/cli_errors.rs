@@ -683,7 +683,7 @@ fn render_draws_a_mesh_or_a_stream_and_refuses_bad_cameras() {
         d,
     );
     assert_clean_failure(&out, "--fov 0");
-    write(d, "junk.mc", b"MshC\x02\x04 not a stream");
+    write(d, "junk.mc", b"MshC\x06\x04\x01 not a stream");
     let out = run(
         MESHCODEC,
         &[&["render", "junk.mc", "x.png"][..], &camera].concat(),

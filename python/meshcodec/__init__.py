@@ -32,10 +32,9 @@ from typing import IO, Any, Dict, Iterator, List, Optional, Union
 import numpy as np
 
 from . import _core
-from ._core import APPEARANCE_UNIT_VERSION, FORMAT_VERSION, MeshcodecError, TruncatedStreamError
+from ._core import FORMAT_VERSION, MeshcodecError, TruncatedStreamError
 
 __all__ = [
-    "APPEARANCE_UNIT_VERSION",
     "FORMAT_VERSION",
     "Appearance",
     "Mesh",
@@ -249,8 +248,8 @@ def encode(
             ``attributes`` the stream codes no normal values at all.
         attributes: ``pm`` and ``pm-reordered`` only: "fit" or "keep" codes the appearance
             inside the vertex splits, so that every level carries it (a collapsed wedge takes
-            the values interpolated to where its vertex went, or the survivor's); the stream
-            is then format version :data:`FORMAT_VERSION`, else :data:`APPEARANCE_UNIT_VERSION`.
+            the values interpolated to where its vertex went, or the survivor's); ``info``
+            then says ``appearance["in_levels"]``.
 
     Raises:
         MeshcodecError: bad arrays, an unknown codec or option, or appearance the codec
@@ -433,7 +432,7 @@ def level_ends(stream: Bytes) -> List[int]:
 
 def info(stream: Bytes) -> Dict[str, Any]:
     """What a stream's header and index say, without decoding it, in the keys ``meshcodec info
-    --json`` prints: codec, format_version, bytes, stream_bytes, truncated, the quantization
+    --json`` prints: codec, format_version, syntax, bytes, stream_bytes, truncated, the quantization
     grid (quant_bits, origin, cell), vertices and triangles of the full mesh, levels and
     level_ends (the bytes each level needs), payload_start, layered, every unit (for CAME: every
     meta-node) with its parent and byte range, ``appearance``: None, or what the stream carries

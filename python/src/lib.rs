@@ -11,7 +11,7 @@
 use meshcodec::codecs::{
     self, Capability, Codec, EncodeOptions, EncodeRequest, LevelDecoder, LevelMesh, Stop,
 };
-use meshcodec::container::{APPEARANCE_UNIT_VERSION, FORMAT_VERSION};
+use meshcodec::container::FORMAT_VERSION;
 use meshcodec::mesh::attribute_quantization::AttributeBits;
 use meshcodec::mesh::attributes::{AttributedMesh, Attributes, Materials};
 use meshcodec::mesh::io;
@@ -763,7 +763,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.py().get_type::<TruncatedStreamError>(),
     )?;
     m.add("FORMAT_VERSION", FORMAT_VERSION)?;
-    m.add("APPEARANCE_UNIT_VERSION", APPEARANCE_UNIT_VERSION)?;
     m.add_class::<LevelIterator>()?;
     m.add_function(wrap_pyfunction!(encode, m)?)?;
     m.add_function(wrap_pyfunction!(decode, m)?)?;

@@ -170,7 +170,7 @@ def test_info_reads_the_header_and_index():
     stream = meshcodec.encode(mesh.vertices, mesh.faces, codec="came", quant_bits=14)
     about = meshcodec.info(stream)
     assert about["codec"] == "came" and about["quant_bits"] == 14
-    assert about["format_version"] == 2  # geometry alone; a stream with an appearance unit is APPEARANCE_UNIT_VERSION
+    assert about["format_version"] == meshcodec.FORMAT_VERSION and about["syntax"] == 1
     assert about["appearance"] is None
     assert about["bytes"] == about["stream_bytes"] == len(stream)
     assert not about["layered"] and not about["truncated"]
@@ -241,9 +241,10 @@ def test_appearance_is_loaded_coded_decoded_and_saved(tmp_path):
     assert a.corners.shape == (mesh.face_count, 3) and a.material_names == ["01_-_Default"]
     assert meshcodec.load(MESHES / "bunny-10k-textured.obj", drop_attributes=True).appearance is None
     stream = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc", appearance=a)
-    assert meshcodec.info(stream)["format_version"] == meshcodec.APPEARANCE_UNIT_VERSION
+    about = meshcodec.info(stream)
+    assert about["appearance"]["unit"] is not None and not about["appearance"]["in_levels"]
     plain = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc")
-    assert len(plain) < len(stream) and meshcodec.info(plain)["format_version"] == 2
+    assert len(plain) < len(stream) and meshcodec.info(plain)["appearance"] is None
     levels = list(meshcodec.levels(stream))
     assert all(l.appearance is None for l in levels[:-1])
     full = meshcodec.decode(stream)
@@ -262,7 +263,8 @@ def test_appearance_is_loaded_coded_decoded_and_saved(tmp_path):
     # pm can carry the appearance inside its splits: every level then has it.
     in_levels = meshcodec.encode(mesh.vertices, mesh.faces, codec="pm-reordered", appearance=a,
                                  attributes="keep")
-    assert meshcodec.info(in_levels)["format_version"] == meshcodec.FORMAT_VERSION
+    about = meshcodec.info(in_levels)
+    assert about["appearance"]["in_levels"] and about["appearance"]["unit"] is None
     pm_levels = list(meshcodec.levels(in_levels))
     assert len(pm_levels) > 1 and all(l.appearance is not None for l in pm_levels)
     assert pm_levels[-1].appearance.wedge_count == 6451

@@ -3,7 +3,7 @@
 //! package's `info` all render from its serde form, so each key means the same everywhere. What
 //! only a codec knows how to read of its header it says itself ([`Codec::facts`]).
 
-use super::{by_id, level_ends_of, Codec};
+use super::{for_header, level_ends_of, Codec};
 use crate::container::StreamReader;
 use crate::error::Result;
 use serde::Serialize;
@@ -15,6 +15,8 @@ pub struct StreamInfo {
     pub codec: &'static str,
     /// Its format version (docs/FORMAT.md §1).
     pub format_version: u8,
+    /// The codec's syntax it is written in (docs/FORMAT.md §1).
+    pub syntax: u8,
     /// Bytes given (a prefix, or the whole stream).
     pub bytes: u64,
     /// Bytes of the whole stream, as its index says.
@@ -109,7 +111,7 @@ impl StreamInfo {
     pub fn of(bytes: &[u8]) -> Result<StreamInfo> {
         let reader = StreamReader::open(bytes)?;
         let header = reader.header();
-        let codec: &dyn Codec = by_id(header.codec_id)?;
+        let codec: &dyn Codec = for_header(header)?;
         let index = reader.index();
         let start = reader.payload_start() as u64;
         let unit = |i: usize, entry: &crate::container::UnitEntry, present: bool| UnitInfo {
@@ -143,7 +145,8 @@ impl StreamInfo {
         let ends = level_ends_of(&reader)?;
         Ok(StreamInfo {
             codec: codec.name(),
-            format_version: header.version(),
+            format_version: crate::container::FORMAT_VERSION,
+            syntax: header.syntax,
             bytes: bytes.len() as u64,
             stream_bytes: start + index.payload_bytes,
             truncated: reader.truncated(),
@@ -174,15 +177,15 @@ mod tests {
     #[test]
     fn streams_describe_themselves() {
         for name in [
-            "v2/raw-eight.mc",
-            "v2/emc-beethoven.mc",
-            "v2/emc-paper-eight.mc",
-            "v2/pm-bunny-res4.mc",
-            "v2/pm-reordered-eight.mc",
-            "v2/came-eight.mc",
-            "v2/came-paper-eight.mc",
-            "v4/emc-spot-appearance.mc",
-            "v5/pm-reordered-spot-appearance-fit.mc",
+            "v6/raw-eight.mc",
+            "v6/emc-beethoven.mc",
+            "v6/emc-paper-eight.mc",
+            "v6/pm-bunny-res4.mc",
+            "v6/pm-reordered-eight.mc",
+            "v6/came-eight.mc",
+            "v6/came-paper-eight.mc",
+            "v6/emc-spot-appearance.mc",
+            "v6/pm-reordered-spot-appearance-fit.mc",
         ] {
             let bytes = golden(name);
             let info = StreamInfo::of(&bytes).unwrap();
@@ -221,7 +224,7 @@ mod tests {
     /// `info`; the WebAssembly package's in camelCase), flattened facts included.
     #[test]
     fn the_serde_form_has_the_documented_keys() {
-        let info = StreamInfo::of(&golden("v2/pm-bunny-res4.mc")).unwrap();
+        let info = StreamInfo::of(&golden("v6/pm-bunny-res4.mc")).unwrap();
         let value = serde_json::to_value(&info).unwrap();
         let keys: Vec<&str> = value
             .as_object()
@@ -232,6 +235,7 @@ mod tests {
         for key in [
             "codec",
             "format_version",
+            "syntax",
             "bytes",
             "stream_bytes",
             "truncated",

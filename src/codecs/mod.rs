@@ -133,6 +133,11 @@ pub trait Codec: Send + Sync {
     fn id(&self) -> u8 {
         self.descriptor().naming.id
     }
+
+    /// The syntax byte of the streams it writes, the only one it reads.
+    fn syntax(&self) -> u8 {
+        self.descriptor().naming.syntax
+    }
     /// One line on what the codec is.
     fn summary(&self) -> &'static str {
         self.descriptor().summary
@@ -291,6 +296,21 @@ pub fn by_id(id: u8) -> Result<&'static dyn Codec> {
         .ok_or_else(|| Error::malformed(0, 5, format!("unknown codec id {id}")))
 }
 
+/// The codec that reads a stream with `header`: the one its id names, if the header's syntax
+/// is the one that codec reads (docs/FORMAT.md §1).
+pub fn for_header(header: &Header) -> Result<&'static dyn Codec> {
+    let codec = by_id(header.codec_id)?;
+    if header.syntax != codec.syntax() {
+        return Err(Error::Unsupported(format!(
+            "{} stream of syntax {} (this build reads syntax {})",
+            codec.name(),
+            header.syntax,
+            codec.syntax()
+        )));
+    }
+    Ok(codec)
+}
+
 /// The canonical mesh that a codec encodes for `mesh` quantized by `options`.
 pub fn canonical_for(mesh: &TriMesh, options: &EncodeOptions) -> Result<CanonicalMesh> {
     let grid = Grid::fit(mesh, options.quant_bits, options.grid)?;
@@ -404,7 +424,7 @@ fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
     let unit = reader
         .appearance_unit()
         .map(|(bytes, number, start)| (bytes.to_vec(), number, start));
-    let codec = by_id(reader.header().codec_id)?;
+    let codec = for_header(reader.header())?;
     let in_levels = reader
         .header()
         .appearance
@@ -431,7 +451,7 @@ fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
 /// The most vertices any level of a stream with `header` may decode to
 /// ([`Codec::most_level_vertices`]; an unknown codec: the header's).
 pub fn most_level_vertices(header: &Header) -> u64 {
-    by_id(header.codec_id).map_or(header.vertices, |codec| codec.most_level_vertices(header))
+    for_header(header).map_or(header.vertices, |codec| codec.most_level_vertices(header))
 }
 
 /// The bytes each level of a stream needs ([`Codec::level_ends`]), from a prefix holding at
@@ -443,7 +463,7 @@ pub fn level_ends(bytes: &[u8]) -> Result<Vec<u64>> {
 
 /// [`level_ends`] of a stream already open.
 pub(crate) fn level_ends_of(reader: &StreamReader) -> Result<Vec<u64>> {
-    let mut ends = by_id(reader.header().codec_id)?.level_ends(reader)?;
+    let mut ends = for_header(reader.header())?.level_ends(reader)?;
     if let (Some(unit), Some(last)) = (reader.index().appearance, ends.last_mut()) {
         *last = reader.payload_start() as u64 + unit.end();
     }
@@ -491,7 +511,7 @@ pub(crate) fn on_pool<R: Send>(work: impl FnOnce() -> R + Send) -> R {
 /// [`decode`] with a decoder already opened (where the caller also wants its
 /// [`LevelDecoder::levels`] or header): decodes from where it stands up to `stop`.
 pub fn decode_with(decoder: &mut dyn LevelDecoder, stop: Stop) -> Result<(LevelMesh, usize)> {
-    let codec = by_id(decoder.header().codec_id)?;
+    let codec = for_header(decoder.header())?;
     let levels = decoder.levels();
     let per_level = decoder.pass_stops().map(|p| p.passes_per_level());
     // Whole levels to decode, then passes of the next one.

@@ -1,5 +1,5 @@
-//! The header (FORMAT.md §1): magic, version, codec, parameters, grid, counts, and the
-//! appearance block (§1.1) that says what the appearance unit carries.
+//! The header (FORMAT.md §1): magic, version, codec and its syntax, parameters, grid, counts,
+//! and the appearance block (§1.1) that says what appearance the stream carries and where.
 
 use super::*;
 use crate::coding::varint;
@@ -13,7 +13,9 @@ use crate::mesh::Grid;
 pub struct Header {
     /// Which codec wrote the units.
     pub codec_id: u8,
-    /// Codec-specific parameters.
+    /// Which of the codec's syntaxes the parameters and units are in (the codec checks it).
+    pub syntax: u8,
+    /// The syntax's parameters.
     pub params: Vec<u8>,
     /// The quantization grid of the full mesh.
     pub grid: Grid,
@@ -21,21 +23,9 @@ pub struct Header {
     pub vertices: u64,
     /// Triangles of the full mesh.
     pub triangles: u64,
-    /// What the appearance unit carries, when the stream has one (version 4).
+    /// What appearance the stream carries and where (an appearance unit, or the levels), when
+    /// it carries any.
     pub appearance: Option<AppearanceSpec>,
-}
-
-impl Header {
-    /// The format version this header is written in: [`FORMAT_VERSION`] with appearance in
-    /// the levels, [`APPEARANCE_UNIT_VERSION`] with an appearance unit,
-    /// [`GEOMETRY_ONLY_VERSION`] without.
-    pub fn version(&self) -> u8 {
-        match &self.appearance {
-            Some(a) if a.in_levels => FORMAT_VERSION,
-            Some(_) => APPEARANCE_UNIT_VERSION,
-            None => GEOMETRY_ONLY_VERSION,
-        }
-    }
 }
 
 /// What a stream's appearance unit carries and how it is quantized (docs/FORMAT.md §1.1).
@@ -225,8 +215,9 @@ impl Header {
     /// Appends the header's bytes to `out`.
     pub fn write(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(&MAGIC);
-        out.push(self.version());
+        out.push(FORMAT_VERSION);
         out.push(self.codec_id);
+        out.push(self.syntax);
         varint::put(out, self.params.len() as u64);
         out.extend_from_slice(&self.params);
         out.push(self.grid.bits);
@@ -235,8 +226,9 @@ impl Header {
         }
         varint::put(out, self.vertices);
         varint::put(out, self.triangles);
-        if let Some(appearance) = &self.appearance {
-            appearance.write(out);
+        match &self.appearance {
+            Some(appearance) => appearance.write(out),
+            None => out.push(0),
         }
     }
 
@@ -251,19 +243,19 @@ impl Header {
             return Err(bad(0, "not a meshcodec stream (bad magic)"));
         }
         let version = *bytes.get(4).ok_or_else(cut)?;
-        if ![
-            GEOMETRY_ONLY_VERSION,
-            APPEARANCE_UNIT_VERSION,
-            FORMAT_VERSION,
-        ]
-        .contains(&version)
-        {
+        if version != FORMAT_VERSION {
+            let earlier = if (2..FORMAT_VERSION).contains(&version) {
+                "; re-encode the mesh with this build"
+            } else {
+                ""
+            };
             return Err(Error::Unsupported(format!(
-                "stream format version {version} (this build reads versions {GEOMETRY_ONLY_VERSION}, {APPEARANCE_UNIT_VERSION} and {FORMAT_VERSION})"
+                "stream format version {version} (this build reads version {FORMAT_VERSION}{earlier})"
             )));
         }
         let codec_id = *bytes.get(5).ok_or_else(cut)?;
-        let mut pos = 6;
+        let syntax = *bytes.get(6).ok_or_else(cut)?;
+        let mut pos = 7;
         let param_len = read_count(bytes, &mut pos, "parameter bytes", limits::MAX_PARAM_BYTES)?;
         let params = bytes
             .get(pos..pos + param_len as usize)
@@ -306,23 +298,16 @@ impl Header {
                 &format!("header declares {vertices} vertices and {triangles} triangles"),
             ));
         }
-        let appearance = if version == GEOMETRY_ONLY_VERSION {
-            None
-        } else {
-            let at = pos;
-            let spec = AppearanceSpec::read(bytes, &mut pos)?;
-            // Each version says where the values are: 4 in a unit, 5 in the levels.
-            if spec.in_levels != (version == FORMAT_VERSION) {
-                return Err(Error::malformed(
-                    0,
-                    at,
-                    format!("version {version} streams do not carry appearance that way"),
-                ));
+        let appearance = match bytes.get(pos).ok_or_else(cut)? {
+            0 => {
+                pos += 1;
+                None
             }
-            Some(spec)
+            _ => Some(AppearanceSpec::read(bytes, &mut pos)?),
         };
         let header = Header {
             codec_id,
+            syntax,
             params,
             grid,
             vertices,

@@ -2,11 +2,11 @@
 //! units, then the units' payloads.
 //!
 //! ```text
-//! magic "MshC"  format version (u8)  codec id (u8)
-//! params: varint length + codec-specific bytes
+//! magic "MshC"  format version (u8)  codec id (u8)  codec syntax (u8)
+//! params: varint length + the syntax's bytes
 //! grid: bits (u8), origin 3 × f64 LE, cell 3 × f64 LE
 //! vertices (varint)  triangles (varint)                        -- of the full mesh
-//! version 4 only: appearance block (flags u8, then each attribute's quantization, names)
+//! appearance flags (u8; 0: none), then each attribute's quantization, names
 //! index: units N (varint), payload bytes P (varint),
 //!        N × { offset (varint), length (varint), parent (varint: 0 = none, k = unit i − k) }
 //! payload: P bytes, every byte in exactly one unit
@@ -24,18 +24,12 @@ use std::io::Read as _;
 
 /// First bytes of every stream.
 pub const MAGIC: [u8; 4] = *b"MshC";
-/// Version of the stream syntax: bumped on every change to the bytes any codec writes
-/// (docs/FORMAT.md, "History"). Versions 3 and 4 are version 2 with an appearance block after
-/// the header and an appearance unit after the last level (4 predicts uvs and colours better,
-/// so version 3's units no longer decode); version 5 is version 4 whose appearance block may
-/// say that the values are coded inside the levels (`pm`), with no appearance unit. Each
-/// stream is written in the oldest version that holds it — 2 without appearance, 4 with an
-/// appearance unit — and this build reads 2, 4 and 5.
-pub const FORMAT_VERSION: u8 = 5;
-/// The version of streams with an appearance unit.
-pub const APPEARANCE_UNIT_VERSION: u8 = 4;
-/// The version of streams without appearance, and the oldest this build reads.
-pub const GEOMETRY_ONLY_VERSION: u8 = 2;
+/// Version of the stream format: bumped on every change to the bytes any codec writes
+/// (docs/FORMAT.md, "History"). Every stream of this build is written in it, with or without
+/// appearance (the appearance flags say which), and it is the only version this build reads:
+/// version 6 names each codec's syntax in a byte of its own where earlier versions told
+/// syntaxes apart by the length of their parameters.
+pub const FORMAT_VERSION: u8 = 6;
 /// The fewest bytes an index entry takes (three one-byte varints).
 const MIN_ENTRY_BYTES: u64 = 3;
 

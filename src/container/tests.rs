@@ -11,6 +11,7 @@ use crate::mesh::Grid;
 fn header() -> Header {
     Header {
         codec_id: 7,
+        syntax: 1,
         params: vec![1, 2, 3],
         grid: Grid {
             origin: [0.5, -1.0, 2.0],
@@ -118,10 +119,29 @@ fn unknown_versions_are_refused() {
     bytes[4] = 1;
     let e = StreamReader::open(&bytes).unwrap_err();
     assert!(e.to_string().contains("format version 1"), "{e}");
-    // Version 3's appearance units are not version 4's.
-    bytes[4] = 3;
-    let e = StreamReader::open(&bytes).unwrap_err();
-    assert!(e.to_string().contains("format version 3"), "{e}");
+    // Earlier versions told codec syntaxes apart by their parameters' length: refused, with
+    // what to do.
+    for version in 2..FORMAT_VERSION {
+        bytes[4] = version;
+        let e = StreamReader::open(&bytes).unwrap_err().to_string();
+        assert!(
+            e.contains(&format!("format version {version}")) && e.contains("re-encode"),
+            "{e}"
+        );
+    }
+}
+
+/// Without appearance, the header ends in a zero flags byte; with it, the flags open the
+/// appearance block; a header cut before that byte is truncated.
+#[test]
+fn the_appearance_flags_close_the_header() {
+    let mut bytes = Vec::new();
+    header().write(&mut bytes);
+    assert_eq!(bytes.last(), Some(&0));
+    assert_eq!(Header::read(&bytes).unwrap(), (header(), bytes.len()));
+    let cut = Header::read(&bytes[..bytes.len() - 1]).unwrap_err();
+    assert!(matches!(cut, Error::Truncated(_)), "{cut}");
+    assert_eq!(bytes[6], 1, "the syntax byte follows the codec id");
 }
 
 #[test]

@@ -134,10 +134,10 @@ pub fn level_ends(bytes: &[u8]) -> Result<Vec<f64>, JsError> {
 }
 
 /// What a stream's header and index say, without decoding it: the library's `StreamInfo`
-/// (`codec`, `formatVersion`, `bytes`, `streamBytes`, `truncated`, `quantBits`, `origin`, `cell`,
-/// `vertices`, `triangles`, `levels`, `levelEnds`, `payloadStart`, `layered`, `units` with each
-/// one's byte range, `appearance` or null, `vertexCopies`, `normalCones`): the keys of
-/// `meshcodec info --json` and of the Python package's `info`, in camelCase.
+/// (`codec`, `formatVersion`, `syntax`, `bytes`, `streamBytes`, `truncated`, `quantBits`,
+/// `origin`, `cell`, `vertices`, `triangles`, `levels`, `levelEnds`, `payloadStart`, `layered`,
+/// `units` with each one's byte range, `appearance` or null, `vertexCopies`, `normalCones`): the
+/// keys of `meshcodec info --json` and of the Python package's `info`, in camelCase.
 #[wasm_bindgen]
 pub fn info(bytes: &[u8]) -> Result<JsValue, JsError> {
     let info = codecs::StreamInfo::of(bytes).map_err(to_js)?;

@@ -17,17 +17,18 @@ await init({ module_or_path: readFileSync(join(root, "web/pkg/meshcodec_bg.wasm"
 
 const MAGIC = [0x4d, 0x73, 0x68, 0x43]; // "MshC"
 // What comes before a target's input (fuzz/src/lib.rs): magic, format version, and for the
-// geometry-only targets the codec id.
+// per-codec targets the codec id and its syntax.
+const VERSION = 6;
 const PREFIX = {
-  decode_raw: [...MAGIC, 2, 0],
-  decode_emc_paper: [...MAGIC, 2, 1],
-  decode_pm: [...MAGIC, 2, 2],
-  decode_pm_reordered: [...MAGIC, 2, 3],
-  decode_emc: [...MAGIC, 2, 4],
-  decode_came_paper: [...MAGIC, 2, 5],
-  decode_came: [...MAGIC, 2, 6],
-  decode_appearance: [...MAGIC, 4],
-  decode_pm_wedges: [...MAGIC, 5],
+  decode_raw: [...MAGIC, VERSION, 0, 1],
+  decode_emc_paper: [...MAGIC, VERSION, 1, 1],
+  decode_pm: [...MAGIC, VERSION, 2, 1],
+  decode_pm_reordered: [...MAGIC, VERSION, 3, 1],
+  decode_emc: [...MAGIC, VERSION, 4, 1],
+  decode_came_paper: [...MAGIC, VERSION, 5, 1],
+  decode_came: [...MAGIC, VERSION, 6, 1],
+  decode_appearance: [...MAGIC, VERSION],
+  decode_pm_wedges: [...MAGIC, VERSION],
 };
 
 function inputs(folder) {

@@ -94,7 +94,7 @@ pub fn decode_tree(bytes: &[u8]) -> Result<(Header, decoded::DecodedTree)> {
 /// The codec of the stream of `header`, for view-dependent refinement: an error for a codec
 /// whose streams hold no vertex hierarchy.
 pub fn refining_codec(header: &Header) -> Result<&'static dyn selective::SelectiveRefinement> {
-    let codec = crate::codecs::by_id(header.codec_id)?;
+    let codec = crate::codecs::for_header(header)?;
     codec.selective_refinement().ok_or_else(|| {
         Error::Unsupported(format!(
             "{} streams hold no vertex hierarchy; view-dependent refinement needs a codec with selective refinement (came, came-paper)",
@@ -125,36 +125,37 @@ pub struct Params {
 }
 
 impl Params {
-    /// The header bytes: four, a fifth with the cones' bits when there are cones or
-    /// deviations, and a sixth with the deviations' bits when there are deviations.
-    pub fn to_bytes(self) -> Vec<u8> {
+    /// The header bytes: levels per meta-node, depth, bits per component, bits per radius
+    /// ratio; and, with `per_node_bounds` (`came`), the bits of the cones' axes and of the
+    /// deviations (0: the stream codes none).
+    pub fn to_bytes(self, per_node_bounds: bool) -> Vec<u8> {
         let mut bytes = vec![
             self.meta_levels,
             self.depth,
             self.component_bits,
             self.radius_bits,
         ];
-        if self.cone_bits > 0 || self.deviation_bits > 0 {
-            bytes.push(self.cone_bits);
-        }
-        if self.deviation_bits > 0 {
-            bytes.push(self.deviation_bits);
+        if per_node_bounds {
+            bytes.extend([self.cone_bits, self.deviation_bits]);
         }
         bytes
     }
 
-    /// Parameters from header bytes; `components`: the range bits per component may take.
-    pub fn from_bytes(bytes: &[u8], components: std::ops::RangeInclusive<u8>) -> Result<Params> {
+    /// Parameters from header bytes ([`Self::to_bytes`]); `components`: the range bits per
+    /// component may take.
+    pub fn from_bytes(
+        bytes: &[u8],
+        components: std::ops::RangeInclusive<u8>,
+        per_node_bounds: bool,
+    ) -> Result<Params> {
         let bad = |what: &str| Error::malformed(0, 0, format!("CAME parameters: {what}"));
-        let (cone_bits, deviation_bits) = match bytes.len() {
-            4 => (0, 0),
-            5 if bytes[4] > 0 => (bytes[4], 0),
-            6 if bytes[5] > 0 => (bytes[4], bytes[5]),
-            _ => {
-                return Err(bad(
-                    "4 bytes, 5 with normal cones or 6 with deviations expected",
-                ))
-            }
+        let expected = if per_node_bounds { 6 } else { 4 };
+        if bytes.len() != expected {
+            return Err(bad(&format!("{expected} bytes expected")));
+        }
+        let (cone_bits, deviation_bits) = match bytes {
+            [_, _, _, _, cones, deviations] => (*cones, *deviations),
+            _ => (0, 0),
         };
         let [meta_levels, depth, component_bits, radius_bits] =
             [bytes[0], bytes[1], bytes[2], bytes[3]];
@@ -278,8 +279,10 @@ pub type CodedUnit = (
 /// leaves, and the bits of components and radius ratios (the header's parameters).
 #[derive(Clone, Copy, Debug)]
 pub struct Layout {
-    /// Codec id.
-    pub id: u8,
+    /// The codec's id and syntax.
+    pub naming: crate::codecs::names::Naming,
+    /// Whether the syntax's parameters give the bits of cones and deviations (`came`).
+    pub per_node_bounds: bool,
     /// Meta-nodes near the leaves.
     pub tails: partition::Tails,
     /// Bits per PCA component (0: none).
@@ -327,7 +330,7 @@ pub fn encode_stream(
             (bytes, cost)
         })
         .collect();
-    let (bytes, levels) = write_stream(&header(layout.id, mesh, params), &tree, &part, units);
+    let (bytes, levels) = write_stream(&header(layout, mesh, params), &tree, &part, units);
     let mut stats = Stats::default();
     hierarchy_stats(&tree, &part, seconds, &fields, &mut stats);
     Ok(crate::codecs::Encoded {
@@ -343,10 +346,11 @@ pub fn cut_at(at: usize) -> Error {
 }
 
 /// The stream's header for `mesh` and `params`.
-fn header(id: u8, mesh: &CanonicalMesh, params: Params) -> Header {
+fn header(layout: Layout, mesh: &CanonicalMesh, params: Params) -> Header {
     Header {
-        codec_id: id,
-        params: params.to_bytes(),
+        codec_id: layout.naming.id,
+        syntax: layout.naming.syntax,
+        params: params.to_bytes(layout.per_node_bounds),
         grid: mesh.grid,
         vertices: mesh.vertex_count() as u64,
         triangles: mesh.face_count() as u64,

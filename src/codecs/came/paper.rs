@@ -194,7 +194,8 @@ impl Codec for CamePaper {
             ));
         }
         let layout = Layout {
-            id: self.id(),
+            naming: self.descriptor().naming,
+            per_node_bounds: false,
             tails: Tails::Split,
             component_bits: self.component_bits,
             radius_bits: RADIUS_BITS,
@@ -253,7 +254,7 @@ impl Codec for CamePaper {
 
 /// A `came-paper` stream's parameters, checked.
 pub fn params(header: &Header) -> Result<Params> {
-    let params = Params::from_bytes(&header.params, 1..=16)?;
+    let params = Params::from_bytes(&header.params, 1..=16, false)?;
     if params.cone_bits != 0 || params.deviation_bits != 0 {
         return Err(Error::malformed(
             0,

@@ -43,13 +43,14 @@ pub mod modelled;
 pub mod paper;
 pub mod state;
 
+use crate::codecs::names::Naming;
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::octree::{axes_by_extent, StepOrder};
 use crate::mesh::CanonicalMesh;
 
-/// Parameters stored in the header: the syntax (which coder), the axis order and, for `emc`,
-/// where the face corrections are coded.
+/// Parameters stored in the header: the axis order and, for `emc`, where the face corrections
+/// are coded and how passes are sliced (docs/FORMAT.md §5, §7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EmcParams {
     /// Levels and axis order.
@@ -57,13 +58,12 @@ pub struct EmcParams {
     /// The face corrections follow the first level after which every vertex is decoded (the
     /// edge graph is final from then on), so that the levels after it show the mesh's own
     /// faces; else they follow the last level, as the paper codes them. `emc` writes the
-    /// former (a fifth parameter byte, 1); `emc-paper`, and `emc` streams written before it,
-    /// the latter (four bytes).
+    /// former (its fourth parameter byte, 1); `emc-paper` always codes the latter.
     pub faces_when_settled: bool,
     /// Slabs of a sliced pass (docs/FORMAT.md §7): a pass that visits at least
     /// 2^`sliced_visits_log2` vertices codes each slab's interior in a stream of its own, so
-    /// that the slabs decode at once. 1 (no sixth and seventh parameter bytes): no pass is
-    /// sliced. `emc` slices meshes of [`SLICED_VERTICES`] vertices or more into [`SLABS`].
+    /// that the slabs decode at once. 1: no pass is sliced (and no sixth parameter byte).
+    /// `emc` slices meshes of [`SLICED_VERTICES`] vertices or more into [`SLABS`].
     pub slabs: u8,
     /// See [`Self::slabs`].
     pub sliced_visits_log2: u8,
@@ -85,17 +85,13 @@ pub const SLICED_VERTICES: usize = 1 << 16;
 /// Most slabs a stream may have.
 const MAX_SLABS: u8 = 64;
 
-/// The fifth parameter byte of an `emc` stream whose face corrections follow the level that
-/// decodes the last vertex.
-const FACES_WHEN_SETTLED: u8 = 1;
-
-/// Which of the two syntaxes a stream uses (first parameter byte).
+/// Which of the two coders a stream uses (its codec: `emc-paper` or `emc`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Syntax {
     /// The paper's fixed codes (`emc-paper`).
-    Paper = 0,
+    Paper,
     /// Context-modelled arithmetic coding (`emc`).
-    Modelled = 1,
+    Modelled,
 }
 
 impl EmcParams {
@@ -117,18 +113,19 @@ impl EmcParams {
         }
     }
 
-    /// The header that a stream of `mesh` in `syntax` starts with.
-    pub fn header(&self, syntax: Syntax, codec_id: u8, mesh: &CanonicalMesh) -> Header {
-        let [a, b, c] = self.order.axes;
-        let mut params = vec![syntax as u8, a, b, c];
-        if self.faces_when_settled {
-            params.push(FACES_WHEN_SETTLED);
+    /// The header that a stream of `mesh` in `syntax` by the codec `naming` starts with: the
+    /// axes, and for `emc` the corrections' place and the slabs.
+    pub fn header(&self, syntax: Syntax, naming: Naming, mesh: &CanonicalMesh) -> Header {
+        let mut params = self.order.axes.to_vec();
+        if syntax == Syntax::Modelled {
+            params.extend([u8::from(self.faces_when_settled), self.slabs]);
             if self.slabs > 1 {
-                params.extend([self.slabs, self.sliced_visits_log2]);
+                params.push(self.sliced_visits_log2);
             }
         }
         Header {
-            codec_id,
+            codec_id: naming.id,
+            syntax: naming.syntax,
             params,
             grid: mesh.grid,
             vertices: mesh.vertex_count() as u64,
@@ -148,26 +145,33 @@ impl EmcParams {
     pub fn from_stream(stream: &StreamReader, syntax: Syntax) -> Result<EmcParams> {
         stream.require_layered()?;
         let header = stream.header();
-        let bad = |what: &str| Error::malformed(0, 6, what);
+        let bad = |what: &str| Error::malformed(0, 7, what);
         let p = &header.params;
-        let faces_when_settled = match p.get(4) {
-            None => false,
-            Some(&FACES_WHEN_SETTLED) if syntax == Syntax::Modelled => true,
-            Some(_) => return Err(bad("emc parameters of unknown syntax")),
-        };
-        if ![4, 5, 7].contains(&p.len()) || p[0] != syntax as u8 {
-            return Err(bad("emc parameters of unknown syntax"));
-        }
-        let (slabs, sliced_visits_log2) = match p.get(5..7) {
-            None => (1, SLICED_VISITS_LOG2),
-            Some(&[slabs, log2]) if (2..=MAX_SLABS).contains(&slabs) && log2 < 32 => (slabs, log2),
-            Some(_) => {
+        let (axes, faces_when_settled, slabs, sliced_visits_log2) = match (syntax, &p[..]) {
+            (Syntax::Paper, &[a, b, c]) => ([a, b, c], 0, 1, SLICED_VISITS_LOG2),
+            (Syntax::Modelled, &[a, b, c, settled, 1]) => {
+                ([a, b, c], settled, 1, SLICED_VISITS_LOG2)
+            }
+            (Syntax::Modelled, &[a, b, c, settled, slabs, log2]) => {
+                if !(2..=MAX_SLABS).contains(&slabs) || log2 >= 32 {
+                    return Err(bad(
+                        "emc slabs out of range (2 to 64 slabs, passes of under 2^32 visits)",
+                    ));
+                }
+                ([a, b, c], settled, slabs, log2)
+            }
+            (Syntax::Paper, _) => return Err(bad("emc-paper parameters: 3 bytes expected")),
+            (Syntax::Modelled, _) => {
                 return Err(bad(
-                    "emc slabs out of range (2 to 64 slabs, passes of under 2^32 visits)",
+                    "emc parameters: 5 bytes expected, 6 with slabs (2 to 64)",
                 ))
             }
         };
-        let axes = [p[1], p[2], p[3]];
+        let faces_when_settled = match faces_when_settled {
+            0 => false,
+            1 => true,
+            _ => return Err(bad("emc face corrections byte other than 0 or 1")),
+        };
         let mut sorted = axes;
         sorted.sort_unstable();
         if sorted != [0, 1, 2] {

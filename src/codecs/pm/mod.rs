@@ -92,33 +92,43 @@ pub struct PmParams {
     pub copies: Option<u64>,
 }
 
-/// The flag byte of a stream whose mesh was cut to a manifold.
+/// The first parameter byte of a stream whose mesh was cut to a manifold (docs/FORMAT.md §6).
 const REPAIRED: u8 = 1;
 
 impl PmParams {
+    /// The parameters' bytes: 0, or [`REPAIRED`] and the copies as a varint (the ordering is
+    /// the codec's).
     fn to_bytes(self) -> Vec<u8> {
-        let mut out = vec![match self.ordering {
-            Ordering::Natural => 0,
-            Ordering::Reordered => 1,
-        }];
-        if let Some(copies) = self.copies {
-            out.push(REPAIRED);
-            crate::coding::varint::put(&mut out, copies);
+        let mut out = Vec::new();
+        match self.copies {
+            None => out.push(0),
+            Some(copies) => {
+                out.push(REPAIRED);
+                crate::coding::varint::put(&mut out, copies);
+            }
         }
         out
     }
 
+    /// The parameters of a `pm` or `pm-reordered` stream, checked with its codec and syntax.
     fn from_header(header: &Header) -> Result<PmParams> {
-        let unknown = || Error::malformed(0, 6, "pm parameters of unknown syntax");
-        let ordering = match header.params.first() {
-            Some(0) => Ordering::Natural,
-            Some(1) => Ordering::Reordered,
-            _ => return Err(unknown()),
+        let unknown = || Error::malformed(0, 7, "pm parameters of unknown syntax");
+        let codec = crate::codecs::for_header(header)?;
+        let ordering = if codec.id() == names::PM.id {
+            Ordering::Natural
+        } else if codec.id() == names::PM_REORDERED.id {
+            Ordering::Reordered
+        } else {
+            return Err(Error::malformed(
+                0,
+                5,
+                format!("{} stream read as a pm stream", codec.name()),
+            ));
         };
-        let copies = match header.params.get(1) {
-            None if header.params.len() == 1 => None,
+        let copies = match header.params.first() {
+            Some(0) if header.params.len() == 1 => None,
             Some(&REPAIRED) => {
-                let mut pos = 2;
+                let mut pos = 1;
                 let copies =
                     crate::coding::varint::get(&header.params, &mut pos).map_err(|_| unknown())?;
                 if pos != header.params.len() {
@@ -130,7 +140,7 @@ impl PmParams {
                 {
                     return Err(Error::malformed(
                         0,
-                        6,
+                        7,
                         "pm parameters declare more vertex copies than the mesh has corners",
                     ));
                 }
@@ -260,7 +270,14 @@ impl Pm {
             cells: input.cells.iter().map(|c| c.map(|x| x as u32)).collect(),
             faces: input.faces.clone(),
         };
-        let manifold_stream = encode_pm(self.id(), self.params(), &manifold, &plain, None, None);
+        let manifold_stream = encode_pm(
+            self.descriptor().naming,
+            self.params(),
+            &manifold,
+            &plain,
+            None,
+            None,
+        );
         let stat = |s: &Stats, name: &str| s.get_named(name).unwrap_or(0.0);
         Ok(Some(RepairCost {
             repaired_bytes: repaired.bytes.len(),
@@ -469,7 +486,14 @@ impl Pm {
         let pm = self.progressive_mesh(&input.cells, &input.faces, Some(input.constraints()));
         let plan = RepairPlan::of(cut, &pm);
         let params = self.params_with(Some(&plan));
-        Ok(encode_pm(self.id(), params, mesh, &pm, None, Some(&plan)))
+        Ok(encode_pm(
+            self.descriptor().naming,
+            params,
+            mesh,
+            &pm,
+            None,
+            Some(&plan),
+        ))
     }
 
     /// Encodes with the appearance inside the vertex splits ([`wedges`]).
@@ -551,7 +575,7 @@ impl Pm {
         let plan = input.cut.as_ref().map(|cut| RepairPlan::of(cut, &pm));
         let params = self.params_with(plan.as_ref());
         Ok(encode_pm(
-            self.id(),
+            self.descriptor().naming,
             params,
             mesh,
             &pm,
@@ -604,7 +628,14 @@ impl Codec for Pm {
             return self.encode_cut(mesh, &input, cut);
         }
         let pm = self.progressive_mesh(&input.cells, &input.faces, None);
-        Ok(encode_pm(self.id(), self.params(), mesh, &pm, None, None))
+        Ok(encode_pm(
+            self.descriptor().naming,
+            self.params(),
+            mesh,
+            &pm,
+            None,
+            None,
+        ))
     }
 
     fn encode_with_appearance(
@@ -659,7 +690,7 @@ impl Codec for Pm {
 
 /// Writes the stream of a progressive mesh.
 fn encode_pm(
-    id: u8,
+    naming: names::Naming,
     params: PmParams,
     mesh: &CanonicalMesh,
     pm: &simplify::ProgressiveMesh,
@@ -677,7 +708,8 @@ fn encode_pm(
         vertices += n;
     }
     let header = Header {
-        codec_id: id,
+        codec_id: naming.id,
+        syntax: naming.syntax,
         params: params.to_bytes(),
         grid: mesh.grid,
         vertices: mesh.vertex_count() as u64,

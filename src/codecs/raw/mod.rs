@@ -38,6 +38,7 @@ impl Codec for Raw {
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         let header = Header {
             codec_id: self.id(),
+            syntax: self.syntax(),
             params: Vec::new(),
             grid: mesh.grid,
             vertices: mesh.vertex_count() as u64,

@@ -64,7 +64,8 @@ impl Codec for Came {
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         let layout = Layout {
-            id: self.id(),
+            naming: self.descriptor().naming,
+            per_node_bounds: true,
             tails: Tails::Whole,
             component_bits: 0,
             radius_bits: RADIUS_BITS,
@@ -89,7 +90,7 @@ impl Codec for Came {
 
 /// A `came` stream's parameters, checked.
 pub fn params(header: &Header) -> Result<Params> {
-    let params = Params::from_bytes(&header.params, 0..=0)?;
+    let params = Params::from_bytes(&header.params, 0..=0, true)?;
     if params.radius_bits != RADIUS_BITS {
         return Err(Error::malformed(
             0,

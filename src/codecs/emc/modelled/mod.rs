@@ -155,7 +155,7 @@ impl Codec for Emc {
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         let params = EmcParams::for_mesh(mesh, Syntax::Modelled);
-        let header = params.header(Syntax::Modelled, self.id(), mesh);
+        let header = params.header(Syntax::Modelled, self.descriptor().naming, mesh);
         encoder::encode(mesh, &params, header)
     }
 
@@ -179,6 +179,6 @@ pub fn encode_sliced(mesh: &CanonicalMesh, slabs: u8, sliced_visits_log2: u8) ->
         sliced_visits_log2,
         ..EmcParams::for_mesh(mesh, Syntax::Modelled)
     };
-    let header = params.header(Syntax::Modelled, names::EMC.id, mesh);
+    let header = params.header(Syntax::Modelled, names::EMC, mesh);
     encoder::encode(mesh, &params, header)
 }

@@ -85,7 +85,7 @@ impl Codec for EmcPaper {
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
         let params = EmcParams::for_mesh(mesh, Syntax::Paper);
-        let header = params.header(Syntax::Paper, self.id(), mesh);
+        let header = params.header(Syntax::Paper, self.descriptor().naming, mesh);
         encoder::encode(mesh, &params, header)
     }
 
