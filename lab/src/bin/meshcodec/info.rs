@@ -64,11 +64,12 @@ pub fn info(input: &Path, json: bool) -> Result<()> {
     let mut text = String::new();
     let _ = writeln!(
         text,
-        "{}: {} bytes, format version {}, codec {}",
+        "{}: {} bytes, format version {}, codec {} (syntax {})",
         input.display(),
         info.bytes,
         info.format_version,
-        info.codec
+        info.codec,
+        info.syntax
     );
     let _ = writeln!(
         text,
