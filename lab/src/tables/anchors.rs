@@ -30,9 +30,12 @@ pub(crate) fn optional(x: Option<f64>, digits: usize) -> String {
     x.map_or("—".into(), |x| format!("{x:.digits$}"))
 }
 
+/// The meshes of emc-vs-anchors.md (experiments/anchors.toml): bunny.ply, which the published
+/// coders report, and two larger scans.
+const MESHES: [&str; 3] = ["bunny", "armadillo-43k", "dragon-50k"];
+
 /// Writes paper-tables/emc-vs-anchors.md: connectivity, geometry and total bits per vertex at 12
-/// bits on bunny.ply and armadillo-43k.obj, ours and Draco measured here, and published
-/// progressive coders.
+/// bits on [`MESHES`], ours and Draco measured here, and published progressive coders.
 pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
     let mut md = String::new();
     let _ = writeln!(
@@ -41,7 +44,7 @@ pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
     );
     let _ = writeln!(md, "Regenerate: `{ANCHORS_COMMAND}` (our codecs, then Draco through DracoPy in the same run, then this table).\n");
     let _ = writeln!(md, "Every row of ours is the full decode of the stream on the 12-bit cubic grid of docs/CONTRACT.md §1 (bits over the canonical mesh's vertex count; bunny.ply has 34,834 referenced vertices). Draco (DracoPy, compression_level 10, quantization_bits 12) is single-rate, quantizes on its own grid and is not checked for losslessness; its split between connectivity and geometry is not reported by DracoPy. Decode rates are one thread on this machine (Draco's from Python, best of five).\n");
-    for mesh in ["bunny", "armadillo-43k"] {
+    for mesh in MESHES {
         let _ = writeln!(md, "## {mesh}\n");
         let _ = writeln!(
             md,
@@ -129,7 +132,7 @@ pub(crate) fn intermediate_levels(results: &Path, md: &mut String) -> Result<()>
             .filter(|&(_, rms)| rms > 0.0)
             .collect()
     };
-    for mesh in ["bunny", "armadillo-43k"] {
+    for mesh in MESHES {
         let emc = load_at(results, "emc", mesh, 12)?;
         let pm = rms_points(&load_at(results, "pm", mesh, 12)?);
         let others: Vec<(&str, Vec<(f64, f64)>)> = if mesh == "bunny" {
