@@ -288,12 +288,19 @@ pub fn by_name(name: &str) -> Result<&'static dyn Codec> {
         })
 }
 
-/// The codec whose streams carry `id`.
+/// The codec whose streams carry `id`; an id this build does not know is unsupported
+/// (docs/CONTRACT.md §7: a stream of a later build's codec is valid, just not readable here).
 pub fn by_id(id: u8) -> Result<&'static dyn Codec> {
     registry()
         .into_iter()
         .find(|c| c.id() == id)
-        .ok_or_else(|| Error::malformed(0, 5, format!("unknown codec id {id}")))
+        .ok_or_else(|| {
+            let known: Vec<String> = registry().iter().map(|c| c.id().to_string()).collect();
+            Error::Unsupported(format!(
+                "unknown codec id {id} (this build reads ids {})",
+                known.join(", ")
+            ))
+        })
 }
 
 /// The codec that reads a stream with `header`: the one its id names, if the header's syntax
@@ -559,6 +566,21 @@ mod tests {
 
     /// With the names unique (`names::tests`), every named codec is registered, found by its
     /// name and by its id, and nothing else is registered.
+    #[test]
+    fn streams_of_an_unknown_codec_or_syntax_are_unsupported_in_one_line() {
+        let mut bytes = golden("v6/raw-eight.mc");
+        bytes[5] = 200;
+        let e = decode(&bytes, Stop::All).map(|_| ()).unwrap_err();
+        assert!(matches!(e, Error::Unsupported(_)), "{e}");
+        assert!(e.to_string().contains("unknown codec id 200"), "{e}");
+        let mut bytes = golden("v6/emc-eight.mc");
+        bytes[6] = 2;
+        let e = decode(&bytes, Stop::All).map(|_| ()).unwrap_err();
+        assert!(matches!(e, Error::Unsupported(_)), "{e}");
+        assert!(e.to_string().contains("emc stream of syntax 2"), "{e}");
+        assert!(!e.to_string().contains('\n'));
+    }
+
     #[test]
     fn every_named_codec_is_found_by_name_and_by_id() {
         for naming in names::ALL {
