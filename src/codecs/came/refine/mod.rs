@@ -28,7 +28,7 @@
 //!   bits a triangle). Back-face culling: a node is not refined while every point of its sphere
 //!   sees every normal of its cone from behind ([`View::faces_away`]), Hoppe's test made to
 //!   hold over the sphere. The surface is then drawn one-sided; [`View::two_sided`] turns it
-//!   off. `came-paper` streams and `came` streams written before cones have none: every node
+//!   off. `came-paper` streams and `came` streams of cone bits 0 have none: every node
 //!   is refined as if it faced the eye.
 //! - counterpart: the full mesh's triangle an adapted face stands for (each corner at its
 //!   leaf); a fold-over is a face turned 90° or more from its counterpart. The front keeps

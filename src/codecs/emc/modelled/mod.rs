@@ -33,8 +33,8 @@
 //! exceptions), lengths and gaps in adaptive Exp-Golomb. No split follows, so the edge graph is
 //! final, and the levels after it show the mesh's own faces rather than every 3-clique: the
 //! paper sends the lists after the last level, where the false triangles of the levels before
-//! made bunny's Hausdorff error rise from level 10 to 11. Streams written before this
-//! (4 bytes of parameters) still decode, with the lists after the last level.
+//! made bunny's Hausdorff error rise from level 10 to 11. Streams whose corrections byte is 0
+//! (as `emc` wrote before this) still decode, with the lists after the last level.
 //!
 //! An intermediate level shows each vertex where the walker's estimate expects it inside its
 //! cell, not at the cell's centre (`placement`; no bits).
