@@ -33,21 +33,11 @@ pub fn decode_as(name: &str, body: &[u8]) {
 
 /// Decodes `body` as everything after the first five bytes (magic, version) of a stream with
 /// appearance: its first byte picks the codec, then its syntax, the header with its appearance
-/// block, the index with the appearance unit last, the levels and the unit. (Its seeds are
-/// streams with an appearance unit; [`decode_with_appearance_in_levels`]'s, streams whose
-/// levels carry the appearance.)
+/// block, the index, the levels and the appearance unit, or levels whose vertex splits carry
+/// the values (appearance flag 16, `pm`). Two targets take it, apart only by their seeds:
+/// `decode_appearance` streams with an appearance unit, `decode_pm_wedges` pm streams with the
+/// appearance in their splits.
 pub fn decode_with_appearance(body: &[u8]) {
-    decode_in_this_version(body);
-}
-
-/// Decodes `body` as everything after the first five bytes of a stream whose levels carry the
-/// appearance (appearance flag 16, `pm` and `pm-reordered`): the codec id, its syntax, the header
-/// with its appearance block, the index, and levels whose vertex splits carry the corner values.
-pub fn decode_with_appearance_in_levels(body: &[u8]) {
-    decode_in_this_version(body);
-}
-
-fn decode_in_this_version(body: &[u8]) {
     let mut bytes = Vec::with_capacity(body.len() + 5);
     bytes.extend_from_slice(&MAGIC);
     bytes.push(FORMAT_VERSION);

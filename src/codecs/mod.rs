@@ -564,8 +564,8 @@ mod tests {
     use super::*;
     use crate::mesh::generate;
 
-    /// With the names unique (`names::tests`), every named codec is registered, found by its
-    /// name and by its id, and nothing else is registered.
+    /// A stream of a codec id or a syntax this build does not read is refused as unsupported
+    /// (docs/CONTRACT.md §7), in one line.
     #[test]
     fn streams_of_an_unknown_codec_or_syntax_are_unsupported_in_one_line() {
         let mut bytes = golden("v6/raw-eight.mc");
@@ -581,6 +581,8 @@ mod tests {
         assert!(!e.to_string().contains('\n'));
     }
 
+    /// With the names unique (`names::tests`), every named codec is registered, found by its
+    /// name and by its id, and nothing else is registered.
     #[test]
     fn every_named_codec_is_found_by_name_and_by_id() {
         for naming in names::ALL {

@@ -13,7 +13,8 @@ use crate::mesh::Grid;
 pub struct Header {
     /// Which codec wrote the units.
     pub codec_id: u8,
-    /// Which of the codec's syntaxes the parameters and units are in (the codec checks it).
+    /// Which of the codec's syntaxes the parameters and units are in (`codecs::for_header`
+    /// checks it against the codec's).
     pub syntax: u8,
     /// The syntax's parameters.
     pub params: Vec<u8>,
