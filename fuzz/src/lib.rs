@@ -64,7 +64,7 @@ pub fn decode_unit_alone(name: &str, body: &[u8]) {
     use meshcodec::codecs::came::{modelled, paper};
     let bytes = stream_of(name, body);
     match name {
-        "came" => last_unit_alone(&bytes, modelled::params, modelled::ModelledUnits),
+        "came" => last_unit_alone(&bytes, modelled::params, modelled::ModelledUnits::default()),
         "came-paper" => last_unit_alone(&bytes, paper::params, paper::PaperUnits::default()),
         _ => panic!("{name} has no meta-nodes"),
     }

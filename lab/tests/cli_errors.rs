@@ -692,3 +692,18 @@ fn render_draws_a_mesh_or_a_stream_and_refuses_bad_cameras() {
     assert_clean_failure(&out, "junk.mc");
     assert!(!d.join("x.png").exists());
 }
+
+/// `info` on a `came` stream of one meta-node (its index is trivially layered, but its levels
+/// are depths, not units) lists its levels; it once indexed the units by level and panicked.
+#[test]
+fn info_lists_the_levels_of_a_came_stream_of_one_meta_node() {
+    let dir = scratch();
+    let d = dir.path();
+    let encoded = run(MESHCODEC, &["encode", "--codec", "came", "eight", "c.mc"], d);
+    assert_eq!(encoded.code, Some(0), "{}", encoded.stderr);
+    for args in [&["info", "c.mc"][..], &["info", "c.mc", "--json"][..]] {
+        let info = run(MESHCODEC, args, d);
+        assert_eq!(info.code, Some(0), "{}", info.stderr);
+        assert!(info.stdout.contains("766"), "{}", info.stdout);
+    }
+}

@@ -307,12 +307,17 @@ pub fn by_id(id: u8) -> Result<&'static dyn Codec> {
 /// is the one that codec reads (docs/FORMAT.md §1).
 pub fn for_header(header: &Header) -> Result<&'static dyn Codec> {
     let codec = by_id(header.codec_id)?;
-    if header.syntax != codec.syntax() {
+    let naming = codec.descriptor().naming;
+    if !(naming.reads_from..=naming.syntax).contains(&header.syntax) {
+        let reads = if naming.reads_from == naming.syntax {
+            format!("syntax {}", naming.syntax)
+        } else {
+            format!("syntax {} to {}", naming.reads_from, naming.syntax)
+        };
         return Err(Error::Unsupported(format!(
-            "{} stream of syntax {} (this build reads syntax {})",
+            "{} stream of syntax {} (this build reads {reads})",
             codec.name(),
             header.syntax,
-            codec.syntax()
         )));
     }
     Ok(codec)

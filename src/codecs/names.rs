@@ -10,8 +10,11 @@ pub struct Naming {
     pub name: &'static str,
     /// Codec id in the stream header.
     pub id: u8,
-    /// The syntax byte of the stream header (docs/FORMAT.md §1, and each codec's section).
+    /// The syntax byte of the stream header that this build writes (docs/FORMAT.md §1, and
+    /// each codec's section).
     pub syntax: u8,
+    /// The oldest syntax this build still reads (every one from it to `syntax`).
+    pub reads_from: u8,
 }
 
 /// The uncompressed baseline.
@@ -19,37 +22,43 @@ pub const RAW: Naming = Naming {
     name: "raw",
     id: 0,
     syntax: 1,
+    reads_from: 1,
 };
 /// Magnor & Girod's embedded mesh coding as published.
 pub const EMC_PAPER: Naming = Naming {
     name: "emc-paper",
     id: 1,
     syntax: 1,
+    reads_from: 1,
 };
 /// Hoppe's progressive meshes in collapse order.
 pub const PM: Naming = Naming {
     name: "pm",
     id: 2,
     syntax: 1,
+    reads_from: 1,
 };
 /// Hoppe's progressive meshes, reordered.
 pub const PM_REORDERED: Naming = Naming {
     name: "pm-reordered",
     id: 3,
     syntax: 1,
+    reads_from: 1,
 };
 /// Embedded mesh coding, context-modelled.
 pub const EMC: Naming = Naming {
     name: "emc",
     id: 4,
     syntax: 1,
+    reads_from: 1,
 };
 
 /// Compressed adaptive multiresolution encoding, context-modelled and lossless.
 pub const CAME: Naming = Naming {
     name: "came",
     id: 6,
-    syntax: 1,
+    syntax: 2,
+    reads_from: 1,
 };
 
 /// Compressed adaptive multiresolution encoding as published (lossy).
@@ -57,6 +66,7 @@ pub const CAME_PAPER: Naming = Naming {
     name: "came-paper",
     id: 5,
     syntax: 1,
+    reads_from: 1,
 };
 
 /// Every codec of this build.

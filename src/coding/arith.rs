@@ -91,6 +91,29 @@ impl BitContext {
         }
     }
 
+    /// A context that starts from probability `p1` (of 2^16) of a 1, adapting afterwards as if
+    /// it had seen `seen` symbols (at most the slow rate's 7): a prior learnt elsewhere.
+    pub fn seeded(p1: u32, seen: u32) -> BitContext {
+        let p1 = p1.clamp(32, ONE - 32);
+        BitContext {
+            p1,
+            fast: p1,
+            slow: p1,
+            seen: seen.min(SLOW_RATE),
+        }
+    }
+
+    /// The slow estimate of the probability of a 1 (of 2^16): what the context has learnt over
+    /// its last hundred or so symbols.
+    pub fn learnt(&self) -> u32 {
+        self.slow
+    }
+
+    /// Symbols seen, up to 7 (the slow rate's).
+    pub fn seen(&self) -> u32 {
+        self.seen
+    }
+
     /// Bits an ideal coder spends on `bit` under this context.
     pub fn cost(&self, bit: bool) -> f64 {
         let p = if bit { self.p1 } else { ONE - self.p1 };
@@ -221,6 +244,13 @@ impl UintContext {
     };
 }
 
+impl UintContext {
+    /// Its binary contexts: the length's, then the mantissa's.
+    pub fn bits_mut(&mut self) -> impl Iterator<Item = &mut BitContext> {
+        self.length.iter_mut().chain(self.mantissa.iter_mut())
+    }
+}
+
 impl Default for UintContext {
     fn default() -> Self {
         UintContext::NEW
@@ -242,6 +272,15 @@ impl IntContext {
         sign: BitContext::NEW,
         magnitude: UintContext::NEW,
     };
+}
+
+impl IntContext {
+    /// Its binary contexts: the zero flag's, the sign's, then the magnitude's.
+    pub fn bits_mut(&mut self) -> impl Iterator<Item = &mut BitContext> {
+        [&mut self.zero, &mut self.sign]
+            .into_iter()
+            .chain(self.magnitude.bits_mut())
+    }
 }
 
 impl Default for IntContext {

@@ -86,13 +86,13 @@ impl SelectiveRefinement for modelled::Came {
             index,
             payload_start,
             params,
-            modelled::ModelledUnits,
+            modelled::ModelledUnits::default(),
         )
     }
 
     fn decode_tree(&self, reader: StreamReader<'_>) -> Result<DecodedTree> {
         let params = modelled::params(reader.header())?;
-        whole(reader, params, modelled::ModelledUnits)
+        whole(reader, params, modelled::ModelledUnits::default())
     }
 }
 

@@ -22,6 +22,7 @@ pub(super) enum Kind {
 }
 
 /// Every adaptive context of one unit.
+#[derive(Clone)]
 pub(super) struct Contexts {
     pub(super) whole: BitContext,
     pub(super) leaf_child: Vec<[BitContext; 2]>,
@@ -47,6 +48,10 @@ pub(super) struct Contexts {
     /// coordinates of an axis of its own (differences from the square's centre).
     pub(super) cone_angle: Vec<Vec<BitContext>>,
     pub(super) cone_axis: [IntContext; 2],
+    /// Per radius class, where its difference vectors' contexts start when first used: the
+    /// probability of a 1 of each binary context ([`IntContext::bits_mut`]'s order, the three
+    /// axes in turn; 0: even odds), or nothing (syntax 2's priors, [`super::priors`]).
+    pub(super) class_priors: Option<std::sync::Arc<Vec<Vec<u32>>>>,
 }
 
 impl Contexts {
@@ -73,6 +78,7 @@ impl Contexts {
             stop: [BitContext::default(); 16],
             cone_angle: vec![vec![BitContext::default(); 1 << ANGLE_BITS]; CONE_CLASSES],
             cone_axis: Default::default(),
+            class_priors: None,
         }
     }
 }
@@ -80,7 +86,29 @@ impl Contexts {
 impl Contexts {
     /// The difference vector's contexts for radius class `class`.
     pub(super) fn coordinates(&mut self, class: usize) -> &mut [IntContext; 3] {
-        self.coordinate[class].get_or_insert_with(Default::default)
+        let priors = self.class_priors.as_ref().and_then(|p| p.get(class));
+        self.coordinate[class].get_or_insert_with(|| {
+            let mut axes: Box<[IntContext; 3]> = Default::default();
+            if let Some(priors) = priors {
+                let bits = axes.iter_mut().flat_map(|axis| axis.bits_mut());
+                for (bit, &p1) in bits.zip(priors) {
+                    seed(bit, p1);
+                }
+            }
+            axes
+        })
+    }
+}
+
+/// Symbols a seeded context adapts as if it had already seen (its next updates move it by
+/// 1/2^(PRIOR_SEEN + 1) and less): enough to keep the prior, few enough to follow a unit that
+/// differs from the stream's mean.
+const PRIOR_SEEN: u32 = 4;
+
+/// Starts `bit` from probability `p1` of a 1 (of 2^16), or leaves it fresh for 0.
+pub(super) fn seed(bit: &mut BitContext, p1: u32) {
+    if p1 != 0 {
+        *bit = BitContext::seeded(p1, PRIOR_SEEN);
     }
 }
 

@@ -3,6 +3,7 @@
 use super::super::decoded::{DecodedTree, Triangle, UnitDecoder};
 use super::super::knowledge::Status;
 use super::super::{cut_at, Params};
+use super::priors::{get_priors, Priors};
 use super::contexts::*;
 use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
 use crate::container::Header;
@@ -24,8 +25,12 @@ fn get_symbol(dec: &mut ArithDecoder, contexts: &mut [BitContext], bits: u8) -> 
     Some(value)
 }
 
-/// The unit decoder of `came`.
-pub struct ModelledUnits;
+/// The unit decoder of `came`: syntax 1 starts every unit's contexts afresh, syntax 2 from the
+/// priors its first unit codes (docs/FORMAT.md §8.2), kept here once that unit is decoded.
+#[derive(Default)]
+pub struct ModelledUnits {
+    priors: std::sync::OnceLock<Priors>,
+}
 
 struct UnitReader<'t> {
     tree: &'t mut DecodedTree,
@@ -239,8 +244,44 @@ impl UnitDecoder for ModelledUnits {
         bytes: &[u8],
         at: usize,
     ) -> Result<Vec<u32>> {
-        let dec = ArithDecoder::new(bytes)
+        let mut dec = ArithDecoder::new(bytes)
             .ok_or_else(|| Error::malformed(0, at, "a came unit is not a whole number of words"))?;
+        let first = tree.nodes.is_empty();
+        if header.syntax < 2 {
+            return self.decode_from(tree, header, params, root, dec, at, Contexts::new());
+        }
+        if !first {
+            let prior = self.priors.get().ok_or_else(|| {
+                Error::malformed(0, at, "a came unit decoded before the first one")
+            })?;
+            return self.decode_from(tree, header, params, root, dec, at, prior.start());
+        }
+        let cut = || Error::malformed(0, at, "the came unit's priors are cut");
+        let prior = if dec.bit(&mut BitContext::default()).ok_or_else(cut)? {
+            get_priors(&mut dec).ok_or_else(cut)?
+        } else {
+            Priors::default()
+        };
+        let children = self.decode_from(tree, header, params, root, dec, at, prior.start())?;
+        // A first unit decodes once (a refused one leaves the stream unreadable).
+        let _ = self.priors.set(prior);
+        Ok(children)
+    }
+}
+
+impl ModelledUnits {
+    /// Decodes the rest of a unit with contexts starting from `ctx`.
+    #[allow(clippy::too_many_arguments)]
+    fn decode_from(
+        &self,
+        tree: &mut DecodedTree,
+        header: &Header,
+        params: &Params,
+        root: u32,
+        dec: ArithDecoder,
+        at: usize,
+        ctx: Contexts,
+    ) -> Result<Vec<u32>> {
         let first = tree.nodes.is_empty();
         let unit = if first {
             NodeId::ROOT
@@ -250,7 +291,7 @@ impl UnitDecoder for ModelledUnits {
         let mut r = UnitReader {
             tree,
             dec,
-            ctx: Contexts::new(),
+            ctx,
             unit,
             at,
         };

@@ -5,6 +5,7 @@ use super::super::knowledge::Status;
 use super::super::partition::Partition;
 use super::super::{born_triangles, BornTriangle};
 use super::contexts::*;
+use super::priors::{put_priors, Learning, Priors};
 use crate::coding::arith::{ArithEncoder, BitContext, UintContext};
 use crate::coding::SyntaxClass;
 use crate::hierarchy::came::cones::{self, coded_cones, CodedCone, ANGLE_BITS, NO_CONE};
@@ -120,20 +121,60 @@ impl<'a> Encoder<'a> {
         self.part.knowledge.status(x, self.tree.is_leaf(x), unit)
     }
 
-    /// Codes unit `m`: its bytes, ledger and bits per field.
-    pub(super) fn unit(
-        &self,
-        m: usize,
-    ) -> (
-        Vec<u8>,
-        crate::coding::BitLedger,
-        std::collections::BTreeMap<&'static str, f64>,
-    ) {
+    /// Codes every unit: its bytes, ledger and bits per field. A first pass over all units with
+    /// one set of contexts learns the priors (docs/FORMAT.md §8.2), which the first unit codes
+    /// before anything else and every unit starts from — unless the stream is smaller without
+    /// them (a mesh of a few meta-nodes), which the first unit's first bit says.
+    pub(super) fn units(&self) -> Vec<super::super::CodedUnit> {
+        let mut learning = Learning::new();
+        let mut scratch = ArithEncoder::default();
+        for m in 0..self.part.units.len() {
+            self.unit(m, &mut scratch, &mut learning.contexts);
+            learning.unit_done();
+        }
+        let with = self.all_units(Some(&learning));
+        let without = self.all_units(None);
+        let size = |units: &[super::super::CodedUnit]| -> usize {
+            units.iter().map(|(bytes, _, _)| bytes.len()).sum()
+        };
+        if size(&with) <= size(&without) {
+            with
+        } else {
+            without
+        }
+    }
+
+    /// Codes every unit, every one's contexts starting from the priors of `learning` (coded at
+    /// the head of the first unit), or afresh.
+    fn all_units(&self, learning: Option<&Learning>) -> Vec<super::super::CodedUnit> {
+        let mut priors: Option<Priors> = None;
+        (0..self.part.units.len())
+            .map(|m| {
+                let mut enc = ArithEncoder::default();
+                let mut ctx = priors
+                    .get_or_insert_with(|| {
+                        let g = SyntaxClass::Geometry;
+                        let mut flag = BitContext::NEW;
+                        enc.bit(&mut flag, learning.is_some(), g, "priors");
+                        match learning {
+                            Some(learning) => put_priors(&mut enc, learning),
+                            None => Priors::default(),
+                        }
+                    })
+                    .start();
+                self.unit(m, &mut enc, &mut ctx);
+                let fields = std::mem::take(&mut enc.field_bits);
+                let (bytes, ledger) = enc.finish();
+                (bytes, ledger, fields)
+            })
+            .collect()
+    }
+
+    /// Codes unit `m` into `enc` with contexts `ctx`.
+    fn unit(&self, m: usize, enc: &mut ArithEncoder, ctx: &mut Contexts) {
         let tree = self.tree;
         let meta = &self.part.units[m];
         let unit = tree.ids[meta.root as usize];
-        let mut enc = ArithEncoder::default();
-        let mut ctx = Contexts::new();
         use SyntaxClass::{Connectivity as C, Geometry as G};
         enc.bit(&mut ctx.whole, meta.whole, C, "connectivity");
         if m == 0 {
@@ -146,7 +187,7 @@ impl<'a> Encoder<'a> {
             let e = self.deviations[tree.root as usize] as u64;
             enc.uint(&mut UintContext::default(), e, G, "deviations");
             let cone = self.cones[tree.root as usize];
-            put_cone(&mut enc, &mut ctx, CodedCone::NONE, cone);
+            put_cone(enc, ctx, CodedCone::NONE, cone);
         }
         // Pass 1: shape, positions, spheres.
         for &s in &meta.nodes {
@@ -172,7 +213,7 @@ impl<'a> Encoder<'a> {
                 }
                 let deviation = self.deviation_codes[c as usize];
                 put_symbol(
-                    &mut enc,
+                    enc,
                     &mut ctx.ratio[side],
                     self.ratio_codes[c as usize],
                     RADIUS_BITS,
@@ -180,7 +221,7 @@ impl<'a> Encoder<'a> {
                     "spheres",
                 );
                 put_symbol(
-                    &mut enc,
+                    enc,
                     &mut ctx.deviation,
                     deviation,
                     DEVIATION_BITS,
@@ -188,7 +229,7 @@ impl<'a> Encoder<'a> {
                     "deviations",
                 );
                 let (parent, cone) = (self.cones[s as usize], self.cones[c as usize]);
-                put_cone(&mut enc, &mut ctx, parent, cone);
+                put_cone(enc, ctx, parent, cone);
             }
         }
         // Pass 2: triangles and dependencies.
@@ -211,13 +252,13 @@ impl<'a> Encoder<'a> {
                     self.positions[u as usize],
                     self.positions[s as usize],
                 );
-                self.put_leaf_path(&mut enc, &mut ctx, t, l1, pu, Kind::N1, unit);
-                self.put_leaf_path(&mut enc, &mut ctx, u, l2, pt, Kind::N2, unit);
+                self.put_leaf_path(enc, ctx, t, l1, pu, Kind::N1, unit);
+                self.put_leaf_path(enc, ctx, u, l2, pt, Kind::N2, unit);
                 let junction = tree.ids[l3 as usize].common_len(sid);
                 let up = sid.len() - junction;
                 enc.uint(&mut ctx.up, up as u64 - 1, C, "connectivity");
                 let start = self.other_child(s, up);
-                self.put_leaf_path(&mut enc, &mut ctx, start, l3, ps, Kind::N3, unit);
+                self.put_leaf_path(enc, ctx, start, l3, ps, Kind::N3, unit);
                 enc.bit(
                     &mut ctx.orientation[previous],
                     tri.flipped,
@@ -248,12 +289,9 @@ impl<'a> Encoder<'a> {
                 let up = sid.len() - junction;
                 enc.uint(&mut ctx.dependency_up, up as u64 - 1, C, "dependencies");
                 let start = self.other_child(s, up);
-                self.put_dependency_path(&mut enc, &mut ctx, start, y, unit);
+                self.put_dependency_path(enc, ctx, start, y, unit);
             }
         }
-        let fields = std::mem::take(&mut enc.field_bits);
-        let (bytes, ledger) = enc.finish();
-        (bytes, ledger, fields)
     }
 
     /// The child of s's ancestor `up` levels above that is not on s's path.

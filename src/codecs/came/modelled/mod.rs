@@ -6,11 +6,14 @@
 //! A unit codes its splits' shape, positions and spheres first (pass 1), then their triangles and
 //! dependencies (pass 2), so that paths walk a known shape: no length is coded where the decoder
 //! knows where leaves are, and each direction is coded as "towards the child nearer the other
-//! corner" where both children's positions are known. Contexts start afresh in every unit.
+//! corner" where both children's positions are known. Every unit's contexts start from priors
+//! the first unit codes, learnt by the encoder over the whole stream (syntax 2, `priors`);
+//! in syntax 1 they started afresh, and such streams still decode.
 
 mod contexts;
 mod decoder;
 mod encoder;
+mod priors;
 #[cfg(test)]
 mod tests;
 
@@ -73,8 +76,7 @@ impl Codec for Came {
             deviation_bits: DEVIATION_BITS,
         };
         encode_stream(mesh, layout, |tree, part| {
-            let encoder = Encoder::new(tree, mesh, part);
-            (0..part.units.len()).map(|m| encoder.unit(m)).collect()
+            Encoder::new(tree, mesh, part).units()
         })
     }
 
@@ -84,7 +86,7 @@ impl Codec for Came {
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
         let params = params(stream.header())?;
-        Ok(Box::new(CameDecoder::new(stream, params, ModelledUnits)?))
+        Ok(Box::new(CameDecoder::new(stream, params, ModelledUnits::default())?))
     }
 }
 

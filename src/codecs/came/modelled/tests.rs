@@ -16,7 +16,7 @@ fn stream(mesh: &crate::mesh::TriMesh) -> (CanonicalMesh, Vec<u8>) {
 fn decoder(bytes: &[u8]) -> CameDecoder<'_, ModelledUnits> {
     let reader = StreamReader::open(bytes).unwrap();
     let params = params(reader.header()).unwrap();
-    CameDecoder::new(reader, params, ModelledUnits).unwrap()
+    CameDecoder::new(reader, params, ModelledUnits::default()).unwrap()
 }
 
 #[test]

@@ -15,6 +15,11 @@ impl ViewMesh {
             .map(|v| self.nodes.spheres[v as usize].0)
     }
 
+    /// The front's nodes (the adapted mesh's vertices), by their paths in the hierarchy.
+    pub fn active_nodes(&self) -> impl Iterator<Item = NodeId> + '_ {
+        self.front.active.iter().map(|&v| self.nodes.ids[v as usize])
+    }
+
     /// The present triangles: each one's corners' leaf paths (which name the full mesh's
     /// triangle it stands for) and its corners' positions in the adapted mesh.
     pub fn present_triangles(&self) -> impl Iterator<Item = ([NodeId; 3], [DVec3; 3])> + '_ {

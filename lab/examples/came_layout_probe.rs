@@ -1,0 +1,190 @@
+//! How many meta-nodes, and how many of a hierarchy's splits, the far, middle and near views of
+//! the came-vd table touch under other layouts of the same hierarchy: meta-nodes of L levels
+//! (the stream's), or of as many levels as keep a unit within S splits.
+//! Run: cargo run --release --example came_layout_probe -- STREAM
+use meshcodec::codecs::came::decode_tree;
+use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+use meshcodec_lab::came::vd::{framing, towards, FOV_DEGREES, HEIGHT, VIEWS, WIDTH};
+use std::collections::HashSet;
+
+#[derive(Clone, Copy, Debug)]
+enum Rule {
+    Levels(u8),
+    /// Units rooted at these depths, then meta-nodes of 8 levels.
+    Tiers(&'static [u8]),
+    Splits(usize),
+}
+
+/// Per inner node: the index of the unit that codes its split.
+fn partition(
+    tree: &meshcodec::codecs::came::decoded::DecodedTree,
+    inner_below: &[usize],
+    height: &[u8],
+    rule: Rule,
+) -> (Vec<u32>, usize) {
+    let n = tree.nodes.len();
+    let mut unit_of = vec![u32::MAX; n];
+    let mut roots = std::collections::VecDeque::from([0u32]);
+    let mut units = 0usize;
+    while let Some(root) = roots.pop_front() {
+        let unit = units as u32;
+        units += 1;
+        let top = tree.nodes[root as usize].id.len() as usize;
+        // Levels this unit holds.
+        let levels = match rule {
+            Rule::Levels(l) => {
+                if height[root as usize] <= l + l / 2 {
+                    u8::MAX
+                } else {
+                    l
+                }
+            }
+            Rule::Tiers(tiers) => match tiers.iter().position(|&t| t as usize > top) {
+                Some(i) => tiers[i] - top as u8,
+                None if height[root as usize] <= 12 => u8::MAX,
+                None => 8,
+            },
+            Rule::Splits(s) => {
+                if inner_below[root as usize] <= s + s / 2 {
+                    u8::MAX
+                } else {
+                    // Splits per depth below the root, then the most levels within s.
+                    let mut per_depth: Vec<usize> = Vec::new();
+                    let mut frontier = vec![root];
+                    while !frontier.is_empty() && per_depth.iter().sum::<usize>() <= s {
+                        per_depth.push(frontier.len());
+                        frontier = frontier
+                            .iter()
+                            .flat_map(|&v| tree.nodes[v as usize].children.unwrap())
+                            .filter(|&c| tree.nodes[c as usize].children.is_some())
+                            .collect();
+                    }
+                    let mut total = 0;
+                    let mut l = 0u8;
+                    for count in per_depth {
+                        if total + count > s && l > 0 {
+                            break;
+                        }
+                        total += count;
+                        l += 1;
+                    }
+                    l
+                }
+            }
+        };
+        let mut stack = vec![root];
+        while let Some(v) = stack.pop() {
+            unit_of[v as usize] = unit;
+            for c in tree.nodes[v as usize].children.unwrap() {
+                if tree.nodes[c as usize].children.is_none() {
+                    continue;
+                }
+                let depth = tree.nodes[c as usize].id.len() as usize;
+                if levels == u8::MAX || depth < top + levels as usize {
+                    stack.push(c);
+                } else {
+                    roots.push_back(c);
+                }
+            }
+        }
+    }
+    (unit_of, units)
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let path = std::env::args().nth(1).ok_or("usage: came_layout_probe STREAM")?;
+    let bytes = std::fs::read(&path)?;
+    let (_, tree) = decode_tree(&bytes)?;
+    let n = tree.nodes.len();
+    // Children follow their parents in the decoded order: sizes bottom-up in reverse.
+    let mut inner_below = vec![0usize; n];
+    let mut height = vec![0u8; n];
+    for v in (0..n).rev() {
+        if let Some([t, u]) = tree.nodes[v].children {
+            inner_below[v] = 1 + inner_below[t as usize] + inner_below[u as usize];
+            height[v] = 1 + height[t as usize].max(height[u as usize]);
+        }
+    }
+    let splits = inner_below[0];
+    println!("{path}: {} bytes, {splits} splits, height {}", bytes.len(), height[0]);
+    let mut full = ViewMesh::from_stream(&bytes)?;
+    full.settle(&View::everything(), Budget::UNLIMITED, 256);
+    let (centre, diagonal, spot) = framing(&full.mesh())?;
+    let rules = [
+        Rule::Levels(8),
+        Rule::Levels(4),
+        Rule::Tiers(&[4, 8, 12]),
+        Rule::Tiers(&[4, 8, 10, 12, 14]),
+        Rule::Tiers(&[3, 6, 9, 11, 13, 15]),
+        Rule::Tiers(&[4, 7, 9, 11, 13, 15]),
+        Rule::Splits(16),
+        Rule::Splits(32),
+        Rule::Splits(64),
+        Rule::Splits(128),
+        Rule::Splits(256),
+    ];
+    let partitions: Vec<_> = rules
+        .iter()
+        .map(|&r| partition(&tree, &inner_below, &height, r))
+        .collect();
+    for (rule, (_, units)) in rules.iter().zip(&partitions) {
+        println!("  {rule:?}: {units} units, {:.1} splits a unit", splits as f64 / *units as f64);
+    }
+    for (name, diagonals) in VIEWS {
+        let (eye, target) = if name == "near" {
+            (spot + towards() * diagonals * diagonal, spot)
+        } else {
+            (centre + towards() * diagonals * diagonal, centre)
+        };
+        let camera = Camera {
+            eye,
+            target,
+            up: glam::DVec3::Y,
+            fov_degrees: FOV_DEGREES,
+            width: WIDTH,
+            height: HEIGHT,
+        };
+        for guard in [true, false] {
+            let view = View::new(&camera, 1.0)?
+                .two_sided(true)
+                .keep_orientation(guard);
+            let mut front = ViewMesh::from_stream(&bytes)?;
+            front.settle(&view, Budget::UNLIMITED, 256);
+            let mut split: HashSet<u64> = HashSet::new();
+            for id in front.active_nodes() {
+                let mut a = id;
+                while let Some(p) = a.parent() {
+                    if !split.insert(p.packed()) {
+                        break;
+                    }
+                    a = p;
+                }
+            }
+            let fetched = front.fetched();
+            println!(
+                "{name} guard {guard}: {} faces, {} splits needed ({:.1}%), read today {:.1}% ({} units)",
+                front.face_count(),
+                split.len(),
+                100.0 * split.len() as f64 / splits as f64,
+                100.0 * fetched.bytes_read as f64 / fetched.stream_bytes as f64,
+                fetched.units_loaded
+            );
+            for (rule, (unit_of, _)) in rules.iter().zip(&partitions) {
+                let touched: HashSet<u32> = split
+                    .iter()
+                    .map(|p| unit_of[tree.lookup[p] as usize])
+                    .collect();
+                let held: usize = (0..n)
+                    .filter(|&v| tree.nodes[v].children.is_some())
+                    .filter(|&v| touched.contains(&unit_of[v]))
+                    .count();
+                println!(
+                    "    {rule:?}: {} units, {held} splits ({:.1}%)",
+                    touched.len(),
+                    100.0 * held as f64 / splits as f64
+                );
+            }
+        }
+    }
+    Ok(())
+}
