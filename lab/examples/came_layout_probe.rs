@@ -1,6 +1,7 @@
 //! How many meta-nodes, and how many of a hierarchy's splits, the far, middle and near views of
 //! the came-vd table touch under other layouts of the same hierarchy: meta-nodes of L levels
-//! (the stream's), or of as many levels as keep a unit within S splits.
+//! (the stream's 8, or 4), meta-nodes rooted at given depths before those of 8 levels, or of as
+//! many levels as keep a unit within S splits (BENCHMARKS.md, "What a meta-node costs").
 //! Run: cargo run --release --example came_layout_probe -- STREAM
 use meshcodec::codecs::came::decode_tree;
 use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
@@ -92,7 +93,9 @@ fn partition(
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let path = std::env::args().nth(1).ok_or("usage: came_layout_probe STREAM")?;
+    let path = std::env::args()
+        .nth(1)
+        .ok_or("usage: came_layout_probe STREAM")?;
     let bytes = std::fs::read(&path)?;
     let (_, tree) = decode_tree(&bytes)?;
     let n = tree.nodes.len();
@@ -106,29 +109,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let splits = inner_below[0];
-    println!("{path}: {} bytes, {splits} splits, height {}", bytes.len(), height[0]);
+    println!(
+        "{path}: {} bytes, {splits} splits, height {}",
+        bytes.len(),
+        height[0]
+    );
     let mut full = ViewMesh::from_stream(&bytes)?;
     full.settle(&View::everything(), Budget::UNLIMITED, 256);
     let (centre, diagonal, spot) = framing(&full.mesh())?;
     let rules = [
         Rule::Levels(8),
         Rule::Levels(4),
-        Rule::Tiers(&[4, 8, 12]),
+        Rule::Tiers(&[4, 8, 11]),
         Rule::Tiers(&[4, 8, 10, 12, 14]),
-        Rule::Tiers(&[3, 6, 9, 11, 13, 15]),
-        Rule::Tiers(&[4, 7, 9, 11, 13, 15]),
-        Rule::Splits(16),
-        Rule::Splits(32),
         Rule::Splits(64),
-        Rule::Splits(128),
-        Rule::Splits(256),
     ];
     let partitions: Vec<_> = rules
         .iter()
         .map(|&r| partition(&tree, &inner_below, &height, r))
         .collect();
     for (rule, (_, units)) in rules.iter().zip(&partitions) {
-        println!("  {rule:?}: {units} units, {:.1} splits a unit", splits as f64 / *units as f64);
+        println!(
+            "  {rule:?}: {units} units, {:.1} splits a unit",
+            splits as f64 / *units as f64
+        );
     }
     for (name, diagonals) in VIEWS {
         let (eye, target) = if name == "near" {
