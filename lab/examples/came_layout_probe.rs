@@ -2,17 +2,18 @@
 //! the came-vd table touch under other layouts of the same hierarchy: meta-nodes of L levels
 //! (the stream's 8, or 4), meta-nodes rooted at given depths before those of 8 levels, or of as
 //! many levels as keep a unit within S splits (BENCHMARKS.md, "What a meta-node costs").
-//! Run: cargo run --release --example came_layout_probe -- STREAM
+//! Run: cargo run --release --example came_layout_probe -- STREAM [DEPTHS…] (each DEPTHS a
+//! comma-separated list of root depths, as 4,8,11, to try beside the built-in layouts)
 use meshcodec::codecs::came::decode_tree;
 use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
 use meshcodec_lab::came::vd::{framing, towards, FOV_DEGREES, HEIGHT, VIEWS, WIDTH};
 use std::collections::HashSet;
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 enum Rule {
     Levels(u8),
     /// Units rooted at these depths, then meta-nodes of 8 levels.
-    Tiers(&'static [u8]),
+    Tiers(Vec<u8>),
     Splits(usize),
 }
 
@@ -40,7 +41,7 @@ fn partition(
                     l
                 }
             }
-            Rule::Tiers(tiers) => match tiers.iter().position(|&t| t as usize > top) {
+            Rule::Tiers(ref tiers) => match tiers.iter().position(|&t| t as usize > top) {
                 Some(i) => tiers[i] - top as u8,
                 None if height[root as usize] <= 12 => u8::MAX,
                 None => 8,
@@ -117,16 +118,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut full = ViewMesh::from_stream(&bytes)?;
     full.settle(&View::everything(), Budget::UNLIMITED, 256);
     let (centre, diagonal, spot) = framing(&full.mesh())?;
-    let rules = [
+    let mut rules = vec![
         Rule::Levels(8),
         Rule::Levels(4),
-        Rule::Tiers(&[4, 8, 11]),
-        Rule::Tiers(&[4, 8, 10, 12, 14]),
+        Rule::Tiers(vec![4, 8, 11]),
+        Rule::Tiers(vec![4, 8, 10, 12, 14]),
         Rule::Splits(64),
     ];
+    for depths in std::env::args().skip(2) {
+        let depths: Vec<u8> = depths
+            .split(',')
+            .map(str::parse)
+            .collect::<Result<_, _>>()?;
+        rules.push(Rule::Tiers(depths));
+    }
     let partitions: Vec<_> = rules
         .iter()
-        .map(|&r| partition(&tree, &inner_below, &height, r))
+        .map(|r| partition(&tree, &inner_below, &height, r.clone()))
         .collect();
     for (rule, (_, units)) in rules.iter().zip(&partitions) {
         println!(

@@ -699,7 +699,11 @@ fn render_draws_a_mesh_or_a_stream_and_refuses_bad_cameras() {
 fn info_lists_the_levels_of_a_came_stream_of_one_meta_node() {
     let dir = scratch();
     let d = dir.path();
-    let encoded = run(MESHCODEC, &["encode", "--codec", "came", "eight", "c.mc"], d);
+    let encoded = run(
+        MESHCODEC,
+        &["encode", "--codec", "came", "eight", "c.mc"],
+        d,
+    );
     assert_eq!(encoded.code, Some(0), "{}", encoded.stderr);
     for args in [&["info", "c.mc"][..], &["info", "c.mc", "--json"][..]] {
         let info = run(MESHCODEC, args, d);

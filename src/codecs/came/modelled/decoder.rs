@@ -3,8 +3,8 @@
 use super::super::decoded::{DecodedTree, Triangle, UnitDecoder};
 use super::super::knowledge::Status;
 use super::super::{cut_at, Params};
-use super::priors::{get_priors, Priors};
 use super::contexts::*;
+use super::priors::{get_priors, Priors};
 use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
 use crate::container::Header;
 use crate::error::{Error, Result};

@@ -86,7 +86,11 @@ impl Codec for Came {
 
     fn decoder<'a>(&self, stream: StreamReader<'a>) -> Result<Box<dyn LevelDecoder + 'a>> {
         let params = params(stream.header())?;
-        Ok(Box::new(CameDecoder::new(stream, params, ModelledUnits::default())?))
+        Ok(Box::new(CameDecoder::new(
+            stream,
+            params,
+            ModelledUnits::default(),
+        )?))
     }
 }
 

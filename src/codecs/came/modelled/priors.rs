@@ -197,7 +197,12 @@ impl PriorContexts {
     /// Codes one context's prior (`None`: even odds); returns its probability (0: none).
     fn put(&mut self, enc: &mut ArithEncoder, prior: Option<u32>, previous: &mut bool) -> u32 {
         let g = SyntaxClass::Geometry;
-        enc.bit(&mut self.trained[*previous as usize], prior.is_some(), g, "priors");
+        enc.bit(
+            &mut self.trained[*previous as usize],
+            prior.is_some(),
+            g,
+            "priors",
+        );
         *previous = prior.is_some();
         let Some(p1) = prior else {
             return 0;

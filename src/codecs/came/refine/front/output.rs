@@ -17,7 +17,10 @@ impl ViewMesh {
 
     /// The front's nodes (the adapted mesh's vertices), by their paths in the hierarchy.
     pub fn active_nodes(&self) -> impl Iterator<Item = NodeId> + '_ {
-        self.front.active.iter().map(|&v| self.nodes.ids[v as usize])
+        self.front
+            .active
+            .iter()
+            .map(|&v| self.nodes.ids[v as usize])
     }
 
     /// The present triangles: each one's corners' leaf paths (which name the full mesh's
