@@ -8,6 +8,15 @@ quadric-error optimum). Those are the bits that vertex's path costs when its cel
 so a stream that sends them earlier need not grow at the end; here they are charged in full,
 raw: 3k bits a cluster on top of the level's own bits.
 
+What sending them early would add to the lossless stream: moved earlier along the
+representative's path, the octree's own bits for that path (split or not; which half when not)
+are only moved, but where the path's cell splits the decoder must also learn which child holds
+the representative, a bit the octree never codes. The probe counts those steps ("rep bits at
+splits") for every depth and k: an upper bound of the growth at one bit each, before any
+prediction of the child; how often the representative lies in the half holding more of the
+cell's vertices (a predictor of that bit); and the RMS when the sub-cell is found by that rule
+alone, which a decoder could follow without being told ("majority path").
+
 For every depth l and k it prints the bits a vertex and the RMS error (both ways, relative to the
 bounding box's diagonal, `meshcodec distance`) of that mesh; then, at each `emc` level's bits, the
 lowest RMS among the probe's meshes that cost no more, beside `emc`'s own level, `pm`'s and (on
@@ -91,6 +100,50 @@ def valence_curve():
     return [(lv["bits"], lv["rms_relative"]) for lv in json.load(open(path))["levels"]]
 
 
+def rep_path_splits(cells, representative, depth, extra, q, axes):
+    """Per step after `depth` (three a level, along `axes`): how many representatives' cells
+    split there (hold vertices on both sides of the step's plane), and at how many of those the
+    representative lies in the half holding more of the cell's vertices."""
+    taken = [depth] * 3
+    counts, agreeing = [], []
+    for _ in range(min(extra, q - depth)):
+        for axis in axes:
+            keys = np.stack([cells[:, a] >> (q - taken[a]) for a in range(3)], 1)
+            _, cell_of = np.unique(keys, axis=0, return_inverse=True)
+            cell_of = cell_of.ravel()
+            side = (cells[:, axis] >> (q - taken[axis] - 1)) & 1
+            lower = np.bincount(cell_of, weights=side == 0)
+            upper = np.bincount(cell_of, weights=side == 1)
+            split = (lower > 0) & (upper > 0)
+            at = cell_of[representative]
+            majority = (upper[at] > lower[at]).astype(np.int64)
+            counts.append(int(split[at].sum()))
+            agreeing.append(int((split[at] & (side[representative] == majority)).sum()))
+            taken[axis] += 1
+    return np.array(counts), np.array(agreeing)
+
+
+def majority_cells(cells, cluster, depth, extra, q, axes):
+    """Each cluster's sub-cell `extra` bits an axis below `depth` found without a
+    representative: at every step, the half holding more of the cluster's vertices still on the
+    path (ties: the lower). A stand-in for a rule a decoder could follow untold (it sees the
+    halves' edges when a cell splits, not their vertices). Returns the sub-cells' coordinates
+    at depth + extra."""
+    alive = np.ones(len(cells), dtype=bool)
+    clusters = cluster.max() + 1
+    for level in range(extra):
+        for axis in axes:
+            side = (cells[:, axis] >> (q - depth - 1 - level)) & 1
+            upper = np.bincount(cluster, weights=(alive & (side == 1)), minlength=clusters)
+            lower = np.bincount(cluster, weights=(alive & (side == 0)), minlength=clusters)
+            chosen = (upper > lower).astype(np.int64)
+            alive &= side == chosen[cluster]
+    first = np.full(clusters, -1)
+    order = np.nonzero(alive)[0]
+    first[cluster[order[::-1]]] = order[::-1]
+    return cells[first] >> (q - depth - extra)
+
+
 def probe(mesh, work):
     stream, full = work / "stream.mc", work / "full.obj"
     run("encode", "--codec", "emc", "--quant", 12, mesh, stream)
@@ -98,6 +151,9 @@ def probe(mesh, work):
     info = json.loads(run("info", "--json", stream))
     origin, cell, q = np.array(info["origin"]), np.array(info["cell"]), info["quant_bits"]
     level_bits = [0.0] + [8.0 * end for end in info["level_ends"]]
+    raw = open(stream, "rb").read()
+    # The header's first parameter bytes: the axes of a level's three steps (docs/FORMAT.md §7).
+    axes = list(raw[8:11])
     positions, faces = read_obj(full)
     cells = np.floor((positions - origin) / cell).astype(np.int64)
     n = len(positions)
@@ -133,6 +189,8 @@ def probe(mesh, work):
         mapped = mapped[keep]
         _, unique_rows = np.unique(np.sort(mapped, axis=1), axis=0, return_index=True)
         mapped = mapped[np.sort(unique_rows)]
+        splits_on_paths, agreeing = rep_path_splits(
+            cells, representative, depth, max(EXTRA_BITS), q, axes)
         for extra in EXTRA_BITS:
             finer = min(depth + extra, q)
             sub = cells[representative] >> (q - finer)
@@ -140,10 +198,22 @@ def probe(mesh, work):
             write_obj(work / "probe.obj", shown, mapped)
             bits = level_bits[depth] + 3 * extra * clusters
             rms = rms_relative(full, work / "probe.obj")
+            majority = majority_cells(cells, cluster, depth, finer - depth, q, axes)
+            write_obj(work / "majority.obj",
+                      origin + (majority + 0.5) * cell * (1 << (q - finer)), mapped)
+            rms_majority = rms_relative(full, work / "majority.obj")
+            at_splits = int(splits_on_paths[: 3 * (finer - depth)].sum())
+            agree = int(agreeing[: 3 * (finer - depth)].sum())
             points.append({"depth": depth, "extra_bits": extra, "clusters": int(clusters),
-                           "bits": bits, "bits_per_vertex": bits / n, "rms": rms})
+                           "bits": bits, "bits_per_vertex": bits / n, "rms": rms,
+                           "rep_bits": 3 * (finer - depth) * int(clusters),
+                           "rep_bits_at_splits": at_splits,
+                           "rep_in_larger_half_at_splits": agree, "rms_majority": rms_majority})
             print(f"  depth {depth}, {extra} more bits an axis: {clusters} clusters, "
-                  f"{bits / n:.3f} bits a vertex, RMS {rms:.3e}", flush=True)
+                  f"{bits / n:.3f} bits a vertex, RMS {rms:.3e}, "
+                  f"{at_splits} of {3 * (finer - depth) * clusters} rep bits at splits "
+                  f"({agree} in the larger half); "
+                  f"majority path RMS {rms_majority:.3e}", flush=True)
     return n, points
 
 
