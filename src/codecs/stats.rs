@@ -104,6 +104,8 @@ pub enum CameField {
     Cones,
     /// Deviations (`came`; not in the paper).
     Deviations,
+    /// The priors every unit's contexts start from (`came` syntax 2; not in the paper).
+    Priors,
 }
 
 impl CameField {
@@ -116,17 +118,19 @@ impl CameField {
             CameField::MrData => "spheres",
             CameField::Cones => "cones",
             CameField::Deviations => "deviations",
+            CameField::Priors => "priors",
         }
     }
 
     /// Every field.
-    pub const ALL: [CameField; 6] = [
+    pub const ALL: [CameField; 7] = [
         CameField::Connectivity,
         CameField::Dependencies,
         CameField::Coordinates,
         CameField::MrData,
         CameField::Cones,
         CameField::Deviations,
+        CameField::Priors,
     ];
 }
 
