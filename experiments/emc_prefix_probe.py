@@ -14,7 +14,8 @@ are only moved, but where the path's cell splits the decoder must also learn whi
 the representative, a bit the octree never codes. The probe counts those steps ("rep bits at
 splits") for every depth and k: an upper bound of the growth at one bit each, before any
 prediction of the child; how often the representative lies in the half holding more of the
-cell's vertices (a predictor of that bit); and the RMS when the sub-cell is found by that rule
+cell's vertices, and in the half holding its neighbouring clusters' mean (predictors of that
+bit); and the RMS when the sub-cell is found by that rule
 alone, which a decoder could follow without being told ("majority path").
 
 For every depth l and k it prints the bits a vertex and the RMS error (both ways, relative to the
@@ -100,12 +101,29 @@ def valence_curve():
     return [(lv["bits"], lv["rms_relative"]) for lv in json.load(open(path))["levels"]]
 
 
-def rep_path_splits(cells, representative, depth, extra, q, axes):
+def neighbour_means(cells, cluster, mapped, depth, q):
+    """Per cluster, the mean of its neighbouring clusters' cell centres (grid units): what a
+    decoder knows of where the surface runs past a cell before its vertices are placed."""
+    clusters = cluster.max() + 1
+    centre = np.zeros((clusters, 3))
+    centre[cluster] = ((cells >> (q - depth)) + 0.5) * (1 << (q - depth))
+    edges = np.concatenate([mapped[:, [0, 1]], mapped[:, [1, 2]], mapped[:, [2, 0]]])
+    edges = np.unique(np.sort(edges, axis=1), axis=0)
+    sums = np.zeros((clusters, 3))
+    counts = np.zeros(clusters)
+    for a, b in ((0, 1), (1, 0)):
+        np.add.at(sums, edges[:, a], centre[edges[:, b]])
+        np.add.at(counts, edges[:, a], 1)
+    return np.where(counts[:, None] > 0, sums / np.maximum(counts, 1)[:, None], centre)
+
+
+def rep_path_splits(cells, representative, depth, extra, q, axes, means=None):
     """Per step after `depth` (three a level, along `axes`): how many representatives' cells
-    split there (hold vertices on both sides of the step's plane), and at how many of those the
-    representative lies in the half holding more of the cell's vertices."""
+    split there (hold vertices on both sides of the step's plane), at how many of those the
+    representative lies in the half holding more of the cell's vertices, and at how many in the
+    half its cluster's neighbours' mean lies in (`means`, per cluster in order)."""
     taken = [depth] * 3
-    counts, agreeing = [], []
+    counts, agreeing, by_neighbours = [], [], []
     for _ in range(min(extra, q - depth)):
         for axis in axes:
             keys = np.stack([cells[:, a] >> (q - taken[a]) for a in range(3)], 1)
@@ -119,8 +137,14 @@ def rep_path_splits(cells, representative, depth, extra, q, axes):
             majority = (upper[at] > lower[at]).astype(np.int64)
             counts.append(int(split[at].sum()))
             agreeing.append(int((split[at] & (side[representative] == majority)).sum()))
+            if means is not None:
+                shift = q - taken[axis] - 1
+                plane = ((cells[representative, axis] >> (shift + 1)) * 2 + 1) << shift
+                predicted = (means[:, axis] >= plane).astype(np.int64)
+                by_neighbours.append(
+                    int((split[at] & (side[representative] == predicted)).sum()))
             taken[axis] += 1
-    return np.array(counts), np.array(agreeing)
+    return np.array(counts), np.array(agreeing), np.array(by_neighbours)
 
 
 def majority_cells(cells, cluster, depth, extra, q, axes):
@@ -189,8 +213,9 @@ def probe(mesh, work):
         mapped = mapped[keep]
         _, unique_rows = np.unique(np.sort(mapped, axis=1), axis=0, return_index=True)
         mapped = mapped[np.sort(unique_rows)]
-        splits_on_paths, agreeing = rep_path_splits(
-            cells, representative, depth, max(EXTRA_BITS), q, axes)
+        means = neighbour_means(cells, cluster, mapped, depth, q)
+        splits_on_paths, agreeing, by_neighbours = rep_path_splits(
+            cells, representative, depth, max(EXTRA_BITS), q, axes, means)
         for extra in EXTRA_BITS:
             finer = min(depth + extra, q)
             sub = cells[representative] >> (q - finer)
@@ -204,15 +229,18 @@ def probe(mesh, work):
             rms_majority = rms_relative(full, work / "majority.obj")
             at_splits = int(splits_on_paths[: 3 * (finer - depth)].sum())
             agree = int(agreeing[: 3 * (finer - depth)].sum())
+            agree_neighbours = int(by_neighbours[: 3 * (finer - depth)].sum())
             points.append({"depth": depth, "extra_bits": extra, "clusters": int(clusters),
                            "bits": bits, "bits_per_vertex": bits / n, "rms": rms,
                            "rep_bits": 3 * (finer - depth) * int(clusters),
                            "rep_bits_at_splits": at_splits,
-                           "rep_in_larger_half_at_splits": agree, "rms_majority": rms_majority})
+                           "rep_in_larger_half_at_splits": agree,
+                           "rep_on_neighbours_side_at_splits": agree_neighbours,
+                           "rms_majority": rms_majority})
             print(f"  depth {depth}, {extra} more bits an axis: {clusters} clusters, "
                   f"{bits / n:.3f} bits a vertex, RMS {rms:.3e}, "
                   f"{at_splits} of {3 * (finer - depth) * clusters} rep bits at splits "
-                  f"({agree} in the larger half); "
+                  f"({agree} in the larger half, {agree_neighbours} on the neighbours' side); "
                   f"majority path RMS {rms_majority:.3e}", flush=True)
     return n, points
 
