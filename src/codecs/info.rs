@@ -158,7 +158,9 @@ impl StreamInfo {
             levels: ends.len(),
             level_ends: ends,
             payload_start: start,
-            layered: index.is_layered(),
+            // A CAME stream's units are meta-nodes, even one of a single unit (whose index
+            // is trivially laid out as levels): its levels are depths.
+            layered: index.is_layered() && codec.selective_refinement().is_none(),
             units,
             appearance,
             facts: codec.facts(header),
@@ -210,6 +212,7 @@ mod tests {
             assert_eq!(info.facts, codec.facts(&header), "{name}");
             let refines = codec.selective_refinement().is_some();
             assert_eq!(info.facts.normal_cones.is_some(), refines, "{name}");
+            assert_eq!(info.layered, !refines, "{name}: units are levels");
 
             let cut =
                 &bytes[..(info.payload_start + (info.bytes - info.payload_start) / 2) as usize];

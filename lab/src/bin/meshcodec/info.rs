@@ -41,10 +41,7 @@ pub fn info(input: &Path, json: bool) -> Result<()> {
             mesh, loose_edges, ..
         } = decoder.mesh()?;
         let level = decoder.levels_decoded();
-        // A CAME stream of one meta-node is layered too, but its levels are depths, not units.
-        let unit = (info.layered && info.units.len() == decoder.levels())
-            .then(|| info.units.get(level - 1))
-            .flatten();
+        let unit = info.layered.then(|| &info.units[level - 1]);
         level_sizes.push(LevelSize {
             level,
             end_byte: unit.map(|u| u.end_byte),

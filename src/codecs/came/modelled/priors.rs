@@ -9,7 +9,7 @@
 //! smaller the meta-nodes.
 
 use super::contexts::{seed, Contexts, SCALES};
-use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext};
+use crate::coding::arith::{ArithDecoder, ArithEncoder, BitContext, IntContext};
 use crate::coding::SyntaxClass;
 use std::sync::Arc;
 
@@ -78,11 +78,16 @@ fn each_fixed(ctx: &mut Contexts, f: &mut dyn FnMut(&mut BitContext)) {
     }
 }
 
+/// Binary contexts [`each_fixed`] visits.
+fn fixed_count() -> usize {
+    let mut count = 0;
+    each_fixed(&mut Contexts::new(), &mut |_| count += 1);
+    count
+}
+
 /// Binary contexts of one radius class's difference vectors (three integer contexts).
 fn per_class() -> usize {
-    let mut ctx = Contexts::new();
-    ctx.coordinates(0);
-    class_bits(&mut ctx, 0).len()
+    3 * IntContext::default().bits_mut().count()
 }
 
 /// The difference vectors' binary contexts of radius class `class` (none if it was not used).
@@ -242,8 +247,7 @@ impl PriorContexts {
 pub(super) fn put_priors(enc: &mut ArithEncoder, learning: &Learning) -> Priors {
     let mut pc = PriorContexts::new();
     let mut previous = false;
-    let mut count = 0;
-    each_fixed(&mut Contexts::new(), &mut |_| count += 1);
+    let count = fixed_count();
     let fixed = (0..count)
         .map(|i| pc.put(enc, learning.prior(i), &mut previous))
         .collect();
@@ -271,8 +275,7 @@ pub(super) fn put_priors(enc: &mut ArithEncoder, learning: &Learning) -> Priors 
 pub(super) fn get_priors(dec: &mut ArithDecoder) -> Option<Priors> {
     let mut pc = PriorContexts::new();
     let mut previous = false;
-    let mut count = 0;
-    each_fixed(&mut Contexts::new(), &mut |_| count += 1);
+    let count = fixed_count();
     let fixed = (0..count)
         .map(|_| pc.get(dec, &mut previous))
         .collect::<Option<Vec<u32>>>()?;
