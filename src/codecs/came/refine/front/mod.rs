@@ -39,17 +39,26 @@
 //!   R₁ = r_a + r_b, R₂ = r_a + r_c (for some choice of the corner a); or
 //! - its normal n is within 90° − α_v of the axis of a corner v's normal cone (which holds the
 //!   counterpart's normal, a face with a corner under v); or
+//! - n is within 90° − α of the cone of a loaded node on one of its counterpart's leaf paths
+//!   below its corners (the counterpart has a corner under that node too, and the deeper the
+//!   node, the narrower its cone); or
 //! - the deepest loaded nodes on its counterpart's leaf paths (the leaves themselves once their
 //!   meta-nodes are in) make a proxy triangle whose normal is within β of n and whose spheres
 //!   bound the counterpart's normal within γ of its own (the sphere test above, as a cosine),
-//!   with β + γ < 90°. Coarse faces of a curved region fail the first three, whose spheres and
-//!   cones span the region; this one looks at the counterpart's own neighbourhood wherever the
-//!   stream has been read (on dragon-50k's far view it took the guard from 8× to 1.4× the
-//!   unguarded front's faces).
+//!   with β + γ < 90°. Coarse faces of a curved region fail the tests on their corners, whose
+//!   spheres and cones span the region; these two look at the counterpart's own
+//!   neighbourhood wherever the stream has been read (on dragon-50k's far view they took the
+//!   guard from 8× to 1.4× the unguarded front's faces).
 //!
 //! The faces a split or collapse moves or makes are listed and checked at the end of the
-//! adaptation; a face in view that is not certain has its coarsest corner that can be split
-//! split in turn (with its dependencies) until it is — at worst down to the leaves — and a
+//! adaptation. A face in view that is not certain **first waits for the meta-nodes under the
+//! deepest loaded nodes on its counterpart's leaf paths** ([`ViewMesh::ask_for_certificate`]):
+//! they decide it, exactly once the leaves are in. Only a face that is not certain from its
+//! counterpart itself (it folds over) or whose meta-nodes cannot come (refused) has its
+//! coarsest corner that can be split split in turn (with its dependencies) until it is — at
+//! worst down to the leaves. Splitting for want of data chased each counterpart down the
+//! hierarchy, face after face, and cost the million-triangle mesh's far view 13× the unguarded
+//! front's faces (1.05× now, for 17 points more of its stream read: BENCHMARKS.md). A
 //! collapse that would leave a face in view not certain is not made. Faces out of view that
 //! are not certain stay listed, to be made certain when a view sees them (certainty out of
 //! view would refine the whole surface: 7× the faces close up, in the fly-through). A face

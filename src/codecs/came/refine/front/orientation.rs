@@ -76,41 +76,76 @@ impl ViewMesh {
         if spheres_hold_orientation(p, r).is_some_and(|cos| cos > 0.0) {
             return true;
         }
-        let cones = corners.iter().any(|&v| {
-            let cone = &self.nodes.cones[v as usize];
-            let axis = DVec3::new(
-                cone.axis[0] as f64,
-                cone.axis[1] as f64,
-                cone.axis[2] as f64,
-            );
-            // θ + α < 90° ⇔ cos θ > sin α (α widened by the cone's margin).
-            cone.is_some() && n.dot(axis) > cone.sin as f64 * area * SLACK
-        });
-        cones || self.deeper_nodes_hold_orientation(n, corners, f)
+        corners.iter().any(|&v| self.cone_holds(v, n, area))
+            || self.deeper_nodes_hold_orientation(n, corners, f)
     }
 
-    /// The counterpart's corners lie within the spheres of the deepest loaded nodes on their
-    /// leaf paths (the leaves themselves, radius 0, once loaded): a proxy triangle Q on those
-    /// nodes, whose normal makes an angle β with the face's n, and whose spheres bound the
-    /// angle γ between Q's normal and the counterpart's; the face is certain when β + γ < 90°.
-    ///
-    /// Each leaf path is walked down from the corner above the leaf (`corners`: active nodes,
-    /// or a collapse's parent), not from the root: half the steps or fewer, in nodes near each
-    /// other.
+    /// Whether normal `n` (of length `area`) is within 90° − α of the axis of node `v`'s normal
+    /// cone, which holds the normal of every face with a corner under `v`.
+    fn cone_holds(&self, v: u32, n: DVec3, area: f64) -> bool {
+        let cone = &self.nodes.cones[v as usize];
+        let axis = DVec3::new(
+            cone.axis[0] as f64,
+            cone.axis[1] as f64,
+            cone.axis[2] as f64,
+        );
+        // θ + α < 90° ⇔ cos θ > sin α (α widened by the cone's margin).
+        cone.is_some() && n.dot(axis) > cone.sin as f64 * area * SLACK
+    }
+
+    /// The deepest loaded node on each of face `f`'s leaf paths, walked down from its
+    /// `corners` (active nodes, or a collapse's parent) rather than from the root: half the
+    /// steps or fewer, in nodes near each other.
+    fn deepest_loaded(&self, corners: [u32; 3], f: u32) -> [u32; 3] {
+        let leaves = self.faces.leaf_corners[f as usize];
+        leaves.map(|leaf| {
+            let above = corners
+                .into_iter()
+                .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
+                .unwrap_or(0);
+            self.toward_from(above, leaf).0
+        })
+    }
+
+    /// Asks for the meta-nodes under the deepest loaded nodes on face `f`'s leaf paths, which
+    /// take its certificate closer to its counterpart (exact once they are leaves); true when
+    /// one of them is on its way.
+    pub(super) fn ask_for_certificate(&mut self, f: u32) -> bool {
+        let corners = self.faces.corners[f as usize];
+        let mut on_its_way = false;
+        for v in self.deepest_loaded(corners, f) {
+            if !self.is_leaf(v) {
+                on_its_way |= self.ready(v) == Ready::Waiting;
+            }
+        }
+        on_its_way
+    }
+
+    /// The deepest loaded nodes on the counterpart's leaf paths (the leaves themselves, radius
+    /// 0, once loaded) hold it: the counterpart has a corner under each, so its normal lies in
+    /// each one's normal cone, which is narrower the deeper the node; or, from their spheres,
+    /// a proxy triangle Q on those nodes, whose normal makes an angle β with the face's n, and
+    /// whose spheres bound the angle γ between Q's normal and the counterpart's; the face is
+    /// certain when β + γ < 90°.
     pub(super) fn deeper_nodes_hold_orientation(
         &self,
         n: DVec3,
         corners: [u32; 3],
         f: u32,
     ) -> bool {
-        let leaves = self.faces.leaf_corners[f as usize];
-        let deepest = leaves.map(|leaf| {
-            let above = corners
-                .into_iter()
-                .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
-                .unwrap_or(0);
-            self.toward_from(above, leaf).0
-        });
+        let deepest = self.deepest_loaded(corners, f);
+        // Every loaded node on the paths, not only the deepest: a deeper node's coded cone
+        // need not lie inside its parent's, and a face once certain stays so as more loads.
+        let area = n.length();
+        for &bottom in &deepest {
+            let mut v = bottom;
+            while !corners.contains(&v) && v != NONE {
+                if self.cone_holds(v, n, area) {
+                    return true;
+                }
+                v = self.nodes.parent[v as usize];
+            }
+        }
         let q = deepest.map(|v| self.nodes.spheres[v as usize].0);
         let r = deepest.map(|v| self.nodes.spheres[v as usize].1);
         let Some(cos_gamma) = spheres_hold_orientation(q, r) else {
@@ -234,6 +269,16 @@ impl ViewMesh {
             if done.splits + done.collapses >= budget.operations
                 || self.faces.count >= budget.faces.unwrap_or(usize::MAX)
             {
+                held.push(f);
+                unsure += 1;
+                continue;
+            }
+            // Not certain from what is loaded, but the stream holds what would tell: the
+            // face waits for it. Splitting instead chases its counterpart down the hierarchy,
+            // and the faces each split makes may be no more certain than it.
+            if self.ask_for_certificate(f) {
+                self.guard.suspected[fu] = Suspicion::Moved;
+                done.waiting += 1;
                 held.push(f);
                 unsure += 1;
                 continue;

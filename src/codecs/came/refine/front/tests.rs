@@ -577,3 +577,36 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn the_guard_reads_what_decides_a_face_rather_than_splitting_it() {
+    // A face not certain from the meta-nodes at hand waits for those that hold its
+    // counterpart's corners; splitting it instead chases the counterpart down the hierarchy,
+    // face after face (on the million-triangle mesh's far view, 13× the unguarded front's
+    // faces; BENCHMARKS.md).
+    let full = full_positions();
+    let mut ratios = Vec::new();
+    for eye in [
+        DVec3::new(0.5, 0.8, 6.0),
+        DVec3::new(3.0, 0.5, 1.0),
+        DVec3::new(-4.0, -1.0, -3.0),
+        DVec3::new(0.5, 0.8, 30.0),
+    ] {
+        for tolerance in [0.5, 2.0, 8.0] {
+            let faces = |guard: bool| {
+                let view = View::new(&camera(eye), tolerance)
+                    .unwrap()
+                    .keep_orientation(guard);
+                let mut vm = ViewMesh::from_stream(stream()).unwrap();
+                assert!(vm.settle(&view, Budget::UNLIMITED, 64).settled);
+                vm.check_invariants().unwrap();
+                if guard {
+                    assert_eq!(fold_overs_in_view(&vm, full, &view).0, 0);
+                }
+                vm.face_count()
+            };
+            ratios.push(faces(true) as f64 / faces(false) as f64);
+        }
+    }
+    assert!(ratios.iter().all(|&r| r <= 1.25), "{ratios:?}");
+}
