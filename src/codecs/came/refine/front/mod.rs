@@ -157,7 +157,8 @@ pub struct Adapted {
     pub passes: usize,
     /// Meta-nodes that arrived and were taken in at the start of the call.
     pub loaded: usize,
-    /// Splits the view wanted that wait for a meta-node (asked for; a later call makes them).
+    /// Splits the view wanted, and faces in view not yet certain of their orientation, that
+    /// wait for a meta-node (asked for; a later call makes or decides them).
     pub waiting: usize,
     /// Splits the view wanted that the stream cannot make (a refused meta-node's branch).
     pub blocked: usize,
