@@ -121,30 +121,44 @@ impl ViewMesh {
         on_its_way
     }
 
-    /// The deepest loaded nodes on the counterpart's leaf paths (the leaves themselves, radius
-    /// 0, once loaded) hold it: the counterpart has a corner under each, so its normal lies in
-    /// each one's normal cone, which is narrower the deeper the node; or, from their spheres,
-    /// a proxy triangle Q on those nodes, whose normal makes an angle β with the face's n, and
-    /// whose spheres bound the angle γ between Q's normal and the counterpart's; the face is
-    /// certain when β + γ < 90°.
+    /// The loaded nodes on the counterpart's leaf paths below `corners` (down to the leaves
+    /// themselves, radius 0, once loaded) hold it: the counterpart has a corner under each, so
+    /// its normal lies in each one's normal cone, which is narrower the deeper the node (every
+    /// node on the paths, not only the deepest: a deeper node's coded cone need not lie inside
+    /// its parent's, and a face once certain must stay so as more meta-nodes arrive); or, from
+    /// the deepest ones' spheres, a proxy triangle Q on them, whose normal makes an angle β
+    /// with the face's n, and whose spheres bound the angle γ between Q's normal and the
+    /// counterpart's; the face is certain when β + γ < 90°.
     pub(super) fn deeper_nodes_hold_orientation(
         &self,
         n: DVec3,
         corners: [u32; 3],
         f: u32,
     ) -> bool {
-        let deepest = self.deepest_loaded(corners, f);
-        // Every loaded node on the paths, not only the deepest: a deeper node's coded cone
-        // need not lie inside its parent's, and a face once certain stays so as more loads.
         let area = n.length();
-        for &bottom in &deepest {
-            let mut v = bottom;
-            while !corners.contains(&v) && v != NONE {
+        let leaves = self.faces.leaf_corners[f as usize];
+        let mut deepest = [0u32; 3];
+        for (k, leaf) in leaves.into_iter().enumerate() {
+            // Down from the corner above the leaf, not from the root: half the steps or
+            // fewer, in nodes near each other.
+            let mut v = corners
+                .into_iter()
+                .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
+                .unwrap_or(0);
+            loop {
+                let depth = self.nodes.ids[v as usize].len();
+                if depth >= leaf.len() {
+                    break;
+                }
+                match self.nodes.children[v as usize][leaf.bit(depth) as usize] {
+                    NONE => break,
+                    c => v = c,
+                }
                 if self.cone_holds(v, n, area) {
                     return true;
                 }
-                v = self.nodes.parent[v as usize];
             }
+            deepest[k] = v;
         }
         let q = deepest.map(|v| self.nodes.spheres[v as usize].0);
         let r = deepest.map(|v| self.nodes.spheres[v as usize].1);
