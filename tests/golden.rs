@@ -265,7 +265,7 @@ fn came_streams_without_deviations_still_decode_and_refine_by_their_spheres() {
         front.check_invariants().unwrap();
         front.face_count()
     };
-    // A quarter fewer at least (1,102 against 1,536 at DEVIATION_MARGIN 1.75).
+    // A quarter fewer at least (1,102 against 1,536 with syntax 2's deviations).
     let (old_faces, new_faces) = (faces(&old), faces(&new));
     assert!(
         new_faces * 4 < old_faces * 3,

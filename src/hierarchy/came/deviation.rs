@@ -15,10 +15,17 @@
 //!   into an edge or a point of it), so the fan is where its points went.
 //!   Then the other way: the points of v's fan faces (centroid, edge midpoints) to the full
 //!   mesh's faces with a corner under one of the fan face's corners; own_v is the larger.
-//!   And the other way once more on a **mixed** fan: v's leaves at v, every other leaf at its
-//!   ancestor two levels deeper — v kept coarse among finer neighbours, whose chords reach
-//!   their descendants, which no level mesh has (on the fly-through's close-ups such a chord
-//!   stood 1.49 px off the surface at 1 px before this measure, 0.89 px after).
+//! - Then both ways on **mixed** fronts, v's leaves at v and every other leaf at its ancestor
+//!   one level deeper, then two: v kept coarse among finer neighbours, whose chords reach
+//!   their descendants, which no level mesh has. The points of v's mixed fan faces to the full
+//!   mesh's faces under their corners (on the fly-through's close-ups such a chord stood
+//!   1.49 px off the surface at 1 px before this measure, 0.89 px after), and the full mesh's
+//!   points (leaves and face centroids) under v and under its neighbours to the mixed front's
+//!   faces around them ([`MixedSurface`]): where v's large fan faces cover a region its finer
+//!   neighbours stand for, the surface there is farther from them than from any level mesh.
+//!   With the second way and the front one level deeper (syntax 3), the front takes these
+//!   deviations times 1.1 (`refine::DEVIATION_MARGIN`, measured on random views and the
+//!   table's; BENCHMARKS.md); before, times 1.75.
 //! - e_v = max(own_v, e_t, e_u): monotone, so a parent never claims less than its children,
 //!   and a front whose every node projects its deviation under the tolerance has, over each
 //!   node's region, the error of the coarsest level mesh among its nodes.
@@ -40,8 +47,9 @@ use super::VertexTree;
 pub const DEVIATION_CODES: u32 = 16;
 /// Bits of a deviation code.
 pub const DEVIATION_BITS: u8 = 4;
-/// How many levels finer than a node its neighbours are taken for the mixed-front measure.
-const FINER: u8 = 2;
+/// How many levels finer than a node its neighbours are taken for the mixed-front measures
+/// (each, in turn).
+const FINER: [u8; 2] = [1, 2];
 
 /// Each node's deviation (leaves: 0), in the units of `leaves` and `positions`; `positions`
 /// holds every node's position (leaves and inner nodes).
@@ -213,69 +221,105 @@ pub fn deviations(
         // A front mixes depths: v may stay coarse while its neighbours are finer, and its fan
         // then reaches their descendants, chords no level mesh has. The same way once more,
         // with v's leaves at v and every other leaf at its ancestor FINER levels down.
-        let mut fine = active.clone();
-        fine.par_iter_mut().enumerate().for_each(|(l, a)| {
-            let id = tree.ids[l];
-            while depth_of(*a) < k + FINER {
-                let Some([t, u]) = tree.children_of(*a) else {
-                    break;
-                };
-                *a = if id.bit(depth_of(*a)) { u } else { t };
-            }
-        });
-        let mut under_fine: Vec<(u32, u32)> = Vec::new();
-        let mut touching: Vec<(u32, u32)> = Vec::new();
-        for (f, face) in faces.iter().enumerate() {
-            let corners = face.map(|c| fine[c as usize]);
-            for (i, &a) in corners.iter().enumerate() {
-                if !corners[..i].contains(&a) {
-                    under_fine.push((a, f as u32));
+        for finer in FINER {
+            let mut fine = active.clone();
+            fine.par_iter_mut().enumerate().for_each(|(l, a)| {
+                let id = tree.ids[l];
+                while depth_of(*a) < k + finer {
+                    let Some([t, u]) = tree.children_of(*a) else {
+                        break;
+                    };
+                    *a = if id.bit(depth_of(*a)) { u } else { t };
+                }
+            });
+            let mut under_fine: Vec<(u32, u32)> = Vec::new();
+            let mut touching: Vec<(u32, u32)> = Vec::new();
+            for (f, face) in faces.iter().enumerate() {
+                let corners = face.map(|c| fine[c as usize]);
+                for (i, &a) in corners.iter().enumerate() {
+                    if !corners[..i].contains(&a) {
+                        under_fine.push((a, f as u32));
+                    }
+                }
+                let coarse = face.map(|c| active[c as usize]);
+                for (i, &a) in coarse.iter().enumerate() {
+                    if slot[a as usize] != u32::MAX && !coarse[..i].contains(&a) {
+                        touching.push((slot[a as usize], f as u32));
+                    }
                 }
             }
-            let coarse = face.map(|c| active[c as usize]);
-            for (i, &a) in coarse.iter().enumerate() {
-                if slot[a as usize] != u32::MAX && !coarse[..i].contains(&a) {
-                    touching.push((slot[a as usize], f as u32));
-                }
-            }
-        }
-        under_fine.sort_unstable();
-        touching.sort_unstable();
-        let touching_at = run_starts(touching.iter().map(|&(s, _)| s), level.len());
-        let mixed: Vec<f64> = (0..level.len())
-            .into_par_iter()
-            .map(|i| {
-                let v = level[i];
-                let mut fan: Vec<[u32; 3]> = touching[touching_at[i]..touching_at[i + 1]]
-                    .iter()
-                    .map(|&(_, f)| {
-                        faces[f as usize].map(|c| {
-                            if active[c as usize] == v {
-                                v
-                            } else {
-                                fine[c as usize]
-                            }
-                        })
-                    })
-                    .filter(|c| c[0] != c[1] && c[1] != c[2] && c[0] != c[2])
-                    .collect();
-                fan.sort_unstable();
-                fan.dedup();
-                let mut worst = 0.0f64;
-                for corners in &fan {
-                    // v's own faces under v, the others' under their finer ancestors.
-                    let near: Vec<[DVec3; 3]> = corners
+            under_fine.sort_unstable();
+            touching.sort_unstable();
+            let touching_at = run_starts(touching.iter().map(|&(s, _)| s), level.len());
+            let mixed: Vec<f64> = (0..level.len())
+                .into_par_iter()
+                .map(|i| {
+                    let v = level[i];
+                    let mut fan: Vec<[u32; 3]> = touching[touching_at[i]..touching_at[i + 1]]
                         .iter()
-                        .flat_map(|&x| faces_of(if x == v { &under } else { &under_fine }, x))
-                        .map(|f| faces[f as usize].map(leaf_point))
+                        .map(|&(_, f)| {
+                            faces[f as usize].map(|c| {
+                                if active[c as usize] == v {
+                                    v
+                                } else {
+                                    fine[c as usize]
+                                }
+                            })
+                        })
+                        .filter(|c| c[0] != c[1] && c[1] != c[2] && c[0] != c[2])
                         .collect();
-                    worst = farthest_probe(corners.map(point), &near, worst);
-                }
-                worst.sqrt()
-            })
-            .collect();
-        for (&v, e) in level.iter().zip(mixed) {
-            own[v as usize] = own[v as usize].max(e);
+                    fan.sort_unstable();
+                    fan.dedup();
+                    let mut worst = 0.0f64;
+                    for corners in &fan {
+                        // v's own faces under v, the others' under their finer ancestors.
+                        let near: Vec<[DVec3; 3]> = corners
+                            .iter()
+                            .flat_map(|&x| faces_of(if x == v { &under } else { &under_fine }, x))
+                            .map(|f| faces[f as usize].map(leaf_point))
+                            .collect();
+                        worst = farthest_probe(corners.map(point), &near, worst);
+                    }
+                    // And the full mesh's points around the mixed fan to it and the finer
+                    // faces around it.
+                    let image = |c: u32| {
+                        if active[c as usize] == v {
+                            v
+                        } else {
+                            fine[c as usize]
+                        }
+                    };
+                    let mut neighbours: Vec<u32> =
+                        fan.iter().flatten().copied().filter(|&x| x != v).collect();
+                    neighbours.sort_unstable();
+                    neighbours.dedup();
+                    let mut sampled: Vec<u32> = faces_of(&under, v).collect();
+                    for &x in &neighbours {
+                        sampled.extend(faces_of(&under_fine, x));
+                    }
+                    sampled.sort_unstable();
+                    sampled.dedup();
+                    let surface = MixedSurface::new(
+                        v,
+                        &neighbours,
+                        &sampled,
+                        &under_fine,
+                        faces,
+                        image,
+                        point,
+                    );
+                    for &f in &sampled {
+                        let face = faces[f as usize];
+                        let mut samples = face.map(leaf_point).to_vec();
+                        samples.push(centroids[f as usize]);
+                        worst = surface.farthest(&samples, face.map(image), worst);
+                    }
+                    worst.sqrt()
+                })
+                .collect();
+            for (&v, e) in level.iter().zip(mixed) {
+                own[v as usize] = own[v as usize].max(e);
+            }
         }
         for &v in &level {
             slot[v as usize] = u32::MAX;
@@ -286,6 +330,102 @@ pub fn deviations(
         own[n + i] = own[n + i].max(own[t as usize]).max(own[u as usize]);
     }
     own
+}
+
+/// The surface a front shows around node v kept coarse among neighbours one or two levels
+/// finer: the images of the full mesh's faces under v, under its neighbours and under their
+/// other neighbours (each corner at v if it is under v, else at its finer ancestor), those
+/// keeping three corners — so that a sample at the neighbours' outer edge finds the surface
+/// beside it.
+struct MixedSurface {
+    triangles: Vec<[DVec3; 3]>,
+    /// (node, triangle) pairs sorted by node: the triangles at each corner.
+    at_node: Vec<(u32, u32)>,
+}
+
+impl MixedSurface {
+    fn new(
+        v: u32,
+        neighbours: &[u32],
+        sampled: &[u32],
+        under_fine: &[(u32, u32)],
+        faces: &[[u32; 3]],
+        image: impl Fn(u32) -> u32,
+        point: impl Fn(u32) -> DVec3,
+    ) -> MixedSurface {
+        let mut outer: Vec<u32> = sampled
+            .iter()
+            .flat_map(|&f| faces[f as usize].map(&image))
+            .filter(|&x| x != v && neighbours.binary_search(&x).is_err())
+            .collect();
+        outer.sort_unstable();
+        outer.dedup();
+        let mut around = sampled.to_vec();
+        for &x in &outer {
+            around.extend(faces_of(under_fine, x));
+        }
+        around.sort_unstable();
+        around.dedup();
+        let mut corners: Vec<[u32; 3]> = around
+            .iter()
+            .map(|&f| faces[f as usize].map(&image))
+            .filter(|c| distinct(*c))
+            .map(|mut c| {
+                c.sort_unstable();
+                c
+            })
+            .collect();
+        corners.sort_unstable();
+        corners.dedup();
+        let mut at_node: Vec<(u32, u32)> = corners
+            .iter()
+            .enumerate()
+            .flat_map(|(i, c)| c.map(|x| (x, i as u32)))
+            .collect();
+        at_node.sort_unstable();
+        MixedSurface {
+            triangles: corners.iter().map(|c| c.map(&point)).collect(),
+            at_node,
+        }
+    }
+
+    /// The larger of `worst` and the largest squared distance from `samples` (of one full-mesh
+    /// face, whose corners the front shows at `image`) to the surface. Each looks first at its
+    /// own face's image and the triangles at its corners, nearly always the nearest, and at
+    /// the rest only while it is farther than `worst`, which it could then raise.
+    fn farthest(&self, samples: &[DVec3], image: [u32; 3], mut worst: f64) -> f64 {
+        for &q in samples {
+            let mut d = f64::INFINITY;
+            'near: for x in image {
+                for i in faces_of(&self.at_node, x) {
+                    d = d.min(point_triangle_distance_squared(
+                        q,
+                        &self.triangles[i as usize],
+                    ));
+                    if d <= worst {
+                        break 'near;
+                    }
+                }
+            }
+            if d > worst {
+                for t in &self.triangles {
+                    d = d.min(point_triangle_distance_squared(q, t));
+                    if d <= worst {
+                        break;
+                    }
+                }
+            }
+            if d.is_finite() {
+                worst = worst.max(d);
+            }
+        }
+        worst
+    }
+}
+
+/// Whether a triangle's corners are three distinct nodes.
+fn distinct(c: [u32; 3]) -> bool {
+    c[0] != c[1] && c[1] != c[2] && c[0] != c[2]
 }
 
 /// The faces listed for `node` in `list`, (node, face) pairs sorted by node.
