@@ -54,9 +54,9 @@
 //! adaptation. A face in view that is not certain **first waits for the meta-nodes under the
 //! deepest loaded nodes on its counterpart's leaf paths** ([`ViewMesh::ask_for_certificate`]):
 //! they decide it, exactly once the leaves are in. Only a face that is not certain from its
-//! counterpart itself (it folds over) or whose meta-nodes cannot come (refused) has its
-//! coarsest corner that can be split split in turn (with its dependencies) until it is — at
-//! worst down to the leaves. Splitting for want of data chased each counterpart down the
+//! counterpart itself (it folds over) or whose meta-nodes cannot come (refused) has a corner
+//! split (with its dependencies) — the coarsest whose split alone would make it certain, else
+//! the coarsest that can be split — in turn until it is, at worst down to the leaves. Splitting for want of data chased each counterpart down the
 //! hierarchy, face after face, and cost the million-triangle mesh's far view 13× the unguarded
 //! front's faces (1.05× now, for 17 points more of its stream read: BENCHMARKS.md). A
 //! collapse that would leave a face in view not certain is not made. Faces out of view that

@@ -302,6 +302,24 @@ impl ViewMesh {
                 let radius = |v: u32| self.nodes.spheres[v as usize].1;
                 radius(b).total_cmp(&radius(a))
             });
+            // First the coarsest corner whose split alone turns the face the right way (its
+            // child on the counterpart's leaf path in its place), if one does: on dragon-50k's
+            // far view 1,178 faces against 1,264 splitting the coarsest (990 unguarded).
+            let now = self.faces.corners[fu];
+            let leaves = self.faces.leaf_corners[fu];
+            let fixes = |x: u32| {
+                let Some(k) = now.iter().position(|&c| c == x) else {
+                    return false;
+                };
+                let child = self.nodes.children[x as usize]
+                    [leaves[k].bit(self.nodes.ids[x as usize].len()) as usize];
+                let mut moved = now;
+                moved[k] = child;
+                child != NONE && self.orientation_certain(moved, f)
+            };
+            if let Some(i) = (0..3).find(|&i| fixes(corners[i])) {
+                corners[..=i].rotate_right(1);
+            }
             let mut outcome = Ready::Never;
             let mut no_room = false;
             for x in corners {

@@ -585,7 +585,7 @@ fn the_guard_reads_what_decides_a_face_rather_than_splitting_it() {
     // face after face (on the million-triangle mesh's far view, 13× the unguarded front's
     // faces; BENCHMARKS.md).
     let full = full_positions();
-    let mut ratios = Vec::new();
+    let mut counts = Vec::new();
     for eye in [
         DVec3::new(0.5, 0.8, 6.0),
         DVec3::new(3.0, 0.5, 1.0),
@@ -605,8 +605,14 @@ fn the_guard_reads_what_decides_a_face_rather_than_splitting_it() {
                 }
                 vm.face_count()
             };
-            ratios.push(faces(true) as f64 / faces(false) as f64);
+            counts.push((faces(true), faces(false)));
         }
     }
-    assert!(ratios.iter().all(|&r| r <= 1.25), "{ratios:?}");
+    // A front of a few dozen faces may need a dozen more for a face that truly folds over.
+    let (guarded, unguarded) = counts.iter().fold((0, 0), |(g, u), &(a, b)| (g + a, u + b));
+    assert!(guarded * 10 <= unguarded * 11, "{counts:?}");
+    assert!(
+        counts.iter().all(|&(g, u)| u < 100 || g * 4 <= u * 5),
+        "{counts:?}"
+    );
 }
