@@ -21,7 +21,7 @@
 //!   mesh's faces under their corners (on the fly-through's close-ups such a chord stood
 //!   1.49 px off the surface at 1 px before this measure, 0.89 px after), and the full mesh's
 //!   points (leaves and face centroids) under v and under its neighbours to the mixed front's
-//!   faces around them ([`MixedSurface`]): where v's large fan faces cover a region its finer
+//!   faces around them (`MixedSurface`): where v's large fan faces cover a region its finer
 //!   neighbours stand for, the surface there is farther from them than from any level mesh.
 //!   With the second way and the front one level deeper (syntax 3), the front takes these
 //!   deviations times 1.1 (`refine::DEVIATION_MARGIN`, measured on random views and the
