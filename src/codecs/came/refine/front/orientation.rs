@@ -5,6 +5,7 @@
 use super::super::loader::NONE;
 use super::super::view::View;
 use super::{Adapted, Budget, Ready, State, Suspicion, ViewMesh};
+use crate::hierarchy::came::NodeId;
 use glam::DVec3;
 
 /// A margin for the rounding of the orientation tests' products (relative to their size).
@@ -93,18 +94,39 @@ impl ViewMesh {
         cone.is_some() && n.dot(axis) > cone.sin as f64 * area * SLACK
     }
 
-    /// The deepest loaded node on each of face `f`'s leaf paths, walked down from its
-    /// `corners` (active nodes, or a collapse's parent) rather than from the root: half the
-    /// steps or fewer, in nodes near each other.
+    /// Walks down face `f`'s leaf path to `leaf` from the corner among `corners` above it
+    /// (active nodes, or a collapse's parent) rather than from the root — half the steps or
+    /// fewer, in nodes near each other — to the deepest loaded node on it; `None` as soon as
+    /// `stop` holds for a node below the corner.
+    fn down_leaf_path(
+        &self,
+        corners: [u32; 3],
+        leaf: NodeId,
+        stop: impl Fn(u32) -> bool,
+    ) -> Option<u32> {
+        let mut v = corners
+            .into_iter()
+            .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
+            .unwrap_or(0);
+        loop {
+            let depth = self.nodes.ids[v as usize].len();
+            if depth >= leaf.len() {
+                return Some(v);
+            }
+            match self.nodes.children[v as usize][leaf.bit(depth) as usize] {
+                NONE => return Some(v),
+                c => v = c,
+            }
+            if stop(v) {
+                return None;
+            }
+        }
+    }
+
+    /// The deepest loaded node on each of face `f`'s leaf paths.
     fn deepest_loaded(&self, corners: [u32; 3], f: u32) -> [u32; 3] {
-        let leaves = self.faces.leaf_corners[f as usize];
-        leaves.map(|leaf| {
-            let above = corners
-                .into_iter()
-                .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
-                .unwrap_or(0);
-            self.toward_from(above, leaf).0
-        })
+        self.faces.leaf_corners[f as usize]
+            .map(|leaf| self.down_leaf_path(corners, leaf, |_| false).unwrap_or(0))
     }
 
     /// Asks for the meta-nodes under the deepest loaded nodes on face `f`'s leaf paths, which
@@ -139,26 +161,10 @@ impl ViewMesh {
         let leaves = self.faces.leaf_corners[f as usize];
         let mut deepest = [0u32; 3];
         for (k, leaf) in leaves.into_iter().enumerate() {
-            // Down from the corner above the leaf, not from the root: half the steps or
-            // fewer, in nodes near each other.
-            let mut v = corners
-                .into_iter()
-                .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
-                .unwrap_or(0);
-            loop {
-                let depth = self.nodes.ids[v as usize].len();
-                if depth >= leaf.len() {
-                    break;
-                }
-                match self.nodes.children[v as usize][leaf.bit(depth) as usize] {
-                    NONE => break,
-                    c => v = c,
-                }
-                if self.cone_holds(v, n, area) {
-                    return true;
-                }
+            match self.down_leaf_path(corners, leaf, |v| self.cone_holds(v, n, area)) {
+                Some(v) => deepest[k] = v,
+                None => return true,
             }
-            deepest[k] = v;
         }
         let q = deepest.map(|v| self.nodes.spheres[v as usize].0);
         let r = deepest.map(|v| self.nodes.spheres[v as usize].1);
