@@ -408,12 +408,7 @@ impl MixedSurface {
                 }
             }
             if d > worst {
-                for t in &self.triangles {
-                    d = d.min(point_triangle_distance_squared(q, t));
-                    if d <= worst {
-                        break;
-                    }
-                }
+                d = nearest_within(q, &self.triangles, d, worst);
             }
             if d.is_finite() {
                 worst = worst.max(d);
@@ -421,6 +416,18 @@ impl MixedSurface {
         }
         worst
     }
+}
+
+/// The squared distance from `q` to the nearest of `near`, or `d` if that is nearer; it stops
+/// looking once within `worst`, which it can then no longer raise.
+fn nearest_within(q: DVec3, near: &[[DVec3; 3]], mut d: f64, worst: f64) -> f64 {
+    for t in near {
+        d = d.min(point_triangle_distance_squared(q, t));
+        if d <= worst {
+            break;
+        }
+    }
+    d
 }
 
 /// Whether a triangle's corners are three distinct nodes.
@@ -447,13 +454,7 @@ fn farthest_probe(p: [DVec3; 3], near: &[[DVec3; 3]], mut worst: f64) -> f64 {
         (b + c) / 2.0,
         (c + a) / 2.0,
     ] {
-        let mut d = f64::INFINITY;
-        for t in near {
-            d = d.min(point_triangle_distance_squared(q, t));
-            if d <= worst {
-                break;
-            }
-        }
+        let d = nearest_within(q, near, f64::INFINITY, worst);
         if d.is_finite() {
             worst = worst.max(d);
         }

@@ -359,6 +359,15 @@ impl ModelledUnits {
                 }
                 *p += d as f64;
             }
+            // Differences add up down the tree: a corrupt stream's can take a node where the
+            // grid's cells multiply out past the largest float.
+            if !crate::codecs::came::decoded::to_world(&header.grid, pu).is_finite() {
+                return Err(Error::malformed(
+                    0,
+                    at,
+                    "a node lies beyond the grid's reach",
+                ));
+            }
             let positions = [ps, pu];
             let mut radii = [0.0; 2];
             let mut deviations = [0.0f32; 2];

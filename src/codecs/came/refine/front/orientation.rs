@@ -317,8 +317,13 @@ impl ViewMesh {
                 let Some(k) = now.iter().position(|&c| c == x) else {
                     return false;
                 };
-                let child = self.nodes.children[x as usize]
-                    [leaves[k].bit(self.nodes.ids[x as usize].len()) as usize];
+                // (A corner is on its leaf's path above it, but a corrupt stream may say
+                // otherwise.)
+                let depth = self.nodes.ids[x as usize].len();
+                if depth >= leaves[k].len() {
+                    return false;
+                }
+                let child = self.nodes.children[x as usize][leaves[k].bit(depth) as usize];
                 let mut moved = now;
                 moved[k] = child;
                 child != NONE && self.orientation_certain(moved, f)
