@@ -255,18 +255,19 @@ pub fn deviations(
                 .into_par_iter()
                 .map(|i| {
                     let v = level[i];
+                    // Where the mixed front shows a leaf: at v if it is under v, else at its
+                    // finer ancestor.
+                    let image = |c: u32| {
+                        if active[c as usize] == v {
+                            v
+                        } else {
+                            fine[c as usize]
+                        }
+                    };
                     let mut fan: Vec<[u32; 3]> = touching[touching_at[i]..touching_at[i + 1]]
                         .iter()
-                        .map(|&(_, f)| {
-                            faces[f as usize].map(|c| {
-                                if active[c as usize] == v {
-                                    v
-                                } else {
-                                    fine[c as usize]
-                                }
-                            })
-                        })
-                        .filter(|c| c[0] != c[1] && c[1] != c[2] && c[0] != c[2])
+                        .map(|&(_, f)| faces[f as usize].map(image))
+                        .filter(|&c| distinct(c))
                         .collect();
                     fan.sort_unstable();
                     fan.dedup();
@@ -282,13 +283,6 @@ pub fn deviations(
                     }
                     // And the full mesh's points around the mixed fan to it and the finer
                     // faces around it.
-                    let image = |c: u32| {
-                        if active[c as usize] == v {
-                            v
-                        } else {
-                            fine[c as usize]
-                        }
-                    };
                     let mut neighbours: Vec<u32> =
                         fan.iter().flatten().copied().filter(|&x| x != v).collect();
                     neighbours.sort_unstable();
