@@ -115,10 +115,9 @@ pub fn deviations(
         }
         for (f, &centroid) in centroids.iter().enumerate() {
             let corners = image(f);
-            let distinct =
-                corners[0] != corners[1] && corners[1] != corners[2] && corners[0] != corners[2];
+            let three = distinct(corners);
             for (i, &a) in corners.iter().enumerate() {
-                if distinct {
+                if three {
                     at_corner.push((a, f as u32));
                 }
                 let s = slot[a as usize];
@@ -189,9 +188,7 @@ pub fn deviations(
                     under.push((a, f as u32));
                 }
             }
-            let distinct =
-                corners[0] != corners[1] && corners[1] != corners[2] && corners[0] != corners[2];
-            if distinct && corners.iter().any(|&a| slot[a as usize] != u32::MAX) {
+            if distinct(corners) && corners.iter().any(|&a| slot[a as usize] != u32::MAX) {
                 let mut key = corners;
                 key.sort_unstable();
                 level_faces.push(key);

@@ -108,19 +108,13 @@ impl ViewMesh {
             .into_iter()
             .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
             .unwrap_or(0);
-        loop {
-            let depth = self.nodes.ids[v as usize].len();
-            if depth >= leaf.len() {
-                return Some(v);
-            }
-            match self.nodes.children[v as usize][leaf.bit(depth) as usize] {
-                NONE => return Some(v),
-                c => v = c,
-            }
+        while let Some(c) = self.child_toward(v, leaf) {
+            v = c;
             if stop(v) {
                 return None;
             }
         }
+        Some(v)
     }
 
     /// The deepest loaded node on each of face `f`'s leaf paths.
@@ -317,16 +311,12 @@ impl ViewMesh {
                 let Some(k) = now.iter().position(|&c| c == x) else {
                     return false;
                 };
-                // (A corner is on its leaf's path above it, but a corrupt stream may say
-                // otherwise.)
-                let depth = self.nodes.ids[x as usize].len();
-                if depth >= leaves[k].len() {
+                let Some(child) = self.child_toward(x, leaves[k]) else {
                     return false;
-                }
-                let child = self.nodes.children[x as usize][leaves[k].bit(depth) as usize];
+                };
                 let mut moved = now;
                 moved[k] = child;
-                child != NONE && self.orientation_certain(moved, f)
+                self.orientation_certain(moved, f)
             };
             if let Some(i) = (0..3).find(|&i| fixes(corners[i])) {
                 corners[..=i].rotate_right(1);

@@ -47,16 +47,20 @@ impl ViewMesh {
     /// [`ViewMesh::toward`], walking down from `start`, an ancestor of `id` (or `id`).
     pub(super) fn toward_from(&self, start: u32, id: NodeId) -> (u32, bool) {
         let mut v = start;
-        loop {
-            let len = self.nodes.ids[v as usize].len();
-            if len >= id.len() {
-                return (v, self.nodes.ids[v as usize] == id);
-            }
-            match self.nodes.children[v as usize][id.bit(len) as usize] {
-                NONE => return (v, false),
-                c => v = c,
-            }
+        while let Some(c) = self.child_toward(v, id) {
+            v = c;
         }
+        (v, self.nodes.ids[v as usize] == id)
+    }
+
+    /// The loaded child of `v` on the path to `id`: none when `v` is as deep as `id` (or,
+    /// in a corrupt stream, deeper) or that child is not loaded.
+    pub(super) fn child_toward(&self, v: u32, id: NodeId) -> Option<u32> {
+        let depth = self.nodes.ids[v as usize].len();
+        if depth >= id.len() {
+            return None;
+        }
+        Some(self.nodes.children[v as usize][id.bit(depth) as usize]).filter(|&c| c != NONE)
     }
 
     /// A node to split before `v` may be: its first dependency not split (or planned to be),
