@@ -106,6 +106,8 @@ pub enum CameField {
     Deviations,
     /// The priors every unit's contexts start from (`came` syntax 2; not in the paper).
     Priors,
+    /// Triangles' own normals (`came` syntax 4; not in the paper).
+    FaceNormals,
 }
 
 impl CameField {
@@ -119,11 +121,12 @@ impl CameField {
             CameField::Cones => "cones",
             CameField::Deviations => "deviations",
             CameField::Priors => "priors",
+            CameField::FaceNormals => "triangle normals",
         }
     }
 
     /// Every field.
-    pub const ALL: [CameField; 7] = [
+    pub const ALL: [CameField; 8] = [
         CameField::Connectivity,
         CameField::Dependencies,
         CameField::Coordinates,
@@ -131,6 +134,7 @@ impl CameField {
         CameField::Cones,
         CameField::Deviations,
         CameField::Priors,
+        CameField::FaceNormals,
     ];
 }
 

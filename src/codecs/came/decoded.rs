@@ -8,6 +8,7 @@ use crate::codecs::{LevelDecoder, LevelMesh};
 use crate::container::{Header, Index, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::CodedCone;
+pub use crate::hierarchy::came::face_normals::FaceNormal;
 use crate::hierarchy::came::NodeId;
 use crate::mesh::TriMesh;
 use glam::DVec3;
@@ -39,13 +40,16 @@ pub struct Node {
     pub split_unit: Option<NodeId>,
 }
 
-/// A decoded triangle: its corners' leaf paths in face order, and the depth of its split.
+/// A decoded triangle: its corners' leaf paths in face order, the depth of its split, and what
+/// the stream says of its normal.
 #[derive(Clone, Copy, Debug)]
 pub struct Triangle {
     /// Leaf paths of the corners, oriented.
     pub corners: [NodeId; 3],
     /// Depth of the node whose split creates it.
     pub birth_depth: u8,
+    /// Its normal in the mesh's units (`came` syntax 4), known where it is born.
+    pub normal: FaceNormal,
 }
 
 /// The sizes of a [`DecodedTree`] at one moment.

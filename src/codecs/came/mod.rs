@@ -122,12 +122,19 @@ pub struct Params {
     /// Bits of a deviation code (0: the stream codes no deviations, and refinement projects
     /// the spheres).
     pub deviation_bits: u8,
+    /// Steps of a triangle normal's octahedral half axis (syntax 4; 0: the stream codes no
+    /// triangle normals, `hierarchy::came::face_normals`).
+    pub face_normal_steps: u8,
+    /// The largest angle between a coded triangle normal and the triangle's, in half-degrees
+    /// (`face_normals::bound_code`).
+    pub face_normal_bound: u8,
 }
 
 impl Params {
     /// The header bytes: levels per meta-node, depth, bits per component, bits per radius
     /// ratio; and, with `per_node_bounds` (`came`), the bits of the cones' axes and of the
-    /// deviations (0: the stream codes none).
+    /// deviations (0: the stream codes none), then, with triangle normals (syntax 4), their
+    /// steps and bound.
     pub fn to_bytes(self, per_node_bounds: bool) -> Vec<u8> {
         let mut bytes = vec![
             self.meta_levels,
@@ -137,6 +144,9 @@ impl Params {
         ];
         if per_node_bounds {
             bytes.extend([self.cone_bits, self.deviation_bits]);
+            if self.face_normal_steps > 0 {
+                bytes.extend([self.face_normal_steps, self.face_normal_bound]);
+            }
         }
         bytes
     }
@@ -149,12 +159,18 @@ impl Params {
         per_node_bounds: bool,
     ) -> Result<Params> {
         let bad = |what: &str| Error::malformed(0, 0, format!("CAME parameters: {what}"));
-        let expected = if per_node_bounds { 6 } else { 4 };
-        if bytes.len() != expected {
+        let expected: &[usize] = if per_node_bounds { &[6, 8] } else { &[4] };
+        if !expected.contains(&bytes.len()) {
+            let expected: Vec<String> = expected.iter().map(|n| n.to_string()).collect();
+            let expected = expected.join(" or ");
             return Err(bad(&format!("{expected} bytes expected")));
         }
         let (cone_bits, deviation_bits) = match bytes {
-            [_, _, _, _, cones, deviations] => (*cones, *deviations),
+            [_, _, _, _, cones, deviations, ..] => (*cones, *deviations),
+            _ => (0, 0),
+        };
+        let (face_normal_steps, face_normal_bound) = match bytes {
+            [_, _, _, _, _, _, steps, bound] => (*steps, *bound),
             _ => (0, 0),
         };
         let [meta_levels, depth, component_bits, radius_bits] =
@@ -178,6 +194,8 @@ impl Params {
             radius_bits,
             cone_bits,
             deviation_bits,
+            face_normal_steps,
+            face_normal_bound,
         })
     }
 }
@@ -293,15 +311,18 @@ pub struct Layout {
     pub cone_bits: u8,
     /// Bits of a deviation code (0: no deviations).
     pub deviation_bits: u8,
+    /// Steps of a triangle normal's octahedral half axis (0: no triangle normals).
+    pub face_normal_steps: u8,
 }
 
 /// Encodes `mesh` as a CAME stream: builds the hierarchy, partitions it into meta-nodes, has
-/// `code_units` code every unit in stream order, and writes the stream with its levels and
-/// statistics.
+/// `code_units` code every unit in stream order (and say the bound of the triangle normals they
+/// code, in half-degrees: `hierarchy::came::face_normals`), and writes the stream with its
+/// levels and statistics.
 pub fn encode_stream(
     mesh: &CanonicalMesh,
     layout: Layout,
-    code_units: impl FnOnce(&VertexTree, &Partition) -> Vec<CodedUnit>,
+    code_units: impl FnOnce(&VertexTree, &Partition) -> (Vec<CodedUnit>, u8),
 ) -> Result<crate::codecs::Encoded> {
     let started = std::time::Instant::now();
     let tree = hierarchy(mesh)?;
@@ -314,9 +335,16 @@ pub fn encode_stream(
         radius_bits: layout.radius_bits,
         cone_bits: layout.cone_bits,
         deviation_bits: layout.deviation_bits,
+        face_normal_steps: layout.face_normal_steps,
+        face_normal_bound: 0,
+    };
+    let (coded, face_normal_bound) = code_units(&tree, &part);
+    let params = Params {
+        face_normal_bound,
+        ..params
     };
     let mut fields = std::collections::BTreeMap::<&'static str, f64>::new();
-    let units: Vec<(Vec<u8>, LevelCost)> = code_units(&tree, &part)
+    let units: Vec<(Vec<u8>, LevelCost)> = coded
         .into_iter()
         .map(|(bytes, ledger, unit_fields)| {
             for (k, v) in unit_fields {

@@ -13,7 +13,7 @@
 //! bound the vertices as decoded. The full level is not the input mesh: it is reported with its
 //! Hausdorff error.
 
-use super::decoded::{CameDecoder, DecodedTree, Triangle, UnitDecoder};
+use super::decoded::{CameDecoder, DecodedTree, FaceNormal, Triangle, UnitDecoder};
 use super::frame::Frame;
 use super::partition::{Partition, Tails};
 use super::{born_triangles, cut_at, encode_stream, BornTriangle, Layout, Params};
@@ -201,6 +201,7 @@ impl Codec for CamePaper {
             radius_bits: RADIUS_BITS,
             cone_bits: 0,
             deviation_bits: 0,
+            face_normal_steps: 0,
         };
         let bits = self.component_bits;
         encode_stream(mesh, layout, |tree, part| {
@@ -216,7 +217,7 @@ impl Codec for CamePaper {
                 .iter()
                 .map(|c| Huffman::from_lengths(&Huffman::lengths_for(c)))
                 .collect();
-            (0..part.units.len())
+            let units = (0..part.units.len())
                 .map(|m| {
                     let mut writer = Writer {
                         sink: BitSink::default(),
@@ -234,7 +235,8 @@ impl Codec for CamePaper {
                     let (bytes, ledger) = writer.sink.finish();
                     (bytes, ledger, writer.fields)
                 })
-                .collect()
+                .collect();
+            (units, 0)
         })
     }
 
@@ -638,6 +640,7 @@ impl UnitDecoder for PaperUnits {
                     Triangle {
                         corners,
                         birth_depth: sid.len(),
+                        normal: FaceNormal::Unknown,
                     },
                     at,
                 )?;

@@ -23,6 +23,7 @@
 mod build;
 pub mod cones;
 pub mod deviation;
+pub mod face_normals;
 mod grid;
 pub mod node_id;
 pub mod spheres;

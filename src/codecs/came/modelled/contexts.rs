@@ -48,6 +48,10 @@ pub(super) struct Contexts {
     /// coordinates of an axis of its own (differences from the square's centre).
     pub(super) cone_angle: Vec<Vec<BitContext>>,
     pub(super) cone_axis: [IntContext; 2],
+    /// A triangle's normal (syntax 4): whether it has no area; its code's two coordinates.
+    /// Not among the priors: each unit learns them afresh.
+    pub(super) face_no_area: BitContext,
+    pub(super) face_normal: [IntContext; 2],
     /// Per radius class, where its difference vectors' contexts start when first used: the
     /// probability of a 1 of each binary context ([`IntContext::bits_mut`]'s order, the three
     /// axes in turn; 0: even odds), or nothing (syntax 2's priors, [`super::priors`]).
@@ -78,6 +82,8 @@ impl Contexts {
             stop: [BitContext::default(); 16],
             cone_angle: vec![vec![BitContext::default(); 1 << ANGLE_BITS]; CONE_CLASSES],
             cone_axis: Default::default(),
+            face_no_area: BitContext::default(),
+            face_normal: Default::default(),
             class_priors: None,
         }
     }

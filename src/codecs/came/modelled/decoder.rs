@@ -1,6 +1,6 @@
 //! `came`'s unit decoder: a unit's two passes read back into the decoded tree.
 
-use super::super::decoded::{DecodedTree, Triangle, UnitDecoder};
+use super::super::decoded::{DecodedTree, FaceNormal, Triangle, UnitDecoder};
 use super::super::knowledge::Status;
 use super::super::{cut_at, Params};
 use super::contexts::*;
@@ -11,6 +11,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self, CodedCone, ANGLE_BITS, NO_CONE};
 use crate::hierarchy::came::deviation::{decoded_deviation, round_up, DEVIATION_BITS};
 use crate::hierarchy::came::spheres::{decoded_radius, ratio_base};
+use crate::hierarchy::came::face_normals::{bound_degrees, decoded, scaled_normal};
 use crate::hierarchy::came::NodeId;
 use crate::mesh::attribute_quantization::octahedral_max;
 
@@ -153,17 +154,22 @@ impl UnitReader<'_> {
         (self.tree.status_of(child, self.unit), Some(child))
     }
 
-    /// A leaf's path from `start` (decoded node `known`).
+    /// A leaf's path from `start` (decoded node `known`), and its proxy: the first node on it
+    /// that is not an inner node whose split the unit knows (`hierarchy::came::face_normals`).
     fn leaf_path(
         &mut self,
         start: NodeId,
         known: u32,
         target: [f64; 3],
         kind: Kind,
-    ) -> Result<NodeId> {
+    ) -> Result<(NodeId, u32)> {
         let mut x = start;
         let (mut status, mut node) = (self.tree.status_of(known, self.unit), Some(known));
+        let mut proxy = None;
         loop {
+            if status != Status::Inner && proxy.is_none() {
+                proxy = node;
+            }
             let depth = x.len() as usize;
             let ends_here = match status {
                 Status::Leaf => true,
@@ -171,7 +177,7 @@ impl UnitReader<'_> {
                 Status::Inner | Status::Open => false,
             };
             if ends_here {
-                return Ok(x);
+                return Ok((x, proxy.unwrap_or(known)));
             }
             let bit = if status == Status::Inner {
                 let (_, positions) = self.children_positions(node.expect("decoded"));
@@ -184,6 +190,43 @@ impl UnitReader<'_> {
             (status, node) = self.descend(status, node, bit);
             x = self.child(x, bit)?;
         }
+    }
+
+    /// What the stream says of a triangle's normal (syntax 4), after its orientation bit: on
+    /// proxies that are its leaves, the normal they make; else a code about theirs.
+    fn face_normal(&mut self, proxies: [u32; 3], params: &Params, cell: [f64; 3]) -> Result<FaceNormal> {
+        let steps = params.face_normal_steps;
+        if steps == 0 {
+            return Ok(FaceNormal::Unknown);
+        }
+        let at = proxies.map(|p| self.tree.nodes[p as usize].position);
+        let normal = scaled_normal(at, cell);
+        if proxies.iter().all(|&p| self.tree.nodes[p as usize].leaf) {
+            let length = normal.length();
+            return Ok(if length > 0.0 && length.is_finite() {
+                FaceNormal::Within {
+                    direction: normal / length,
+                    degrees: 0.0,
+                }
+            } else {
+                FaceNormal::NoArea
+            });
+        }
+        if self.bit(|c| &mut c.face_no_area)? {
+            return Ok(FaceNormal::NoArea);
+        }
+        let mut code = [0i32; 2];
+        for (k, c) in code.iter_mut().enumerate() {
+            let v = self.dec.int(&mut self.ctx.face_normal[k]).ok_or_else(|| self.cut())?;
+            if v.unsigned_abs() > steps as u64 {
+                return Err(Error::malformed(0, self.at, "a triangle normal's code runs past its square"));
+            }
+            *c = v as i32;
+        }
+        Ok(FaceNormal::Within {
+            direction: decoded(normal, code, steps),
+            degrees: bound_degrees(params.face_normal_bound),
+        })
     }
 
     fn dependency_path(&mut self, start: NodeId, known: u32) -> Result<NodeId> {
@@ -423,19 +466,25 @@ impl ModelledUnits {
             let mut thirds = Vec::with_capacity(count as usize);
             for _ in 0..count {
                 let [t, u] = children;
-                let n1 = r.leaf_path(r.child(sid, false)?, t, positions[1], Kind::N1)?;
-                let n2 = r.leaf_path(r.child(sid, true)?, u, positions[0], Kind::N2)?;
+                let (n1, p1) = r.leaf_path(r.child(sid, false)?, t, positions[1], Kind::N1)?;
+                let (n2, p2) = r.leaf_path(r.child(sid, true)?, u, positions[0], Kind::N2)?;
                 let up = r.uint(|c| &mut c.up, 52, "n3.up")? + 1;
                 let (start, start_node) = r.other_child(s, up)?;
-                let n3 = r.leaf_path(start, start_node, ps, Kind::N3)?;
+                let (n3, p3) = r.leaf_path(start, start_node, ps, Kind::N3)?;
                 thirds.push((n3, start.len()));
                 let flipped = r.bit(|c| &mut c.orientation[previous])?;
                 previous = 1 + flipped as usize;
-                let corners = if flipped { [n2, n1, n3] } else { [n1, n2, n3] };
+                let (corners, proxies) = if flipped {
+                    ([n2, n1, n3], [p2, p1, p3])
+                } else {
+                    ([n1, n2, n3], [p1, p2, p3])
+                };
+                let normal = r.face_normal(proxies, params, header.grid.cell)?;
                 r.tree.add_triangle(
                     Triangle {
                         corners,
                         birth_depth: sid.len(),
+                        normal,
                     },
                     at,
                 )?;

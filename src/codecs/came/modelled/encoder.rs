@@ -13,6 +13,7 @@ use crate::hierarchy::came::deviation::{
     decoded_deviation, deviation_code, deviations, round_up, DEVIATION_BITS,
 };
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
+use crate::hierarchy::came::face_normals::{self, nearest_code, scaled_normal};
 use crate::hierarchy::came::{NodeId, VertexTree};
 use crate::mesh::attribute_quantization::octahedral_max;
 use crate::mesh::CanonicalMesh;
@@ -55,6 +56,12 @@ pub(super) struct Encoder<'a> {
     /// Each node's normal cone as coded.
     cones: Vec<CodedCone>,
     born: Vec<Vec<BornTriangle>>,
+    /// Per triangle born at each split (`born`'s order): its normal's code
+    /// (`hierarchy::came::face_normals`) — nothing where its proxies are its leaves, `None`
+    /// for a triangle of no area.
+    face_normal_codes: Vec<Vec<Option<Option<[i32; 2]>>>>,
+    /// The largest angle between a coded normal and its triangle's, in degrees.
+    face_normal_error: f64,
 }
 
 impl<'a> Encoder<'a> {
@@ -103,7 +110,7 @@ impl<'a> Encoder<'a> {
             }
         }
         let cones = coded_cones(tree, &mesh.cells, &mesh.faces, mesh.grid.cell);
-        Encoder {
+        let mut encoder = Encoder {
             tree,
             part,
             grid_bits: mesh.grid.bits,
@@ -114,7 +121,74 @@ impl<'a> Encoder<'a> {
             deviation_codes,
             cones,
             born: born_triangles(tree, mesh),
+            face_normal_codes: Vec::new(),
+            face_normal_error: 0.0,
+        };
+        encoder.code_face_normals(mesh.grid.cell);
+        encoder
+    }
+
+    /// Codes every triangle's normal about its proxies (the first node of each corner's leaf
+    /// path whose split its unit does not know), noting the largest angle a code is off by.
+    fn code_face_normals(&mut self, cell: [f64; 3]) {
+        let tree = self.tree;
+        let mut codes = vec![Vec::new(); self.born.len()];
+        let mut worst = 0.0f64;
+        for meta in &self.part.units {
+            let unit = tree.ids[meta.root as usize];
+            for &s in &meta.nodes {
+                let [t, u] = tree.children_of(s).expect("inner");
+                let sid = tree.ids[s as usize];
+                let born = &self.born[s as usize - tree.leaves];
+                codes[s as usize - tree.leaves] = born
+                    .iter()
+                    .map(|tri| {
+                        let [l1, l2, l3] = tri.leaves;
+                        let up = sid.len() - tree.ids[l3 as usize].common_len(sid);
+                        let third = self.other_child(s, up);
+                        let proxies = [(t, l1), (u, l2), (third, l3)]
+                            .map(|(start, leaf)| self.proxy(start, leaf, unit));
+                        if proxies.iter().all(|&p| tree.is_leaf(p)) {
+                            return None;
+                        }
+                        let oriented = |p: [u32; 3]| {
+                            let p = if tri.flipped { [p[1], p[0], p[2]] } else { p };
+                            scaled_normal(p.map(|v| self.positions[v as usize]), cell)
+                        };
+                        let proxy = oriented(proxies);
+                        let normal = oriented(tri.leaves);
+                        let code = nearest_code(proxy, normal, face_normals::STEPS);
+                        if let Some((_, angle)) = code {
+                            worst = worst.max(angle);
+                        }
+                        Some(code.map(|(code, _)| code))
+                    })
+                    .collect();
+            }
         }
+        self.face_normal_codes = codes;
+        self.face_normal_error = worst;
+    }
+
+    /// The header's bound on the coded normals' error (`face_normals::bound_code`).
+    pub(super) fn face_normal_bound(&self) -> u8 {
+        face_normals::bound_code(self.face_normal_error)
+    }
+
+    /// The first node on the path from `start` to `leaf` that is not an inner node whose
+    /// split `unit` knows: the deepest whose position the unit and its ancestors give.
+    fn proxy(&self, start: u32, leaf: u32, unit: NodeId) -> u32 {
+        let lid = self.tree.ids[leaf as usize];
+        let mut x = start;
+        while self.status(x, unit) == Status::Inner {
+            let [a, b] = self.tree.children_of(x).expect("inner");
+            x = if lid.bit(self.tree.ids[x as usize].len()) {
+                b
+            } else {
+                a
+            };
+        }
+        x
     }
 
     fn status(&self, x: u32, unit: NodeId) -> Status {
@@ -245,7 +319,8 @@ impl<'a> Encoder<'a> {
                 "connectivity",
             );
             let mut previous = 0;
-            for tri in born {
+            let normals = &self.face_normal_codes[s as usize - tree.leaves];
+            for (tri, normal) in born.iter().zip(normals) {
                 let [l1, l2, l3] = tri.leaves;
                 let (pt, pu, ps) = (
                     self.positions[t as usize],
@@ -266,6 +341,13 @@ impl<'a> Encoder<'a> {
                     "connectivity",
                 );
                 previous = 1 + tri.flipped as usize;
+                if let Some(code) = normal {
+                    let name = "triangle normals";
+                    enc.bit(&mut ctx.face_no_area, code.is_none(), G, name);
+                    for (k, &c) in code.iter().flatten().enumerate() {
+                        enc.int(&mut ctx.face_normal[k], c as i64, G, name);
+                    }
+                }
             }
             let deps = &tree.dependencies[s as usize - tree.leaves];
             enc.uint(&mut ctx.dependencies, deps.len() as u64, C, "dependencies");

@@ -30,6 +30,7 @@ use crate::codecs::{names, Capability, Codec, Encoded, LevelDecoder, Stats};
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self};
+use crate::hierarchy::came::face_normals;
 use crate::hierarchy::came::deviation::DEVIATION_BITS;
 use crate::mesh::CanonicalMesh;
 
@@ -74,9 +75,11 @@ impl Codec for Came {
             radius_bits: RADIUS_BITS,
             cone_bits: cones::AXIS_BITS,
             deviation_bits: DEVIATION_BITS,
+            face_normal_steps: face_normals::STEPS,
         };
         encode_stream(mesh, layout, |tree, part| {
-            Encoder::new(tree, mesh, part).units()
+            let encoder = Encoder::new(tree, mesh, part);
+            (encoder.units(), encoder.face_normal_bound())
         })
     }
 
@@ -109,6 +112,32 @@ pub fn params(header: &Header) -> Result<Params> {
             0,
             0,
             format!("came streams code deviations on {DEVIATION_BITS} bits"),
+        ));
+    }
+    // Syntax 4 adds the triangle normals' steps and bound; earlier syntaxes have none.
+    let with_face_normals = header.syntax >= 4;
+    if with_face_normals != (header.params.len() == 8) {
+        return Err(Error::malformed(
+            0,
+            0,
+            format!(
+                "came syntax {} has {} parameter bytes",
+                header.syntax,
+                if with_face_normals { 8 } else { 6 }
+            ),
+        ));
+    }
+    if with_face_normals
+        && (params.face_normal_steps != face_normals::STEPS
+            || params.face_normal_bound > face_normals::BOUND_HALF_DEGREES_MAX)
+    {
+        return Err(Error::malformed(
+            0,
+            0,
+            format!(
+                "came streams code triangle normals in {} steps within at most 90°",
+                face_normals::STEPS
+            ),
         ));
     }
     if ![0, cones::AXIS_BITS].contains(&params.cone_bits) {

@@ -12,6 +12,7 @@ use crate::codecs::came::selective::DetachedUnits;
 use crate::container::{read_header_and_index, Header, Index};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::NormalCone;
+use crate::hierarchy::came::face_normals::FaceNormal;
 use crate::hierarchy::came::NodeId;
 use glam::DVec3;
 use smallvec::SmallVec;
@@ -138,8 +139,9 @@ pub(super) struct Dependency {
 #[derive(Debug, Default)]
 pub(super) struct UnitDelta {
     pub nodes: Vec<NewNode>,
-    /// Per triangle: the node whose split creates it, and its corners' leaf paths.
-    pub triangles: Vec<(u32, [NodeId; 3])>,
+    /// Per triangle: the node whose split creates it, its corners' leaf paths, and what the
+    /// stream says of its normal.
+    pub triangles: Vec<(u32, [NodeId; 3], FaceNormal)>,
     /// Per split: the node and the splits it depends on.
     pub splits: Vec<(u32, SmallVec<[Dependency; 2]>)>,
     /// The units under this one and their root nodes, open until they are loaded.
@@ -198,7 +200,7 @@ fn delta(decoded: &DecodedUnit, header: &Header) -> Result<UnitDelta> {
             .and_then(|b| tree.get(b))
             .filter(|&b| split_here(b))
             .ok_or_else(|| bad("a triangle's corners do not part at a split of its unit"))?;
-        out.triangles.push((birth, c));
+        out.triangles.push((birth, c, t.normal));
     }
     for k in since.dependencies..tree.dependencies.len() {
         let (s, deps) = tree.dependencies_of(k);

@@ -2,6 +2,7 @@
 //! hierarchy under the front, and whether a node's split is loaded, on its way or impossible.
 
 use super::super::loader::{Loaded, UnitDelta, NONE};
+use super::orientation::CodedNormal;
 use super::{Ready, State, Suspicion, UnitState, ViewMesh};
 use smallvec::SmallVec;
 
@@ -60,9 +61,10 @@ impl ViewMesh {
         self.front
             .active_bits
             .resize(self.nodes.ids.len().div_ceil(64), 0);
-        for (birth, corners) in delta.triangles {
+        for (birth, corners, normal) in delta.triangles {
             self.nodes.born[birth as usize].push(self.faces.leaf_corners.len() as u32);
             self.faces.leaf_corners.push(corners);
+            self.faces.normals.push(CodedNormal::from(normal));
             self.faces.corners.push([NONE; 3]);
             self.faces.present.push(false);
             self.guard.suspected.push(Suspicion::None);

@@ -5,6 +5,7 @@
 use super::super::loader::NONE;
 use super::super::view::View;
 use super::{Adapted, Budget, Ready, State, Suspicion, ViewMesh};
+use crate::hierarchy::came::face_normals::FaceNormal;
 use crate::hierarchy::came::NodeId;
 use glam::DVec3;
 
@@ -30,6 +31,52 @@ fn spheres_hold_orientation(p: [DVec3; 3], r: [f64; 3]) -> Option<f64> {
             (area > slack).then(|| (area - slack) / ((e1 + r1) * (e2 + r2)))
         })
         .reduce(f64::max)
+}
+
+/// What a triangle's own coded normal proves (`came` syntax 4,
+/// `hierarchy::came::face_normals`): its counterpart's normal lies within the angle whose sine
+/// is `sin` of the unit vector `direction` — `sin` below 0 for a counterpart of no area (which
+/// turns no way), above 1 where the stream says nothing.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CodedNormal {
+    direction: [f32; 3],
+    sin: f32,
+}
+
+impl CodedNormal {
+    pub(super) fn from(normal: FaceNormal) -> CodedNormal {
+        match normal {
+            FaceNormal::Within { direction, degrees } if degrees < 90.0 => CodedNormal {
+                direction: direction.as_vec3().to_array(),
+                // The direction's rounding to f32 is within 1e-7.
+                sin: (degrees.to_radians().sin() + 1e-6) as f32,
+            },
+            FaceNormal::NoArea => CodedNormal {
+                direction: [0.0; 3],
+                sin: -1.0,
+            },
+            _ => CodedNormal {
+                direction: [0.0; 3],
+                sin: 2.0,
+            },
+        }
+    }
+
+    /// Whether it decides every face standing for the triangle: certain, or folding over.
+    pub(super) fn decides(self) -> bool {
+        self.sin <= 1.0
+    }
+
+    /// Whether a face of normal `n` (of length `area`) surely turns within 90° of the
+    /// counterpart's: n's angle to the direction and the bound sum to less than 90°.
+    fn holds(self, n: DVec3, area: f64) -> bool {
+        let d = DVec3::new(
+            self.direction[0] as f64,
+            self.direction[1] as f64,
+            self.direction[2] as f64,
+        );
+        self.decides() && n.dot(d) > area * self.sin as f64 * SLACK
+    }
 }
 
 impl ViewMesh {
@@ -74,11 +121,13 @@ impl ViewMesh {
         if !(area > 0.0 && area.is_finite()) {
             return false;
         }
-        if spheres_hold_orientation(p, r).is_some_and(|cos| cos > 0.0) {
+        let coded = self.faces.normals[f as usize];
+        if coded.holds(n, area) || spheres_hold_orientation(p, r).is_some_and(|cos| cos > 0.0) {
             return true;
         }
+        // A triangle's own normal decides it: nothing deeper would prove more.
         corners.iter().any(|&v| self.cone_holds(v, n, area))
-            || self.deeper_nodes_hold_orientation(n, corners, f)
+            || !coded.decides() && self.deeper_nodes_hold_orientation(n, corners, f)
     }
 
     /// Whether normal `n` (of length `area`) is within 90° − α of the axis of node `v`'s normal
@@ -290,7 +339,7 @@ impl ViewMesh {
             // Not certain from what is loaded, but the stream holds what would tell: the
             // face waits for it. Splitting instead chases its counterpart down the hierarchy,
             // and the faces each split makes may be no more certain than it.
-            if self.ask_for_certificate(f) {
+            if !self.faces.normals[fu].decides() && self.ask_for_certificate(f) {
                 self.guard.suspected[fu] = Suspicion::Moved;
                 done.waiting += 1;
                 held.push(f);

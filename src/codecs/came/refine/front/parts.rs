@@ -5,6 +5,7 @@
 use super::super::loader::NONE;
 use super::super::loader::{Dependency, Loader};
 use super::super::view::View;
+use super::orientation::CodedNormal;
 use super::{State, Suspicion, UnitState};
 use crate::hierarchy::came::cones::NormalCone;
 use crate::hierarchy::came::NodeId;
@@ -56,6 +57,8 @@ pub(super) struct Front {
 pub(super) struct Faces {
     // Per triangle.
     pub(super) leaf_corners: Vec<[NodeId; 3]>,
+    /// What the stream says of the counterpart's normal (`came` syntax 4).
+    pub(super) normals: Vec<CodedNormal>,
     pub(super) corners: Vec<[u32; 3]>,
     pub(super) present: Vec<bool>,
     /// Present triangles.
