@@ -16,8 +16,8 @@
 //!   its splits: spot's uvs, vw-beetle's normals predicted from geometry, and spot's creased
 //!   normals derived.
 //! - `*-before-*.mc` are streams of parameters today's encoders no longer choose (`emc` with its
-//!   face corrections after the last level, `came` without normal cones or deviations), kept
-//!   to show that those parameters still decode as they did.
+//!   face corrections after the last level, `came` without normal cones, deviations or
+//!   triangle normals), kept to show that those parameters still decode as they did.
 //!
 //! All are regenerated on purpose with `UPDATE_GOLDEN=1 cargo test --release --test golden`,
 //! which a change of syntax must come with (and a new format version: docs/FORMAT.md, History).
@@ -271,6 +271,52 @@ fn came_streams_without_deviations_still_decode_and_refine_by_their_spheres() {
         new_faces * 4 < old_faces * 3,
         "{new_faces} against {old_faces}"
     );
+}
+
+/// `came` streams of syntax 3, before each triangle's normal was coded, still decode exactly
+/// and refine with the orientation guard, which then reads what decides a face from the
+/// meta-nodes under it: `came-eight-before-triangle-normals.mc` is the golden stream of that
+/// build, kept. Today's stream says something of every triangle's normal; syntax 3's of none.
+#[test]
+fn came_streams_without_triangle_normals_still_decode_and_refine_with_the_guard() {
+    use meshcodec::codecs::came::decode_tree;
+    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    let (old, new) = kept_came_stream_and_todays("came-eight-before-triangle-normals.mc");
+    let syntax = |bytes: &[u8]| {
+        meshcodec::container::StreamReader::open(bytes)
+            .unwrap()
+            .header()
+            .syntax
+    };
+    assert_eq!(syntax(&old), 3);
+    assert!(syntax(&new) >= 4);
+    let unknown = |bytes: &[u8]| {
+        let (_, tree) = decode_tree(bytes).unwrap();
+        let unknown = tree
+            .triangles
+            .iter()
+            .filter(|t| !t.normal.is_known())
+            .count();
+        (unknown, tree.triangles.len())
+    };
+    let (old_unknown, old_triangles) = unknown(&old);
+    assert_eq!(old_unknown, old_triangles);
+    assert_eq!(unknown(&new).0, 0);
+    let camera = Camera {
+        eye: glam::DVec3::new(0.0, 0.0, 25.0),
+        target: glam::DVec3::ZERO,
+        up: glam::DVec3::Y,
+        fov_degrees: 40.0,
+        width: 640,
+        height: 480,
+    };
+    let view = View::new(&camera, 1.0).unwrap().two_sided(true);
+    for bytes in [&old, &new] {
+        let mut front = ViewMesh::from_stream(bytes).unwrap();
+        let adapted = front.settle(&view, Budget::UNLIMITED, 64);
+        assert!(adapted.settled && adapted.unsure == 0, "{adapted:?}");
+        front.check_invariants().unwrap();
+    }
 }
 
 #[test]

@@ -1,11 +1,11 @@
 //! Probe: how many faces in view a per-triangle orientation bound would prove, coded beside each
 //! triangle against the proxy triangle its own and its ancestors' meta-nodes place.
 //! Run: cargo run --release --example came_cert_probe -- STREAM [DEPTHS…]
+use glam::DVec3;
 use meshcodec::codecs::came::decode_tree;
 use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
 use meshcodec::hierarchy::came::NodeId;
 use meshcodec_lab::came::vd::{framing, towards, FOV_DEGREES, HEIGHT, VIEWS, WIDTH};
-use glam::DVec3;
 use std::collections::HashMap;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -33,7 +33,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect(),
     )];
     for depths in std::env::args().skip(2) {
-        let tiers: Vec<u8> = depths.split(',').map(str::parse).collect::<Result<_, _>>()?;
+        let tiers: Vec<u8> = depths
+            .split(',')
+            .map(str::parse)
+            .collect::<Result<_, _>>()?;
         // Unit root of an inner node: its ancestor at the deepest tier depth at or above it,
         // then every 8 levels past the last tier.
         let last = *tiers.last().unwrap();
@@ -56,7 +59,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
     let angle = |a: DVec3, b: DVec3| {
         let c = a.dot(b) / (a.length() * b.length());
-        if c.is_finite() { c.clamp(-1.0, 1.0).acos().to_degrees() } else { 180.0 }
+        if c.is_finite() {
+            c.clamp(-1.0, 1.0).acos().to_degrees()
+        } else {
+            180.0
+        }
     };
     // The proxy of a triangle under a layout: on each leaf path, the deepest node whose position
     // the birth node's unit and its ancestors give.
@@ -89,12 +96,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for t in &tree.triangles {
             let pr = proxy(roots, t.corners);
             let cp = t.corners.map(|l| world[tree.lookup[&l.packed()] as usize]);
-            if pr.iter().zip(t.corners).all(|(&p, l)| tree.nodes[p as usize].id == l) {
+            if pr
+                .iter()
+                .zip(t.corners)
+                .all(|(&p, l)| tree.nodes[p as usize].id == l)
+            {
                 exact += 1;
                 continue;
             }
             let b = angle(normal(pr.map(|p| world[p as usize])), normal(cp));
-            let code = if b >= 90.0 { 16 } else { (b / (90.0 / 16.0)).ceil() as usize };
+            let code = if b >= 90.0 {
+                16
+            } else {
+                (b / (90.0 / 16.0)).ceil() as usize
+            };
             hist[code.min(16)] += 1;
         }
         for eps in [11.25f64, 5.625] {
@@ -102,22 +117,44 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let mut m = 0usize;
             for t in &tree.triangles {
                 let pr = proxy(roots, t.corners);
-                if pr.iter().zip(t.corners).all(|(&p, l)| tree.nodes[p as usize].id == l) {
+                if pr
+                    .iter()
+                    .zip(t.corners)
+                    .all(|(&p, l)| tree.nodes[p as usize].id == l)
+                {
                     continue;
                 }
                 let cp = t.corners.map(|l| world[tree.lookup[&l.packed()] as usize]);
                 let np = normal(pr.map(|p| world[p as usize])).normalize_or_zero();
                 let nc = normal(cp).normalize_or_zero();
                 // Tangent frame of the proxy's normal; residual as azimuthal-equidistant coordinates.
-                let (u, w) = if np == DVec3::ZERO { (DVec3::X, DVec3::Y) } else { np.any_orthonormal_pair() };
+                let (u, w) = if np == DVec3::ZERO {
+                    (DVec3::X, DVec3::Y)
+                } else {
+                    np.any_orthonormal_pair()
+                };
                 let th = np.dot(nc).clamp(-1.0, 1.0).acos().to_degrees();
                 let dir = DVec3::new(nc.dot(u), nc.dot(w), 0.0).normalize_or_zero();
-                let key = ((th * dir.x / eps).round() as i64, (th * dir.y / eps).round() as i64);
+                let key = (
+                    (th * dir.x / eps).round() as i64,
+                    (th * dir.y / eps).round() as i64,
+                );
                 *cells.entry(key).or_default() += 1;
                 m += 1;
             }
-            let h: f64 = cells.values().map(|&c| { let p = c as f64 / m as f64; -(c as f64) * p.log2() }).sum();
-            println!("  residual at {eps}°: {} cells, {:.2} bits each coded, {:.3} bits a triangle", cells.len(), h / m.max(1) as f64, h / tree.triangles.len() as f64);
+            let h: f64 = cells
+                .values()
+                .map(|&c| {
+                    let p = c as f64 / m as f64;
+                    -(c as f64) * p.log2()
+                })
+                .sum();
+            println!(
+                "  residual at {eps}°: {} cells, {:.2} bits each coded, {:.3} bits a triangle",
+                cells.len(),
+                h / m.max(1) as f64,
+                h / tree.triangles.len() as f64
+            );
         }
         let coded: usize = hist.iter().sum();
         let entropy: f64 = hist
@@ -143,9 +180,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         } else {
             (centre + towards() * diagonals * diagonal, centre)
         };
-        let camera = Camera { eye, target, up: DVec3::Y, fov_degrees: FOV_DEGREES, width: WIDTH, height: HEIGHT };
+        let camera = Camera {
+            eye,
+            target,
+            up: DVec3::Y,
+            fov_degrees: FOV_DEGREES,
+            width: WIDTH,
+            height: HEIGHT,
+        };
         for guard in [false, true] {
-            let view = View::new(&camera, 1.0)?.two_sided(true).keep_orientation(guard);
+            let view = View::new(&camera, 1.0)?
+                .two_sided(true)
+                .keep_orientation(guard);
             let mut front = ViewMesh::from_stream(&bytes)?;
             front.settle(&view, Budget::UNLIMITED, 256);
             let mut shown = 0;
@@ -161,7 +207,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let nf = normal(at);
                 let cp = leaves.map(|l| world[tree.lookup[&l.packed()] as usize]);
                 let t_angle = angle(nf, normal(cp));
-                for (k, e) in [0.0, 8.0, 16.0].iter().enumerate() { truth[k] += (t_angle + e < 90.0) as usize; }
+                for (k, e) in [0.0, 8.0, 16.0].iter().enumerate() {
+                    truth[k] += (t_angle + e < 90.0) as usize;
+                }
                 if nf.dot(normal(cp)) <= 0.0 {
                     folded += 1;
                 }
@@ -169,7 +217,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     let pr = proxy(roots, leaves);
                     let np = normal(pr.map(|p| world[p as usize]));
                     let b = angle(np, normal(cp));
-                    let bq = if b >= 90.0 { 90.0 } else { (b / (90.0 / 16.0)).ceil() * (90.0 / 16.0) };
+                    let bq = if b >= 90.0 {
+                        90.0
+                    } else {
+                        (b / (90.0 / 16.0)).ceil() * (90.0 / 16.0)
+                    };
                     let a = angle(nf, np);
                     proved[k] += (a + b < 90.0) as usize;
                     proved_q[k] += (a + bq < 90.0) as usize;

@@ -135,6 +135,13 @@ impl OurRow {
             .get(Stat::CameBits(CameField::Priors))
             .unwrap_or(0.0)
     }
+
+    /// Bits of the triangles' own normals (none in the paper's coding).
+    fn face_normal_bits(&self) -> f64 {
+        self.stats
+            .get(Stat::CameBits(CameField::FaceNormals))
+            .unwrap_or(0.0)
+    }
 }
 
 fn load(results: &Path, codec: &str, mesh: &str) -> Result<RunResult> {
@@ -264,16 +271,16 @@ pub fn tables(results: &Path, out: &Path) -> Result<PathBuf> {
     }
 
     let _ = writeln!(md, "\n## Table 3: bits per field\n");
-    let _ = writeln!(md, "Connectivity: tree shape (leaf flags), triangle counts and the corner paths n1, n2, n3 with their lengths, ups and orientation; dependencies: their counts and paths; coordinates: the root, the difference vectors and (`came-paper`) the meta-nodes' frames; MR data: the error spheres' radii; normal cones (`came` only, not in the paper): each inner node's cone of face normals for back-face culling; deviations (`came` only, not in the paper): each inner node's measured deviation, the error view-dependent refinement projects (docs/FORMAT.md §8.2); priors (`came` only): where every unit's contexts start, coded once in the first unit. Total = the fields (the paper's four, the cones, the deviations and the priors); the stream adds its header and unit index (\"stream bits\"). Bits/triangle is the total over the triangles, as the paper's.\n");
-    let _ = writeln!(md, "| model | depth | connect. | depend. | coord. | MR data | normal cones | deviations | priors | total | bits/triangle | stream bits | deps/node (raw) | meta-nodes | full level |");
+    let _ = writeln!(md, "Connectivity: tree shape (leaf flags), triangle counts and the corner paths n1, n2, n3 with their lengths, ups and orientation; dependencies: their counts and paths; coordinates: the root, the difference vectors and (`came-paper`) the meta-nodes' frames; MR data: the error spheres' radii; normal cones (`came` only, not in the paper): each inner node's cone of face normals for back-face culling; deviations (`came` only, not in the paper): each inner node's measured deviation, the error view-dependent refinement projects (docs/FORMAT.md §8.2); priors (`came` only): where every unit's contexts start, coded once in the first unit; triangle normals (`came` only): each triangle's own normal where the meta-node that creates it does not hold its corners, so that the orientation guard proves faces without reading further (docs/FORMAT.md §8.2). Total = the fields (the paper's four, the cones, the deviations, the priors and the triangle normals); the stream adds its header and unit index (\"stream bits\"). Bits/triangle is the total over the triangles, as the paper's.\n");
+    let _ = writeln!(md, "| model | depth | connect. | depend. | coord. | MR data | normal cones | deviations | priors | triangle normals | total | bits/triangle | stream bits | deps/node (raw) | meta-nodes | full level |");
     let _ = writeln!(
         md,
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"
     );
     for p in &PAPER {
         let _ = writeln!(
             md,
-            "| paper: {} | {} | {} | {} | {} | {} | — | — | — | {} | {:.1} | | 1.5–2 | | lossy |",
+            "| paper: {} | {} | {} | {} | {} | {} | — | — | — | — | {} | {:.1} | | 1.5–2 | | lossy |",
             p.name,
             p.depth,
             p.bits[0],
@@ -290,10 +297,11 @@ pub fn tables(results: &Path, out: &Path) -> Result<PathBuf> {
             let cones = r.cone_bits();
             let deviations = r.deviation_bits();
             let priors = r.prior_bits();
-            let total: f64 = bits.iter().sum::<f64>() + cones + deviations + priors;
+            let normals = r.face_normal_bits();
+            let total: f64 = bits.iter().sum::<f64>() + cones + deviations + priors + normals;
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | **{:.1}** | {} | {:.2} ({:.2}) | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | **{:.1}** | {} | {:.2} ({:.2}) | {} | {} |",
                 r.label,
                 r.stat(Stat::HierarchyDepth)?,
                 short(bits[0]),
@@ -303,6 +311,7 @@ pub fn tables(results: &Path, out: &Path) -> Result<PathBuf> {
                 if cones > 0.0 { short(cones) } else { "—".into() },
                 if deviations > 0.0 { short(deviations) } else { "—".into() },
                 if priors > 0.0 { short(priors) } else { "—".into() },
+                if normals > 0.0 { short(normals) } else { "—".into() },
                 short(total),
                 total / r.triangles as f64,
                 short(r.bytes as f64 * 8.0),

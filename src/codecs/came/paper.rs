@@ -640,7 +640,7 @@ impl UnitDecoder for PaperUnits {
                     Triangle {
                         corners,
                         birth_depth: sid.len(),
-                        normal: FaceNormal::Unknown,
+                        normal: FaceNormal::UNKNOWN,
                     },
                     at,
                 )?;

@@ -18,6 +18,7 @@
 //! counterpart's over the whole stream, rounded up ([`bound_code`]): a client takes each coded
 //! normal as a cone of that half-angle about it.
 
+use crate::mesh::attribute_quantization::{octahedral_code, octahedral_normal};
 use glam::DVec3;
 
 /// Steps of the octahedral square's half axis: codes run −STEPS … STEPS on each axis. Eight
@@ -88,10 +89,7 @@ pub fn nearest_code(proxy: DVec3, normal: DVec3, steps: u8) -> Option<([i32; 2],
         (u, v) = ((1.0 - v.abs()) * sign(u), (1.0 - u.abs()) * sign(v));
     }
     let m = steps as i32;
-    let (i0, j0) = (
-        (u * m as f64).round() as i32,
-        (v * m as f64).round() as i32,
-    );
+    let (i0, j0) = ((u * m as f64).round() as i32, (v * m as f64).round() as i32);
     let mut best: Option<([i32; 2], f64)> = None;
     for i in (i0 - 1).max(-m)..=(i0 + 1).min(m) {
         for j in (j0 - 1).max(-m)..=(j0 + 1).min(m) {
@@ -116,16 +114,71 @@ pub fn bound_degrees(code: u8) -> f64 {
     code as f64 / 2.0
 }
 
-/// What a decoder knows of a triangle's normal.
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-pub enum FaceNormal {
-    /// Nothing (streams before syntax 4).
-    #[default]
-    Unknown,
+/// Bits a coordinate of the octahedral direction a decoder keeps a triangle's normal in.
+const KEPT_BITS: u8 = 16;
+/// The most a kept direction is off its decoded normal, in degrees (16-bit octahedral
+/// coordinates are off by under 0.004°: `kept_directions_are_within_their_margin`).
+const KEPT_MARGIN_DEGREES: f64 = 0.01;
+const UNKNOWN: u8 = u8::MAX;
+const NO_AREA: u8 = u8::MAX - 1;
+
+/// What a decoder knows of a triangle's normal, in six bytes (a decoded triangle keeps it in
+/// the padding of its record): a direction as 16-bit octahedral coordinates and the angle
+/// within which the normal lies, in half-degrees rounded up.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FaceNormal {
+    direction: [u16; 2],
+    /// Half-degrees, or [`UNKNOWN`], or [`NO_AREA`].
+    bound: u8,
+}
+
+impl Default for FaceNormal {
+    fn default() -> FaceNormal {
+        FaceNormal::UNKNOWN
+    }
+}
+
+impl FaceNormal {
+    /// Nothing known (streams before syntax 4).
+    pub const UNKNOWN: FaceNormal = FaceNormal {
+        direction: [0; 2],
+        bound: UNKNOWN,
+    };
     /// The triangle has no area: it turns no way.
-    NoArea,
-    /// Its normal lies within `degrees` of the unit vector `direction` (the mesh's units).
-    Within { direction: DVec3, degrees: f64 },
+    pub const NO_AREA: FaceNormal = FaceNormal {
+        direction: [0; 2],
+        bound: NO_AREA,
+    };
+
+    /// A normal within `degrees` of `direction` (a unit vector in the mesh's units); unknown
+    /// when that is 90° or more, which proves nothing.
+    pub fn within(direction: DVec3, degrees: f64) -> FaceNormal {
+        let half = ((degrees + KEPT_MARGIN_DEGREES) * 2.0).ceil();
+        if !(half < BOUND_HALF_DEGREES_MAX as f64) || !direction.is_finite() {
+            return FaceNormal::UNKNOWN;
+        }
+        let code = octahedral_code(direction, KEPT_BITS);
+        FaceNormal {
+            direction: code.map(|c| c as u16),
+            bound: half.max(0.0) as u8,
+        }
+    }
+
+    /// The normal's direction and the angle within which it lies, in degrees; `None` for a
+    /// triangle of no area or an unknown normal ([`Self::is_known`] tells them apart).
+    pub fn cone(self) -> Option<(DVec3, f64)> {
+        (self.bound < NO_AREA).then(|| {
+            (
+                octahedral_normal(self.direction.map(u32::from), KEPT_BITS),
+                bound_degrees(self.bound),
+            )
+        })
+    }
+
+    /// Whether the stream says anything of the normal.
+    pub fn is_known(self) -> bool {
+        self.bound != UNKNOWN
+    }
 }
 
 #[cfg(test)]
@@ -157,7 +210,11 @@ mod tests {
             let (code, angle) = nearest_code(proxy, normal, STEPS).expect("a normal");
             assert!(code.iter().all(|c| c.abs() <= STEPS as i32));
             let back = decoded(proxy, code, STEPS);
-            let measured = back.dot(normal.normalize()).clamp(-1.0, 1.0).acos().to_degrees();
+            let measured = back
+                .dot(normal.normalize())
+                .clamp(-1.0, 1.0)
+                .acos()
+                .to_degrees();
             assert!((measured - angle).abs() < 1e-9);
             worst = worst.max(angle);
         }
@@ -175,6 +232,21 @@ mod tests {
         // A proxy of no area: the world's axes.
         let (code, _) = nearest_code(DVec3::ZERO, DVec3::Z, STEPS).unwrap();
         assert_eq!(code, [0, 0]);
+    }
+
+    #[test]
+    fn kept_directions_are_within_their_margin() {
+        let mut seed = 3;
+        for _ in 0..20_000 {
+            let n = random_unit(&mut seed);
+            let (kept, degrees) = FaceNormal::within(n, 1.0).cone().unwrap();
+            let off = kept.dot(n).clamp(-1.0, 1.0).acos().to_degrees();
+            assert!(off < 0.4 * KEPT_MARGIN_DEGREES, "{off}°");
+            assert!(degrees >= 1.0 + KEPT_MARGIN_DEGREES);
+        }
+        assert_eq!(FaceNormal::within(DVec3::Z, 89.9), FaceNormal::UNKNOWN);
+        assert!(FaceNormal::NO_AREA.cone().is_none() && FaceNormal::NO_AREA.is_known());
+        assert!(!FaceNormal::UNKNOWN.is_known());
     }
 
     #[test]

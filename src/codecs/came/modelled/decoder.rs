@@ -10,8 +10,8 @@ use crate::container::Header;
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self, CodedCone, ANGLE_BITS, NO_CONE};
 use crate::hierarchy::came::deviation::{decoded_deviation, round_up, DEVIATION_BITS};
-use crate::hierarchy::came::spheres::{decoded_radius, ratio_base};
 use crate::hierarchy::came::face_normals::{bound_degrees, decoded, scaled_normal};
+use crate::hierarchy::came::spheres::{decoded_radius, ratio_base};
 use crate::hierarchy::came::NodeId;
 use crate::mesh::attribute_quantization::octahedral_max;
 
@@ -194,39 +194,48 @@ impl UnitReader<'_> {
 
     /// What the stream says of a triangle's normal (syntax 4), after its orientation bit: on
     /// proxies that are its leaves, the normal they make; else a code about theirs.
-    fn face_normal(&mut self, proxies: [u32; 3], params: &Params, cell: [f64; 3]) -> Result<FaceNormal> {
+    fn face_normal(
+        &mut self,
+        proxies: [u32; 3],
+        params: &Params,
+        cell: [f64; 3],
+    ) -> Result<FaceNormal> {
         let steps = params.face_normal_steps;
         if steps == 0 {
-            return Ok(FaceNormal::Unknown);
+            return Ok(FaceNormal::UNKNOWN);
         }
         let at = proxies.map(|p| self.tree.nodes[p as usize].position);
         let normal = scaled_normal(at, cell);
         if proxies.iter().all(|&p| self.tree.nodes[p as usize].leaf) {
             let length = normal.length();
             return Ok(if length > 0.0 && length.is_finite() {
-                FaceNormal::Within {
-                    direction: normal / length,
-                    degrees: 0.0,
-                }
+                FaceNormal::within(normal / length, 0.0)
             } else {
-                FaceNormal::NoArea
+                FaceNormal::NO_AREA
             });
         }
         if self.bit(|c| &mut c.face_no_area)? {
-            return Ok(FaceNormal::NoArea);
+            return Ok(FaceNormal::NO_AREA);
         }
         let mut code = [0i32; 2];
         for (k, c) in code.iter_mut().enumerate() {
-            let v = self.dec.int(&mut self.ctx.face_normal[k]).ok_or_else(|| self.cut())?;
+            let v = self
+                .dec
+                .int(&mut self.ctx.face_normal[k])
+                .ok_or_else(|| self.cut())?;
             if v.unsigned_abs() > steps as u64 {
-                return Err(Error::malformed(0, self.at, "a triangle normal's code runs past its square"));
+                return Err(Error::malformed(
+                    0,
+                    self.at,
+                    "a triangle normal's code runs past its square",
+                ));
             }
             *c = v as i32;
         }
-        Ok(FaceNormal::Within {
-            direction: decoded(normal, code, steps),
-            degrees: bound_degrees(params.face_normal_bound),
-        })
+        Ok(FaceNormal::within(
+            decoded(normal, code, steps),
+            bound_degrees(params.face_normal_bound),
+        ))
     }
 
     fn dependency_path(&mut self, start: NodeId, known: u32) -> Result<NodeId> {

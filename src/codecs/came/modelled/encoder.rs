@@ -12,8 +12,8 @@ use crate::hierarchy::came::cones::{self, coded_cones, CodedCone, ANGLE_BITS, NO
 use crate::hierarchy::came::deviation::{
     decoded_deviation, deviation_code, deviations, round_up, DEVIATION_BITS,
 };
-use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
 use crate::hierarchy::came::face_normals::{self, nearest_code, scaled_normal};
+use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
 use crate::hierarchy::came::{NodeId, VertexTree};
 use crate::mesh::attribute_quantization::octahedral_max;
 use crate::mesh::CanonicalMesh;

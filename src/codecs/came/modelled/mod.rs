@@ -30,8 +30,8 @@ use crate::codecs::{names, Capability, Codec, Encoded, LevelDecoder, Stats};
 use crate::container::{Header, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self};
-use crate::hierarchy::came::face_normals;
 use crate::hierarchy::came::deviation::DEVIATION_BITS;
+use crate::hierarchy::came::face_normals;
 use crate::mesh::CanonicalMesh;
 
 /// The `came` codec.

@@ -33,6 +33,9 @@
 //! checked that neighbourhood for flips), and the counterpart's corners are not known where
 //! their meta-nodes are not loaded, so the front makes sure of it from what it holds
 //! ([`ViewMesh::orientation_certain`]): a face is certain when
+//! - its triangle's own normal, coded where the triangle is born (`came` syntax 4,
+//!   [`crate::hierarchy::came::face_normals`]), makes with n an angle that, plus the header's
+//!   bound on the code's error, is under 90°; or
 //! - its corners are leaves (it is its counterpart); or
 //! - its corners' error spheres are small beside it: with e₁ = b − a, e₂ = c − a, and each
 //!   counterpart corner within r of its node, n·n' ≥ |n|(|n| − |e₁|R₂ − R₁|e₂| − R₁R₂) where
@@ -51,7 +54,11 @@
 //!   guard from 8× to 1.4× the unguarded front's faces).
 //!
 //! The faces a split or collapse moves or makes are listed and checked at the end of the
-//! adaptation. A face in view that is not certain **first waits for the meta-nodes under the
+//! adaptation. With triangle normals (syntax 4) every face is decided by the triangle's own
+//! normal, whatever is loaded: a face in view that is not certain folds over (or nearly), and
+//! is split as below, never waiting for data — so the guard reads nothing the view does not
+//! (dragon-50k's far view: 71.6% of the stream against 98.5% when it waited; 68.0% unguarded).
+//! Before syntax 4, a face in view that is not certain **first waits for the meta-nodes under the
 //! deepest loaded nodes on its counterpart's leaf paths** ([`ViewMesh::ask_for_certificate`]):
 //! they decide it, exactly once the leaves are in. Only a face that is not certain from its
 //! counterpart itself (it folds over) or whose meta-nodes cannot come (refused) has a corner

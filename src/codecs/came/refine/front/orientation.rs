@@ -45,17 +45,17 @@ pub(super) struct CodedNormal {
 
 impl CodedNormal {
     pub(super) fn from(normal: FaceNormal) -> CodedNormal {
-        match normal {
-            FaceNormal::Within { direction, degrees } if degrees < 90.0 => CodedNormal {
+        match normal.cone() {
+            Some((direction, degrees)) => CodedNormal {
                 direction: direction.as_vec3().to_array(),
                 // The direction's rounding to f32 is within 1e-7.
                 sin: (degrees.to_radians().sin() + 1e-6) as f32,
             },
-            FaceNormal::NoArea => CodedNormal {
+            None if normal.is_known() => CodedNormal {
                 direction: [0.0; 3],
                 sin: -1.0,
             },
-            _ => CodedNormal {
+            None => CodedNormal {
                 direction: [0.0; 3],
                 sin: 2.0,
             },
