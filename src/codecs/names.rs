@@ -57,7 +57,7 @@ pub const EMC: Naming = Naming {
 pub const CAME: Naming = Naming {
     name: "came",
     id: 6,
-    syntax: 4,
+    syntax: 5,
     reads_from: 1,
 };
 

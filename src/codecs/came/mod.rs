@@ -43,16 +43,19 @@ use crate::mesh::CanonicalMesh;
 use partition::Partition;
 
 /// The bytes each level (front depth) of a CAME stream needs: the front at depth k needs every
-/// unit whose root lies above depth k, and a unit's root lies L levels below its parent's.
-/// Units come in the order their roots deepen (docs/FORMAT.md §8.1), so level k needs the stream
-/// up to the end of the last such unit.
+/// unit whose splits start above depth k ([`partition::Shape::band`]). Units come in the order
+/// their bands deepen (docs/FORMAT.md §8.1), so level k needs the stream up to the end of the
+/// last such unit.
 pub fn level_ends(stream: &crate::container::StreamReader, params: &Params) -> Result<Vec<u64>> {
     let units = &stream.index().units;
-    let mut root_depth: Vec<u64> = Vec::with_capacity(units.len());
+    let shape = params.shape();
+    // Per unit: the depth of its root, and of its first splits.
+    let mut root_depth: Vec<u8> = Vec::with_capacity(units.len());
+    let mut start_depth: Vec<u64> = Vec::with_capacity(units.len());
     for (i, unit) in units.iter().enumerate() {
         let depth = match unit.parent {
             None if i == 0 => 0,
-            Some(p) if p < i => root_depth[p] + params.meta_levels as u64,
+            Some(p) if p < i => shape.band(root_depth[p]).child,
             _ => {
                 return Err(Error::malformed(
                     0,
@@ -62,11 +65,13 @@ pub fn level_ends(stream: &crate::container::StreamReader, params: &Params) -> R
             }
         };
         root_depth.push(depth);
+        start_depth.push(shape.band(depth).start as u64);
     }
-    // The last byte of a unit rooted at each depth, then the furthest of those above each level.
+    // The last byte of a unit starting at each depth, then the furthest of those above each
+    // level.
     let levels = params.depth as usize;
     let mut last_at_depth = vec![0u64; levels];
-    for (unit, &depth) in units.iter().zip(&root_depth) {
+    for (unit, &depth) in units.iter().zip(&start_depth) {
         if let Some(last) = last_at_depth.get_mut(depth as usize) {
             *last = (*last).max(unit.end());
         }
@@ -128,6 +133,9 @@ pub struct Params {
     /// The largest angle between a coded triangle normal and the triangle's, in half-degrees
     /// (`face_normals::bound_code`).
     pub face_normal_bound: u8,
+    /// Levels of a unit's region (syntax 5, `partition::Shape::Bands`, whose band is
+    /// `meta_levels` deep; 0: meta-nodes of `meta_levels` levels).
+    pub region_levels: u8,
 }
 
 impl Params {
@@ -147,6 +155,9 @@ impl Params {
             if self.face_normal_steps > 0 {
                 bytes.extend([self.face_normal_steps, self.face_normal_bound]);
             }
+            if self.region_levels > 0 {
+                bytes.push(self.region_levels);
+            }
         }
         bytes
     }
@@ -159,7 +170,7 @@ impl Params {
         per_node_bounds: bool,
     ) -> Result<Params> {
         let bad = |what: &str| Error::malformed(0, 0, format!("CAME parameters: {what}"));
-        let expected: &[usize] = if per_node_bounds { &[6, 8] } else { &[4] };
+        let expected: &[usize] = if per_node_bounds { &[6, 8, 9] } else { &[4] };
         if !expected.contains(&bytes.len()) {
             let expected: Vec<String> = expected.iter().map(|n| n.to_string()).collect();
             let expected = expected.join(" or ");
@@ -170,9 +181,13 @@ impl Params {
             _ => (0, 0),
         };
         let (face_normal_steps, face_normal_bound) = match bytes {
-            [_, _, _, _, _, _, steps, bound] => (*steps, *bound),
+            [_, _, _, _, _, _, steps, bound, ..] => (*steps, *bound),
             _ => (0, 0),
         };
+        let region_levels = bytes.get(8).copied().unwrap_or(0);
+        if region_levels > 16 {
+            return Err(bad("region levels outside 0..16"));
+        }
         let [meta_levels, depth, component_bits, radius_bits] =
             [bytes[0], bytes[1], bytes[2], bytes[3]];
         if !(1..=16).contains(&meta_levels) {
@@ -196,7 +211,24 @@ impl Params {
             deviation_bits,
             face_normal_steps,
             face_normal_bound,
+            region_levels,
         })
+    }
+
+    /// How the stream's hierarchy is cut into units (what a decoder needs of it).
+    pub fn shape(&self) -> partition::Shape {
+        if self.region_levels > 0 {
+            partition::Shape::Bands {
+                region: self.region_levels,
+                band: self.meta_levels,
+                whole: 0,
+            }
+        } else {
+            partition::Shape::Levels {
+                levels: self.meta_levels,
+                tails: partition::Tails::Whole,
+            }
+        }
     }
 }
 
@@ -301,8 +333,8 @@ pub struct Layout {
     pub naming: crate::codecs::names::Naming,
     /// Whether the syntax's parameters give the bits of cones and deviations (`came`).
     pub per_node_bounds: bool,
-    /// Meta-nodes near the leaves.
-    pub tails: partition::Tails,
+    /// How the hierarchy is cut into units.
+    pub shape: partition::Shape,
     /// Bits per PCA component (0: none).
     pub component_bits: u8,
     /// Bits per radius ratio.
@@ -327,9 +359,14 @@ pub fn encode_stream(
     let started = std::time::Instant::now();
     let tree = hierarchy(mesh)?;
     let seconds = started.elapsed().as_secs_f64();
-    let part = partition::partition(&tree, META_LEVELS, layout.tails);
+    let part = partition::partition(&tree, layout.shape);
+    let (meta_levels, region_levels) = match layout.shape {
+        partition::Shape::Levels { levels, .. } => (levels, 0),
+        partition::Shape::Bands { region, band, .. } => (band, region),
+    };
     let params = Params {
-        meta_levels: META_LEVELS,
+        meta_levels,
+        region_levels,
         depth: tree.depth(),
         component_bits: layout.component_bits,
         radius_bits: layout.radius_bits,

@@ -15,8 +15,8 @@
 
 use super::decoded::{CameDecoder, DecodedTree, FaceNormal, Triangle, UnitDecoder};
 use super::frame::Frame;
-use super::partition::{Partition, Tails};
-use super::{born_triangles, cut_at, encode_stream, BornTriangle, Layout, Params};
+use super::partition::{Partition, Shape, Tails};
+use super::{born_triangles, cut_at, encode_stream, BornTriangle, Layout, Params, META_LEVELS};
 use crate::codecs::descriptor::cubic;
 use crate::codecs::{names, Capability, Codec, Encoded, LevelDecoder, Stats};
 use crate::codecs::{CodecFacts, Descriptor};
@@ -196,7 +196,10 @@ impl Codec for CamePaper {
         let layout = Layout {
             naming: self.descriptor().naming,
             per_node_bounds: false,
-            tails: Tails::Split,
+            shape: Shape::Levels {
+                levels: META_LEVELS,
+                tails: Tails::Split,
+            },
             component_bits: self.component_bits,
             radius_bits: RADIUS_BITS,
             cone_bits: 0,

@@ -380,8 +380,34 @@ impl ModelledUnits {
             r.tree.add_root(p, radius, deviation, cone);
         }
         let top = r.tree.nodes[root as usize].id.len();
-        let mut queue = vec![root];
-        let mut children_units = Vec::new();
+        let band = params.shape().band(top);
+        // The band's first splits: breadth first from the root through the nodes its
+        // ancestors split (docs/FORMAT.md §8.1).
+        let mut queue = Vec::new();
+        let mut above = vec![root];
+        let mut k = 0;
+        while k < above.len() {
+            let v = above[k];
+            k += 1;
+            let node = &r.tree.nodes[v as usize];
+            if node.id.len() >= band.start {
+                queue.push(v);
+                continue;
+            }
+            let Some(children) = node.children else {
+                return Err(Error::malformed(
+                    0,
+                    at,
+                    "a unit's region holds a node no unit above it split",
+                ));
+            };
+            for c in children {
+                if !r.tree.nodes[c as usize].leaf {
+                    above.push(c);
+                }
+            }
+        }
+        let mut children_units: Vec<u32> = Vec::new();
         let mut at_node = 0;
         // Pass 1.
         while at_node < queue.len() {
@@ -450,10 +476,17 @@ impl ModelledUnits {
                     continue;
                 }
                 let c = children[side];
-                if whole || (depth as u8) < top + params.meta_levels {
+                if whole || (depth as u8) < band.end {
                     queue.push(c);
-                } else {
-                    children_units.push(c);
+                    continue;
+                }
+                // Its unit is rooted at its ancestor at the band's child depth.
+                let mut root_of = c;
+                while r.tree.nodes[root_of as usize].id.len() > band.child {
+                    root_of = r.tree.nodes[root_of as usize].parent;
+                }
+                if !children_units.contains(&root_of) {
+                    children_units.push(root_of);
                 }
             }
         }

@@ -24,7 +24,7 @@ pub use decoder::ModelledUnits;
 use encoder::Encoder;
 
 use super::decoded::CameDecoder;
-use super::partition::Tails;
+use super::partition::Shape;
 use super::{encode_stream, Layout, Params};
 use crate::codecs::{names, Capability, Codec, Encoded, LevelDecoder, Stats};
 use crate::container::{Header, StreamReader};
@@ -70,7 +70,7 @@ impl Codec for Came {
         let layout = Layout {
             naming: self.descriptor().naming,
             per_node_bounds: true,
-            tails: Tails::Whole,
+            shape: SHAPE,
             component_bits: 0,
             radius_bits: RADIUS_BITS,
             cone_bits: cones::AXIS_BITS,
@@ -97,6 +97,16 @@ impl Codec for Came {
     }
 }
 
+/// How `came` cuts its hierarchy into units (syntax 5): bands of two levels over regions of six
+/// (units of at most about 2^6 · 3 splits, as many as meta-nodes of 8 levels held on
+/// dragon-50k), a unit holding the rest of its subtree when that is at most 256 splits
+/// (BENCHMARKS.md, "Units by depth band").
+pub const SHAPE: Shape = Shape::Bands {
+    region: 6,
+    band: 2,
+    whole: 256,
+};
+
 /// A `came` stream's parameters, checked.
 pub fn params(header: &Header) -> Result<Params> {
     let params = Params::from_bytes(&header.params, 0..=0, true)?;
@@ -114,18 +124,31 @@ pub fn params(header: &Header) -> Result<Params> {
             format!("came streams code deviations on {DEVIATION_BITS} bits"),
         ));
     }
-    // Syntax 4 adds the triangle normals' steps and bound; earlier syntaxes have none.
+    // Syntax 4 adds the triangle normals' steps and bound, syntax 5 the region's levels.
     let with_face_normals = header.syntax >= 4;
-    if with_face_normals != (header.params.len() == 8) {
+    let expected = match header.syntax {
+        ..=3 => 6,
+        4 => 8,
+        _ => 9,
+    };
+    if header.params.len() != expected {
         return Err(Error::malformed(
             0,
             0,
             format!(
-                "came syntax {} has {} parameter bytes",
-                header.syntax,
-                if with_face_normals { 8 } else { 6 }
+                "came syntax {} has {expected} parameter bytes",
+                header.syntax
             ),
         ));
+    }
+    if let (5.., Shape::Bands { region, band, .. }) = (header.syntax, SHAPE) {
+        if params.region_levels != region || params.meta_levels != band {
+            return Err(Error::malformed(
+                0,
+                0,
+                format!("came streams cut bands of {band} levels over regions of {region}"),
+            ));
+        }
     }
     if with_face_normals
         && (params.face_normal_steps != face_normals::STEPS

@@ -144,7 +144,8 @@ pub(super) struct UnitDelta {
     pub triangles: Vec<(u32, [NodeId; 3], FaceNormal)>,
     /// Per split: the node and the splits it depends on.
     pub splits: Vec<(u32, SmallVec<[Dependency; 2]>)>,
-    /// The units under this one and their root nodes, open until they are loaded.
+    /// The units under this one and the nodes whose splits each holds first, open until they
+    /// are loaded.
     pub opens: Vec<(usize, u32)>,
 }
 
@@ -218,7 +219,19 @@ fn delta(decoded: &DecodedUnit, header: &Header) -> Result<UnitDelta> {
         }
         out.splits.push((s, list));
     }
-    out.opens = decoded.child_units.clone();
+    // Every node a child unit splits first: its root, or (depth bands) the open nodes under
+    // it, which this unit created.
+    for &(unit, root) in &decoded.child_units {
+        let mut stack = vec![root];
+        while let Some(v) = stack.pop() {
+            let node = &tree.nodes[v as usize];
+            match node.children {
+                Some([t, u]) => stack.extend([u, t]),
+                None if !node.leaf => out.opens.push((unit, v)),
+                None => {}
+            }
+        }
+    }
     Ok(out)
 }
 
