@@ -154,7 +154,8 @@ impl FaceNormal {
     /// when that is 90° or more, which proves nothing.
     pub fn within(direction: DVec3, degrees: f64) -> FaceNormal {
         let half = ((degrees + KEPT_MARGIN_DEGREES) * 2.0).ceil();
-        if !(half < BOUND_HALF_DEGREES_MAX as f64) || !direction.is_finite() {
+        // (A NaN angle is no bound either.)
+        if half.is_nan() || half >= BOUND_HALF_DEGREES_MAX as f64 || !direction.is_finite() {
             return FaceNormal::UNKNOWN;
         }
         let code = octahedral_code(direction, KEPT_BITS);
