@@ -199,6 +199,25 @@ fn kept_came_stream_and_todays(file: &str) -> (Vec<u8>, Vec<u8>) {
     (old, new)
 }
 
+/// A camera 25 units from eight.off's centre.
+fn far_camera_on_eight() -> meshcodec::codecs::came::refine::Camera {
+    meshcodec::codecs::came::refine::Camera {
+        eye: glam::DVec3::new(0.0, 0.0, 25.0),
+        target: glam::DVec3::ZERO,
+        up: glam::DVec3::Y,
+        fov_degrees: 40.0,
+        width: 640,
+        height: 480,
+    }
+}
+
+fn header_of(bytes: &[u8]) -> meshcodec::container::Header {
+    meshcodec::container::StreamReader::open(bytes)
+        .unwrap()
+        .header()
+        .clone()
+}
+
 /// `came` streams without normal cones (the fifth parameter byte 0, as `came` wrote before them)
 /// still decode exactly, and refine view-dependently without culling:
 /// `came-eight-before-cones.mc` is the golden stream of that build, kept (its header in today's
@@ -237,24 +256,11 @@ fn came_streams_without_normal_cones_still_decode_and_refine() {
 /// today's format). The deviations leave a view's front coarser.
 #[test]
 fn came_streams_without_deviations_still_decode_and_refine_by_their_spheres() {
-    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
     let (old, new) = kept_came_stream_and_todays("came-eight-before-deviations.mc");
-    let params = |bytes: &[u8]| {
-        meshcodec::container::StreamReader::open(bytes)
-            .unwrap()
-            .header()
-            .params[5]
-    };
-    assert_eq!(params(&old), 0);
-    assert!(params(&new) > 0);
-    let camera = Camera {
-        eye: glam::DVec3::new(0.0, 0.0, 25.0),
-        target: glam::DVec3::ZERO,
-        up: glam::DVec3::Y,
-        fov_degrees: 40.0,
-        width: 640,
-        height: 480,
-    };
+    assert_eq!(header_of(&old).params[5], 0);
+    assert!(header_of(&new).params[5] > 0);
+    let camera = far_camera_on_eight();
     let view = View::new(&camera, 1.0)
         .unwrap()
         .two_sided(true)
@@ -280,16 +286,10 @@ fn came_streams_without_deviations_still_decode_and_refine_by_their_spheres() {
 #[test]
 fn came_streams_without_triangle_normals_still_decode_and_refine_with_the_guard() {
     use meshcodec::codecs::came::decode_tree;
-    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
     let (old, new) = kept_came_stream_and_todays("came-eight-before-triangle-normals.mc");
-    let syntax = |bytes: &[u8]| {
-        meshcodec::container::StreamReader::open(bytes)
-            .unwrap()
-            .header()
-            .syntax
-    };
-    assert_eq!(syntax(&old), 3);
-    assert!(syntax(&new) >= 4);
+    assert_eq!(header_of(&old).syntax, 3);
+    assert!(header_of(&new).syntax >= 4);
     let unknown = |bytes: &[u8]| {
         let (_, tree) = decode_tree(bytes).unwrap();
         let unknown = tree
@@ -302,14 +302,7 @@ fn came_streams_without_triangle_normals_still_decode_and_refine_with_the_guard(
     let (old_unknown, old_triangles) = unknown(&old);
     assert_eq!(old_unknown, old_triangles);
     assert_eq!(unknown(&new).0, 0);
-    let camera = Camera {
-        eye: glam::DVec3::new(0.0, 0.0, 25.0),
-        target: glam::DVec3::ZERO,
-        up: glam::DVec3::Y,
-        fov_degrees: 40.0,
-        width: 640,
-        height: 480,
-    };
+    let camera = far_camera_on_eight();
     let view = View::new(&camera, 1.0).unwrap().two_sided(true);
     for bytes in [&old, &new] {
         let mut front = ViewMesh::from_stream(bytes).unwrap();

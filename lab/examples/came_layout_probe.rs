@@ -1,9 +1,12 @@
 //! How many meta-nodes, and how many of a hierarchy's splits, the far, middle and near views of
 //! the came-vd table touch under other layouts of the same hierarchy: meta-nodes of L levels
 //! (the stream's 8, or 4), meta-nodes rooted at given depths before those of 8 levels, or of as
-//! many levels as keep a unit within S splits (BENCHMARKS.md, "What a meta-node costs").
+//! many levels as keep a unit within S splits (BENCHMARKS.md, "What a meta-node costs"), or
+//! units by depth band (a unit rooted at depth d holds its subtree's splits at depths d + K …
+//! d + K + B − 1).
 //! Run: cargo run --release --example came_layout_probe -- STREAM [DEPTHS…] (each DEPTHS a
-//! comma-separated list of root depths, as 4,8,11, to try beside the built-in layouts)
+//! comma-separated list of root depths, as 4,8,11, or band:K,B,WHOLE, to try beside the
+//! built-in layouts)
 use meshcodec::codecs::came::decode_tree;
 use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
 use meshcodec_lab::came::vd::{framing, towards, FOV_DEGREES, HEIGHT, VIEWS, WIDTH};
@@ -15,6 +18,72 @@ enum Rule {
     /// Units rooted at these depths, then meta-nodes of 8 levels.
     Tiers(Vec<u8>),
     Splits(usize),
+    /// Units by depth band: the first holds depths 0 … k + b − 1; a unit rooted at depth
+    /// d ≥ b holds its subtree's splits at depths d + k … d + k + b − 1 — or all of them from
+    /// d + k down when they number at most `whole`.
+    Bands {
+        k: u8,
+        b: u8,
+        whole: usize,
+    },
+}
+
+/// [`Rule::Bands`]: per inner node, the index of the unit that codes its split.
+fn band_partition(
+    tree: &meshcodec::codecs::came::decoded::DecodedTree,
+    inner_below: &[usize],
+    (k, b, whole): (u8, u8, usize),
+) -> (Vec<u32>, usize) {
+    let n = tree.nodes.len();
+    let mut unit_of = vec![u32::MAX; n];
+    let mut whole_unit: Vec<bool> = Vec::new();
+    let mut unit_at: std::collections::HashMap<u32, u32> = Default::default();
+    // Inner nodes under `r` at depth `a` or deeper.
+    let below = |r: u32, a: u8| -> usize {
+        let mut frontier = vec![r];
+        let mut total = 0;
+        while let Some(v) = frontier.pop() {
+            let node = &tree.nodes[v as usize];
+            let Some(ch) = node.children else { continue };
+            if node.id.len() >= a {
+                total += inner_below[v as usize];
+            } else {
+                frontier.extend(ch);
+            }
+        }
+        total
+    };
+    // Parents come before their children in the decoded order.
+    for v in 0..n {
+        let node = &tree.nodes[v];
+        if node.children.is_none() {
+            continue;
+        }
+        if node.parent != u32::MAX {
+            let pu = unit_of[node.parent as usize];
+            if whole_unit[pu as usize] {
+                unit_of[v] = pu;
+                continue;
+            }
+        }
+        let d = node.id.len();
+        let (root_depth, first) = if d < k + b {
+            (0, 0)
+        } else {
+            let a = k + b + (d - k - b) / b * b;
+            (a - k, a)
+        };
+        let mut r = v as u32;
+        while tree.nodes[r as usize].id.len() > root_depth {
+            r = tree.nodes[r as usize].parent;
+        }
+        let unit = *unit_at.entry(r).or_insert_with(|| {
+            whole_unit.push(below(r, first) <= whole);
+            whole_unit.len() as u32 - 1
+        });
+        unit_of[v] = unit;
+    }
+    (unit_of, whole_unit.len())
 }
 
 /// Per inner node: the index of the unit that codes its split.
@@ -46,6 +115,7 @@ fn partition(
                 None if height[root as usize] <= 12 => u8::MAX,
                 None => 8,
             },
+            Rule::Bands { .. } => unreachable!("band_partition"),
             Rule::Splits(s) => {
                 if inner_below[root as usize] <= s + s / 2 {
                     u8::MAX
@@ -126,6 +196,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Rule::Splits(64),
     ];
     for depths in std::env::args().skip(2) {
+        if let Some(band) = depths.strip_prefix("band:") {
+            let v: Vec<usize> = band.split(',').map(str::parse).collect::<Result<_, _>>()?;
+            let [k, b, whole] = v[..] else {
+                return Err("band:K,B,WHOLE".into());
+            };
+            rules.push(Rule::Bands {
+                k: k as u8,
+                b: b as u8,
+                whole,
+            });
+            continue;
+        }
         let depths: Vec<u8> = depths
             .split(',')
             .map(str::parse)
@@ -134,7 +216,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let partitions: Vec<_> = rules
         .iter()
-        .map(|r| partition(&tree, &inner_below, &height, r.clone()))
+        .map(|r| match *r {
+            Rule::Bands { k, b, whole } => band_partition(&tree, &inner_below, (k, b, whole)),
+            _ => partition(&tree, &inner_below, &height, r.clone()),
+        })
         .collect();
     for (rule, (_, units)) in rules.iter().zip(&partitions) {
         println!(

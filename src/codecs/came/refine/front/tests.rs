@@ -578,6 +578,14 @@ proptest! {
     }
 }
 
+/// Eyes around the test stream, near to far, for the guard's comparisons with and without it.
+const GUARD_EYES: [DVec3; 4] = [
+    DVec3::new(0.5, 0.8, 6.0),
+    DVec3::new(3.0, 0.5, 1.0),
+    DVec3::new(-4.0, -1.0, -3.0),
+    DVec3::new(0.5, 0.8, 30.0),
+];
+
 #[test]
 fn the_guard_reads_what_decides_a_face_rather_than_splitting_it() {
     // A face not certain from the meta-nodes at hand waits for those that hold its
@@ -586,12 +594,7 @@ fn the_guard_reads_what_decides_a_face_rather_than_splitting_it() {
     // faces; BENCHMARKS.md).
     let full = full_positions();
     let mut counts = Vec::new();
-    for eye in [
-        DVec3::new(0.5, 0.8, 6.0),
-        DVec3::new(3.0, 0.5, 1.0),
-        DVec3::new(-4.0, -1.0, -3.0),
-        DVec3::new(0.5, 0.8, 30.0),
-    ] {
+    for eye in GUARD_EYES {
         for tolerance in [0.5, 2.0, 8.0] {
             let faces = |guard: bool| {
                 let view = View::new(&camera(eye), tolerance)
@@ -625,12 +628,7 @@ fn with_triangle_normals_the_guard_reads_nothing_the_view_does_not() {
     // its stream against 68.1% unguarded).
     let full = full_positions();
     let (mut guarded_bytes, mut unguarded_bytes) = (0, 0);
-    for eye in [
-        DVec3::new(0.5, 0.8, 6.0),
-        DVec3::new(3.0, 0.5, 1.0),
-        DVec3::new(-4.0, -1.0, -3.0),
-        DVec3::new(0.5, 0.8, 30.0),
-    ] {
+    for eye in GUARD_EYES {
         for tolerance in [0.5, 2.0, 8.0] {
             let read = |guard: bool| {
                 let view = View::new(&camera(eye), tolerance)
