@@ -17,7 +17,8 @@
 //!   normals derived.
 //! - `*-before-*.mc` are streams of parameters today's encoders no longer choose (`emc` with its
 //!   face corrections after the last level, `came` without normal cones, deviations or
-//!   triangle normals), kept to show that those parameters still decode as they did.
+//!   triangle normals, or of meta-nodes of 8 levels), kept to show that those parameters still
+//!   decode as they did.
 //!
 //! All are regenerated on purpose with `UPDATE_GOLDEN=1 cargo test --release --test golden`,
 //! which a change of syntax must come with (and a new format version: docs/FORMAT.md, History).
@@ -309,6 +310,26 @@ fn came_streams_without_triangle_normals_still_decode_and_refine_with_the_guard(
         let adapted = front.settle(&view, Budget::UNLIMITED, 64);
         assert!(adapted.settled && adapted.unsure == 0, "{adapted:?}");
         front.check_invariants().unwrap();
+    }
+}
+
+/// `came` streams of syntax 4, whose meta-nodes hold 8 levels each, still decode exactly and
+/// refine: `came-eight-before-bands.mc` is the golden stream of that build, kept. Today's cuts
+/// units by depth band (docs/FORMAT.md §8.1), a ninth parameter byte giving the regions' levels.
+#[test]
+fn came_streams_of_eight_level_meta_nodes_still_decode_and_refine() {
+    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
+    let (old, new) = kept_came_stream_and_todays("came-eight-before-bands.mc");
+    let (old_header, new_header) = (header_of(&old), header_of(&new));
+    assert_eq!((old_header.syntax, old_header.params.len()), (4, 8));
+    assert!(new_header.syntax >= 5 && new_header.params.len() == 9);
+    let view = View::new(&far_camera_on_eight(), 0.25).unwrap();
+    for bytes in [&old, &new] {
+        let mut front = ViewMesh::from_stream(bytes).unwrap();
+        let adapted = front.settle(&view, Budget::UNLIMITED, 64);
+        assert!(adapted.settled && adapted.unsure == 0, "{adapted:?}");
+        front.check_invariants().unwrap();
+        assert!(front.face_count() > 0);
     }
 }
 

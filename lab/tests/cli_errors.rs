@@ -401,9 +401,10 @@ fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
     args.extend_from_slice(&camera);
     assert_clean_failure(&run(MESHCODEC, &args, d), "e.mc");
     // A stream cut after some meta-nodes: those past the cut are refused, each for its own
-    // branch, and the rest adapts.
+    // branch, and the rest adapts (cut early: this view of bunny 320 pixels wide reads only
+    // coarse bands, and cut at half the stream it lost none).
     let stream = std::fs::read(d.join("b.mc")).unwrap();
-    write(d, "cut.mc", &stream[..stream.len() / 2]);
+    write(d, "cut.mc", &stream[..stream.len() / 20]);
     let mut args = vec!["view", "cut.mc", "w.ply"];
     args.extend_from_slice(&camera);
     let out = run(MESHCODEC, &args, d);

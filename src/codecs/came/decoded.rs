@@ -584,7 +584,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         }
     }
 
-    /// Depth of the next unit in stream order, once its parent is decoded.
+    /// Depth of the next unit's first splits in stream order, once its parent is decoded.
     fn next_unit_depth(&self) -> Result<Option<u8>> {
         let i = self.units_in_order;
         if i >= self.index.len() {
@@ -592,7 +592,10 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         }
         match self.unit_root(i)? {
             Some(_) if i == 0 => Ok(Some(0)),
-            Some(root) => Ok(Some(self.tree.nodes[root as usize].id.len())),
+            Some(root) => {
+                let top = self.tree.nodes[root as usize].id.len();
+                Ok(Some(self.params.shape().band(top).start))
+            }
             None => Err(Error::malformed(
                 i + 1,
                 self.payload_start,

@@ -72,8 +72,11 @@ impl ViewMesh {
         for (s, deps) in delta.splits {
             self.nodes.depends_on[s as usize] = deps;
         }
-        for (unit, root) in delta.opens {
-            self.nodes.opens[root as usize] = unit as u32;
+        for (unit, node) in delta.opens {
+            self.nodes.opens[node as usize] = unit as u32;
+            if let Some(opened) = self.loading.opened.get_mut(unit) {
+                opened.push(node);
+            }
         }
     }
 
@@ -101,18 +104,29 @@ impl ViewMesh {
             UnitState::Idle => {
                 self.loading.units[unit as usize] = UnitState::Requested;
                 self.loading.outstanding += 1;
-                let (center, radius) = self.nodes.spheres[vu];
-                let priority = self.loading.view_now.screen_error(
-                    center,
-                    radius,
-                    self.nodes.deviations[vu],
-                    self.scale,
-                );
+                let priority = self.unit_priority(unit as usize);
                 self.loading.loader.request(unit as usize, priority);
                 Ready::Waiting
             }
             UnitState::Requested | UnitState::Supplied => Ready::Waiting,
             UnitState::Loaded | UnitState::Refused => Ready::Never,
         }
+    }
+
+    /// How much the view wants meta-node `unit`: the largest screen error of the open nodes
+    /// whose splits it holds ([`View::screen_error`]).
+    pub(super) fn unit_priority(&self, unit: usize) -> f64 {
+        self.loading.opened[unit]
+            .iter()
+            .map(|&v| {
+                let (center, radius) = self.nodes.spheres[v as usize];
+                self.loading.view_now.screen_error(
+                    center,
+                    radius,
+                    self.nodes.deviations[v as usize],
+                    self.scale,
+                )
+            })
+            .fold(0.0, f64::max)
     }
 }

@@ -253,6 +253,7 @@ impl ViewMesh {
             scratch: Scratch::default(),
             loading: Loading {
                 loader,
+                opened: vec![Vec::new(); units.len()],
                 units,
                 outstanding: 1,
                 view_now: View::nothing(),

@@ -112,6 +112,9 @@ pub(super) struct Scratch {
 pub(super) struct Loading {
     pub(super) loader: Loader,
     pub(super) units: Vec<UnitState>,
+    /// Per unit: the open nodes whose splits it holds (one, its root, in meta-nodes of L
+    /// levels; those at the band's first depth under its root in depth bands).
+    pub(super) opened: Vec<Vec<u32>>,
     /// Asked for and not arrived.
     pub(super) outstanding: usize,
     /// The view of the adaptation under way: the meta-nodes it asks for go to the loader with

@@ -151,11 +151,16 @@ fn meta_nodes_are_asked_for_most_wanted_first() {
             let errors: Vec<f64> = wanted
                 .iter()
                 .map(|&(unit, _)| {
-                    let v = (0..front.nodes.opens.len())
-                        .find(|&v| front.nodes.opens[v] == unit as u32)
-                        .expect("a node waits for each unit asked for");
-                    let (center, radius) = front.nodes.spheres[v];
-                    view.screen_error(center, radius, front.nodes.deviations[v], front.scale)
+                    // The most wanted of the nodes waiting for it.
+                    let waiting = (0..front.nodes.opens.len())
+                        .filter(|&v| front.nodes.opens[v] == unit as u32);
+                    let errors = waiting.map(|v| {
+                        let (center, radius) = front.nodes.spheres[v];
+                        view.screen_error(center, radius, front.nodes.deviations[v], front.scale)
+                    });
+                    errors
+                        .reduce(f64::max)
+                        .expect("a node waits for each unit asked for")
                 })
                 .collect();
             assert!(
