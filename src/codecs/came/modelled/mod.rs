@@ -98,9 +98,10 @@ impl Codec for Came {
 }
 
 /// How `came` cuts its hierarchy into units (syntax 5): bands of two levels over regions of six
-/// (units of at most about 2^6 · 3 splits, as many as meta-nodes of 8 levels held on
-/// dragon-50k), a unit holding the rest of its subtree when that is at most 256 splits
-/// (BENCHMARKS.md, "Units by depth band").
+/// (units of up to about 2^6 · 3 splits; 110 on average on dragon-50k and the ×16 mesh), a
+/// unit holding the rest of its subtree when that is at most 256 splits. Regions of five read
+/// dragon-50k's far view in 11.4% of a 2.7% larger stream, of seven in 13.6% of a 1.4% smaller
+/// one (BENCHMARKS.md, "`came` syntax 5: units by depth band").
 pub const SHAPE: Shape = Shape::Bands {
     region: 6,
     band: 2,
