@@ -8,6 +8,7 @@ use super::{Adapted, Budget, Ready, State, Suspicion, ViewMesh};
 use crate::hierarchy::came::face_normals::FaceNormal;
 use crate::hierarchy::came::NodeId;
 use glam::DVec3;
+use smallvec::SmallVec;
 
 /// A margin for the rounding of the orientation tests' products (relative to their size).
 const SLACK: f64 = 1.0 + 1e-9;
@@ -367,8 +368,28 @@ impl ViewMesh {
                 moved[k] = child;
                 self.orientation_certain(moved, f)
             };
-            if let Some(i) = (0..3).find(|&i| fixes(corners[i])) {
-                corners[..=i].rotate_right(1);
+            match (0..3).find(|&i| fixes(corners[i])) {
+                Some(i) => corners[..=i].rotate_right(1),
+                None => {
+                    // A corner whose split is not loaded may be the one that fixes it: the face
+                    // waits for those splits rather than splitting the coarsest corner blind.
+                    let unloaded = corners.into_iter().filter(|&x| {
+                        self.nodes.children[x as usize][0] == NONE
+                            && self.nodes.opens[x as usize] != NONE
+                    });
+                    let unloaded: SmallVec<[u32; 3]> = unloaded.collect();
+                    let mut on_its_way = false;
+                    for x in unloaded {
+                        on_its_way |= self.ready(x) == Ready::Waiting;
+                    }
+                    if on_its_way {
+                        self.guard.suspected[fu] = Suspicion::Moved;
+                        done.waiting += 1;
+                        held.push(f);
+                        unsure += 1;
+                        continue;
+                    }
+                }
             }
             let mut outcome = Ready::Never;
             let mut no_room = false;
