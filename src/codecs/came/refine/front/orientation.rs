@@ -8,7 +8,6 @@ use super::{Adapted, Budget, Ready, State, Suspicion, ViewMesh};
 use crate::hierarchy::came::face_normals::FaceNormal;
 use crate::hierarchy::came::NodeId;
 use glam::DVec3;
-use smallvec::SmallVec;
 
 /// A margin for the rounding of the orientation tests' products (relative to their size).
 const SLACK: f64 = 1.0 + 1e-9;
@@ -71,11 +70,7 @@ impl CodedNormal {
     /// Whether a face of normal `n` (of length `area`) surely turns within 90° of the
     /// counterpart's: n's angle to the direction and the bound sum to less than 90°.
     fn holds(self, n: DVec3, area: f64) -> bool {
-        let d = DVec3::new(
-            self.direction[0] as f64,
-            self.direction[1] as f64,
-            self.direction[2] as f64,
-        );
+        let d = glam::Vec3::from(self.direction).as_dvec3();
         self.decides() && n.dot(d) > area * self.sin as f64 * SLACK
     }
 }
@@ -340,56 +335,48 @@ impl ViewMesh {
             // Not certain from what is loaded, but the stream holds what would tell: the
             // face waits for it. Splitting instead chases its counterpart down the hierarchy,
             // and the faces each split makes may be no more certain than it.
-            if !self.faces.normals[fu].decides() && self.ask_for_certificate(f) {
+            let mut waits = !self.faces.normals[fu].decides() && self.ask_for_certificate(f);
+            let mut corners = corners;
+            if !waits {
+                corners.sort_by(|&a, &b| {
+                    let radius = |v: u32| self.nodes.spheres[v as usize].1;
+                    radius(b).total_cmp(&radius(a))
+                });
+                // First the coarsest corner whose split alone turns the face the right way
+                // (its child on the counterpart's leaf path in its place), if one does: on
+                // dragon-50k's far view 1,178 faces against 1,264 splitting the coarsest (990
+                // unguarded).
+                let now = self.faces.corners[fu];
+                let leaves = self.faces.leaf_corners[fu];
+                let fixes = |x: u32| {
+                    let Some(k) = now.iter().position(|&c| c == x) else {
+                        return false;
+                    };
+                    let Some(child) = self.child_toward(x, leaves[k]) else {
+                        return false;
+                    };
+                    let mut moved = now;
+                    moved[k] = child;
+                    self.orientation_certain(moved, f)
+                };
+                match (0..3).find(|&i| fixes(corners[i])) {
+                    Some(i) => corners[..=i].rotate_right(1),
+                    // A corner whose split is not loaded may be the one that fixes it: the
+                    // face waits for those splits rather than splitting the coarsest corner
+                    // blind (`ready` asks for a corner's meta-node only where it is missing).
+                    None => {
+                        for x in corners {
+                            waits |= self.ready(x) == Ready::Waiting;
+                        }
+                    }
+                }
+            }
+            if waits {
                 self.guard.suspected[fu] = Suspicion::Moved;
                 done.waiting += 1;
                 held.push(f);
                 unsure += 1;
                 continue;
-            }
-            let mut corners = corners;
-            corners.sort_by(|&a, &b| {
-                let radius = |v: u32| self.nodes.spheres[v as usize].1;
-                radius(b).total_cmp(&radius(a))
-            });
-            // First the coarsest corner whose split alone turns the face the right way (its
-            // child on the counterpart's leaf path in its place), if one does: on dragon-50k's
-            // far view 1,178 faces against 1,264 splitting the coarsest (990 unguarded).
-            let now = self.faces.corners[fu];
-            let leaves = self.faces.leaf_corners[fu];
-            let fixes = |x: u32| {
-                let Some(k) = now.iter().position(|&c| c == x) else {
-                    return false;
-                };
-                let Some(child) = self.child_toward(x, leaves[k]) else {
-                    return false;
-                };
-                let mut moved = now;
-                moved[k] = child;
-                self.orientation_certain(moved, f)
-            };
-            match (0..3).find(|&i| fixes(corners[i])) {
-                Some(i) => corners[..=i].rotate_right(1),
-                None => {
-                    // A corner whose split is not loaded may be the one that fixes it: the face
-                    // waits for those splits rather than splitting the coarsest corner blind.
-                    let unloaded = corners.into_iter().filter(|&x| {
-                        self.nodes.children[x as usize][0] == NONE
-                            && self.nodes.opens[x as usize] != NONE
-                    });
-                    let unloaded: SmallVec<[u32; 3]> = unloaded.collect();
-                    let mut on_its_way = false;
-                    for x in unloaded {
-                        on_its_way |= self.ready(x) == Ready::Waiting;
-                    }
-                    if on_its_way {
-                        self.guard.suspected[fu] = Suspicion::Moved;
-                        done.waiting += 1;
-                        held.push(f);
-                        unsure += 1;
-                        continue;
-                    }
-                }
             }
             let mut outcome = Ready::Never;
             let mut no_room = false;
