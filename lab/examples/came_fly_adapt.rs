@@ -3,9 +3,12 @@
 //! waits apart — the fly-through experiment interleaves three fronts and the error measurement,
 //! which leaves each front's data out of the cache.
 //! Run: cargo run --release --example came_fly_adapt -- STREAM
-//! (the fly-through's stream: `experiment came-vd` writes its mesh to
-//! target/came-vd/bunny-closed-35k-x16.ply; `meshcodec encode --codec came` it.)
+//! (when STREAM does not exist, the fly-through's stream — bunny-closed-35k subdivided twice,
+//! `came` at 12 bits — is encoded and written there first: about two minutes.)
 use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
+use meshcodec::codecs::{self, EncodeOptions};
+use meshcodec::mesh::quantize::GridShape;
+use meshcodec_lab::came::extras::{table_mesh, QUANT_BITS, TABLE_MESHES};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -13,6 +16,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .nth(1)
         .ok_or("usage: came_fly_adapt STREAM")?;
     let path = std::path::Path::new(&path);
+    if !path.exists() {
+        let (name, subdivisions) = TABLE_MESHES[3];
+        let (_, mesh) = table_mesh(name, subdivisions)?;
+        let options = EncodeOptions {
+            quant_bits: QUANT_BITS,
+            grid: GridShape::Cubic,
+        };
+        let canonical = codecs::canonical_for(&mesh, &options)?;
+        eprintln!("encoding {name} x{} to {}", 4u32.pow(subdivisions), path.display());
+        let stream = codecs::by_name("came")?.encode(&canonical)?.bytes;
+        std::fs::write(path, stream)?;
+    }
     let mut full = ViewMesh::open_file(path)?;
     full.settle(&View::everything(), Budget::UNLIMITED, 256);
     let cameras = meshcodec_lab::came::flythrough::cameras(&full.mesh())?;
