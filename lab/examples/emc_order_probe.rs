@@ -1,0 +1,666 @@
+//! What `emc`'s intermediate levels could gain from another order of the same octree decisions
+//! (issue "EMC at every prefix"), estimated before any syntax is built.
+//!
+//! The octree of `emc` is a binary tree over the steps (three a level, one axis each): a node
+//! either keeps all its vertices in one half (a "which half" bit) or splits. Coded in level
+//! order, a cluster is shown at its cell's centre until its vertices part, so that by the level
+//! where the prefix costs 5 bits a vertex on bunny.ply nearly every vertex is present at 7 bits of
+//! precision. The order probed here lets a cluster's **representative** — the vertex on the
+//! cluster's leftmost path of the tree, a real vertex of the mesh — refine ahead of the cluster's
+//! split: *extend* codes the next decision on that path (where the path's node splits, the
+//! representative takes the lower half by this convention, so the choice costs nothing; the
+//! other half waits), and *split* shows the waiting half at the shallowest branch point as a
+//! vertex of its own. Every decision of the tree is still coded exactly once, so the lossless
+//! stream carries the same information; only the order changes.
+//!
+//! Bits per decision are `emc`'s own, level by level, from its encoding of the same mesh: a
+//! split costs that level's connectivity bits per split, a "which half" bit that level's
+//! geometry bits per such bit. A context model built for the new order would code them
+//! differently: these are estimates, not a stream.
+//!
+//! Orders compared, at the bits of each `emc` level (every mesh shown with the original
+//! triangles projected through the clusters, vertices at their representatives' cell centres,
+//! RMS both ways relative to the diagonal, as `experiment` measures):
+//! - *level order*: every decision of a level before the next (today's order, at cell centres);
+//! - *greedy*: the decision that removes the most quadric error (the sum of squared distances of
+//!   the cluster's vertices' face planes from its representative, plus a tenth of their area
+//!   times the squared distance from the vertices) per estimated bit, chosen with the encoder's
+//!   knowledge, which a decoder-side estimate would only approximate. Gains are taken at the
+//!   representatives the decisions place, or, for splits, at the quadrics' least points (what the
+//!   split could give once its halves are refined);
+//! - and the level order with each cluster at its quadric's least point, its bits not counted:
+//!   what knowing where a cluster should stand would be worth.
+//!
+//! BENCHMARKS.md ("`emc`'s intermediate levels", the second probe) has the figures.
+//! Run: cargo run --release --example emc_order_probe -- [mesh…]
+
+use meshcodec::codecs::emc::{EmcParams, Syntax};
+use meshcodec::codecs::{self, EncodeOptions, LevelMesh};
+use meshcodec::mesh::io::{read_mesh, resolve};
+use meshcodec::mesh::quantize::GridShape;
+use meshcodec::mesh::{CanonicalMesh, TriMesh};
+use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SEED};
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashSet};
+
+/// A quadric: err(p) = pᵀAp + 2bᵀp + c (A symmetric: xx, xy, xz, yy, yz, zz).
+#[derive(Clone, Copy, Default)]
+struct Quadric([f64; 10]);
+
+impl Quadric {
+    fn plane(n: [f64; 3], d: f64, w: f64) -> Quadric {
+        let [a, b, c] = n;
+        Quadric(
+            [
+                a * a,
+                a * b,
+                a * c,
+                b * b,
+                b * c,
+                c * c,
+                a * d,
+                b * d,
+                c * d,
+                d * d,
+            ]
+            .map(|x| x * w),
+        )
+    }
+    fn add(&mut self, o: &Quadric) {
+        for i in 0..10 {
+            self.0[i] += o.0[i];
+        }
+    }
+    fn sub(&self, o: &Quadric) -> Quadric {
+        Quadric(std::array::from_fn(|i| self.0[i] - o.0[i]))
+    }
+    /// Its least value (A is positive definite: every vertex's quadric holds a point term).
+    fn least(&self) -> f64 {
+        self.least_point().map_or(0.0, |p| self.at(p).max(0.0))
+    }
+    /// Where it is least.
+    fn least_point(&self) -> Option<[f64; 3]> {
+        let q = &self.0;
+        let a =
+            glam::DMat3::from_cols_array(&[q[0], q[1], q[2], q[1], q[3], q[4], q[2], q[4], q[5]]);
+        (a.determinant().abs() > 1e-300)
+            .then(|| (a.inverse() * -glam::DVec3::new(q[6], q[7], q[8])).to_array())
+    }
+    fn at(&self, p: [f64; 3]) -> f64 {
+        let q = &self.0;
+        let [x, y, z] = p;
+        q[0] * x * x
+            + 2.0 * q[1] * x * y
+            + 2.0 * q[2] * x * z
+            + q[3] * y * y
+            + 2.0 * q[4] * y * z
+            + q[5] * z * z
+            + 2.0 * (q[6] * x + q[7] * y + q[8] * z)
+            + q[9]
+    }
+}
+
+/// The octree of one mesh as sorted keys, with per-level costs.
+struct Tree {
+    mesh: CanonicalMesh,
+    steps: usize,
+    levels: usize,
+    axis: Vec<usize>,
+    /// Vertex ids sorted by key, their keys, and each vertex's place in that order.
+    sorted: Vec<u32>,
+    keys: Vec<u128>,
+    rank: Vec<u32>,
+    /// Prefix sums of the vertices' quadrics in sorted order.
+    prefix: Vec<Quadric>,
+    /// Estimated bits of a split and of a "which half" bit, per level (0-based).
+    split_bits: Vec<f64>,
+    half_bits: Vec<f64>,
+    /// Bits before the first decision (header, index, flushes).
+    fixed_bits: f64,
+    /// Whether a split is valued by the quadrics' least values (where the clusters' vertices
+    /// could best stand) rather than at the representatives the decisions so far place.
+    splits_at_best: bool,
+}
+
+impl Tree {
+    fn bit(&self, i: usize, t: usize) -> u32 {
+        ((self.keys[i] >> (self.steps - 1 - t)) & 1) as u32
+    }
+    /// End of the node at depth `t` holding sorted vertex `lo`, within `[lo, hi)`.
+    fn node_end(&self, lo: usize, hi: usize, t: usize) -> usize {
+        if t == 0 {
+            return hi;
+        }
+        let shift = self.steps - t;
+        let key = self.keys[lo] >> shift;
+        lo + self.keys[lo..hi].partition_point(|k| (k >> shift) == key)
+    }
+    /// Where the node `[lo, e)` at depth `t` parts (first vertex of the upper half).
+    fn middle(&self, lo: usize, e: usize, t: usize) -> usize {
+        lo + (lo..e).take_while(|&i| self.bit(i, t) == 0).count()
+    }
+    /// Estimated bits of the "which half" decisions on the leftmost path of `[lo, hi)` from
+    /// depth `from` to `to` (its branch points cost nothing: the splits pay for them).
+    fn path_bits(&self, lo: usize, hi: usize, from: usize, to: usize) -> f64 {
+        (from..to)
+            .filter(|&t| {
+                let e = self.node_end(lo, hi, t);
+                let m = self.middle(lo, e, t);
+                !(m > lo && m < e)
+            })
+            .map(|t| self.half_bits[t / 3])
+            .sum()
+    }
+    fn quadric(&self, lo: usize, hi: usize) -> Quadric {
+        self.prefix[hi].sub(&self.prefix[lo])
+    }
+    /// World position of sorted vertex `lo` known to depth `r`: its cell's centre there.
+    fn position(&self, lo: usize, r: usize) -> [f64; 3] {
+        let v = self.sorted[lo] as usize;
+        let g = &self.mesh.grid;
+        let l = self.levels as u32;
+        std::array::from_fn(|a| {
+            let k = (0..r).filter(|&t| self.axis[t] == a).count() as u32;
+            let c = self.mesh.cells[v][a];
+            let span = 1u64 << (l - k);
+            let centre = ((c as u64 >> (l - k)) * span) as f64 + (span as f64 - 1.0) / 2.0;
+            g.origin[a] + (centre + 0.5) * g.cell[a]
+        })
+    }
+}
+
+#[derive(Clone, Copy)]
+struct Cluster {
+    lo: usize,
+    hi: usize,
+    /// Depth of the cluster's node (every member agrees on the steps before it).
+    s: usize,
+    /// Depth the representative is known to.
+    r: usize,
+}
+
+enum Op {
+    Extend,
+    /// Show the waiting half at the shallowest branch point, its representative known to the
+    /// given depth.
+    Split(usize),
+    /// Extend to the next branch point on the path, then split there (a cluster whose next
+    /// steps would move its representative away from its vertices still splits).
+    SplitNext,
+}
+
+/// The two operations of cluster `c` with their gain and estimated bits.
+fn operations(tree: &Tree, c: &Cluster) -> Vec<(Op, f64, f64)> {
+    let mut out = Vec::new();
+    let q = tree.quadric(c.lo, c.hi);
+    let here = tree.position(c.lo, c.r);
+    if c.r < tree.steps {
+        let e = tree.node_end(c.lo, c.hi, c.r);
+        let m = tree.middle(c.lo, e, c.r);
+        let branches = m > c.lo && m < e;
+        let bits = if branches {
+            0.0
+        } else {
+            tree.half_bits[c.r / 3]
+        };
+        let gain = q.at(here) - q.at(tree.position(c.lo, c.r + 1));
+        out.push((Op::Extend, gain, bits));
+    }
+    if let Some((b, mid)) = branch(tree, c) {
+        // The new vertex comes in at its sibling's precision (a coarse cell's centre can lie
+        // farther from its vertices than the sibling's representative does).
+        let right = tree.quadric(mid, c.hi);
+        let best = (b + 1..=c.r)
+            .map(|k| {
+                let gain = if tree.splits_at_best {
+                    q.least() - tree.quadric(c.lo, mid).least() - right.least()
+                } else {
+                    right.at(here) - right.at(tree.position(mid, k))
+                };
+                let bits = tree.split_bits[b / 3] + tree.path_bits(mid, c.hi, b + 1, k);
+                (Op::Split(k), gain, bits)
+            })
+            .max_by(|a, b| priority(a.1, a.2).total_cmp(&priority(b.1, b.2)))
+            .expect("b < r");
+        out.push(best);
+    } else if c.hi - c.lo > 1 {
+        let mut bits = 0.0;
+        for t in c.r..tree.steps {
+            let e = tree.node_end(c.lo, c.hi, t);
+            let m = tree.middle(c.lo, e, t);
+            if m > c.lo && m < e {
+                let (left, right) = (tree.quadric(c.lo, m), tree.quadric(m, c.hi));
+                let gain = if tree.splits_at_best {
+                    q.least() - left.least() - right.least()
+                } else {
+                    q.at(here)
+                        - left.at(tree.position(c.lo, t + 1))
+                        - right.at(tree.position(m, t + 1))
+                };
+                out.push((Op::SplitNext, gain, bits + tree.split_bits[t / 3]));
+                break;
+            }
+            bits += tree.half_bits[t / 3];
+        }
+    }
+    out
+}
+
+/// The shallowest branch point known on the cluster's leftmost path, and where it parts.
+fn branch(tree: &Tree, c: &Cluster) -> Option<(usize, usize)> {
+    (c.s..c.r).find_map(|t| {
+        let m = tree.middle(c.lo, c.hi, t);
+        (m > c.lo && m < c.hi).then_some((t, m))
+    })
+}
+
+struct State<'a> {
+    tree: &'a Tree,
+    clusters: Vec<Cluster>,
+    owner: Vec<u32>,
+    bits: f64,
+}
+
+impl<'a> State<'a> {
+    fn new(tree: &'a Tree) -> State<'a> {
+        State {
+            tree,
+            clusters: vec![Cluster {
+                lo: 0,
+                hi: tree.sorted.len(),
+                s: 0,
+                r: 0,
+            }],
+            owner: vec![0; tree.sorted.len()],
+            bits: tree.fixed_bits,
+        }
+    }
+    fn apply(&mut self, id: usize, op: &Op, bits: f64) -> Option<usize> {
+        self.bits += bits;
+        let c = self.clusters[id];
+        match op {
+            Op::Extend => {
+                self.clusters[id].r += 1;
+                None
+            }
+            Op::SplitNext => {
+                while branch(self.tree, &self.clusters[id]).is_none() {
+                    self.clusters[id].r += 1;
+                }
+                let r = self.clusters[id].r;
+                self.apply(id, &Op::Split(r), 0.0)
+            }
+            &Op::Split(k) => {
+                let (b, mid) = branch(self.tree, &c).expect("a split has a branch");
+                self.clusters[id] = Cluster {
+                    lo: c.lo,
+                    hi: mid,
+                    s: b + 1,
+                    r: c.r,
+                };
+                let new = self.clusters.len();
+                self.clusters.push(Cluster {
+                    lo: mid,
+                    hi: c.hi,
+                    s: b + 1,
+                    r: k,
+                });
+                for o in &mut self.owner[mid..c.hi] {
+                    *o = new as u32;
+                }
+                Some(new)
+            }
+        }
+    }
+    /// The mesh shown: the original triangles through the clusters, each at its
+    /// representative — or, `ideal`, where its quadric is least (bits not counted).
+    fn mesh(&self, ideal: bool) -> LevelMesh {
+        let positions = self
+            .clusters
+            .iter()
+            .map(|c| {
+                let coded = self.tree.position(c.lo, c.r);
+                let at = if ideal {
+                    self.tree.quadric(c.lo, c.hi).least_point().unwrap_or(coded)
+                } else {
+                    coded
+                };
+                at.into()
+            })
+            .collect();
+        let mut seen = HashSet::new();
+        let mut faces = Vec::new();
+        for f in &self.tree.mesh.faces {
+            let t = f.map(|v| self.owner[self.tree.rank[v as usize] as usize]);
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                continue;
+            }
+            let key = meshcodec::mesh::canonical::rotate_to_smallest(t);
+            if seen.insert(key) {
+                faces.push(t);
+            }
+        }
+        LevelMesh {
+            mesh: TriMesh::new(positions, faces),
+            loose_edges: Vec::new(),
+            attributes: None,
+        }
+    }
+}
+
+#[derive(PartialEq)]
+struct Candidate {
+    priority: f64,
+    id: usize,
+    version: u32,
+}
+impl Eq for Candidate {}
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Candidate {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.priority
+            .total_cmp(&o.priority)
+            .then(o.id.cmp(&self.id))
+    }
+}
+
+/// Gain per bit; a decision the model prices at nothing (the path meeting a branch, whose
+/// flag the split's bits pay) is taken at once, whatever it does to the error: the split
+/// needs it.
+fn priority(gain: f64, bits: f64) -> f64 {
+    if bits <= 0.0 {
+        f64::INFINITY
+    } else {
+        gain / bits
+    }
+}
+
+fn best(tree: &Tree, c: &Cluster) -> Option<(Op, f64, f64)> {
+    operations(tree, c)
+        .into_iter()
+        .max_by(|a, b| priority(a.1, a.2).total_cmp(&priority(b.1, b.2)))
+}
+
+/// A mesh as read, its octree, and `emc`'s bits and RMS at the end of each level.
+struct Built {
+    original: TriMesh,
+    tree: Tree,
+    level_bits: Vec<f64>,
+    emc_rms: Vec<f64>,
+}
+
+fn build(name: &str) -> Result<Built, Box<dyn std::error::Error>> {
+    let mesh = read_mesh(&resolve(name)?)?;
+    let options = EncodeOptions {
+        quant_bits: 12,
+        grid: GridShape::Cubic,
+    };
+    let canonical = codecs::canonical_for(&mesh, &options)?;
+    let encoded = codecs::by_name("emc")?.encode(&canonical)?;
+    let order = EmcParams::for_mesh(&canonical, Syntax::Modelled).order;
+    let levels = order.levels as usize;
+    let steps = 3 * levels;
+    let axis: Vec<usize> = (0..steps).map(|t| order.axis(t)).collect();
+    let n = canonical.vertex_count();
+    let key = |v: usize| -> u128 {
+        (0..steps).fold(0u128, |k, t| {
+            let c = canonical.cells[v][axis[t]];
+            (k << 1) | ((c >> (levels - 1 - t / 3)) & 1) as u128
+        })
+    };
+    let mut sorted: Vec<u32> = (0..n as u32).collect();
+    let all: Vec<u128> = (0..n).map(key).collect();
+    sorted.sort_by_key(|&v| all[v as usize]);
+    let keys: Vec<u128> = sorted.iter().map(|&v| all[v as usize]).collect();
+    let mut rank = vec![0u32; n];
+    for (i, &v) in sorted.iter().enumerate() {
+        rank[v as usize] = i as u32;
+    }
+    // Area-weighted face planes at the cells' centres.
+    let world = canonical.to_mesh();
+    let mut per_vertex = vec![Quadric::default(); n];
+    for f in &canonical.faces {
+        let p = f.map(|v| world.positions[v as usize]);
+        let cross = (p[1] - p[0]).cross(p[2] - p[0]);
+        let area = cross.length() / 2.0;
+        if area <= 0.0 {
+            continue;
+        }
+        let normal = cross.normalize();
+        let q = Quadric::plane(normal.to_array(), -normal.dot(p[0]), area);
+        for v in f {
+            per_vertex[*v as usize].add(&q);
+        }
+    }
+    // Plus a tenth of each vertex's area times its squared distance from the representative:
+    // planes alone let a coarse cluster sit on a plane of its vertices far from them.
+    // (1.0 measured alike; with planes alone the greedy order stalls on clusters no single
+    // decision improves.)
+    let weight = 0.1;
+    for (v, q) in per_vertex.iter_mut().enumerate() {
+        let area = q.0[0] + q.0[3] + q.0[5];
+        let w = weight * area;
+        let p = world.positions[v].to_array();
+        q.add(&Quadric([
+            w,
+            0.0,
+            0.0,
+            w,
+            0.0,
+            w,
+            -w * p[0],
+            -w * p[1],
+            -w * p[2],
+            w * (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]),
+        ]));
+    }
+    let mut prefix = vec![Quadric::default(); n + 1];
+    for (i, &v) in sorted.iter().enumerate() {
+        prefix[i + 1] = prefix[i];
+        prefix[i + 1].add(&per_vertex[v as usize]);
+    }
+    // Distinct prefixes at each depth: nodes; a level's splits and "which half" bits.
+    let distinct: Vec<usize> = (0..=steps)
+        .map(|t| {
+            if t == 0 {
+                return 1;
+            }
+            1 + keys
+                .windows(2)
+                .filter(|w| (w[0] >> (steps - t)) != (w[1] >> (steps - t)))
+                .count()
+        })
+        .collect();
+    let mut split_bits = vec![0.0; levels];
+    let mut half_bits = vec![0.0; levels];
+    let mut conn_before = 0;
+    let mut geom_before = 0;
+    for l in 0..levels {
+        let record = &encoded.levels[l];
+        let conn = (record.connectivity_bits - conn_before) as f64;
+        let geom = (record.geometry_bits - geom_before) as f64;
+        conn_before = record.connectivity_bits;
+        geom_before = record.geometry_bits;
+        let splits = (distinct[3 * l + 3] - distinct[3 * l]) as f64;
+        let halves: usize = (3 * l..3 * l + 3)
+            .map(|t| 2 * distinct[t] - distinct[t + 1])
+            .sum();
+        split_bits[l] = if splits > 0.0 { conn / splits } else { 0.0 };
+        half_bits[l] = if halves > 0 {
+            geom / halves as f64
+        } else {
+            0.0
+        };
+    }
+    let last = encoded.levels.last().expect("levels");
+    let fixed_bits =
+        8.0 * last.end_byte as f64 - last.connectivity_bits as f64 - last.geometry_bits as f64;
+    let level_bits: Vec<f64> = encoded
+        .levels
+        .iter()
+        .map(|r| 8.0 * r.end_byte as f64)
+        .collect();
+    let reference = Reference::new(&mesh, SampleBudget::default(), DEFAULT_SEED);
+    let mut emc_rms = Vec::new();
+    let mut decoder = codecs::open(&encoded.bytes)?;
+    while decoder.advance()? {
+        emc_rms.push(
+            reference
+                .compare(&decoder.mesh()?)
+                .map_or(f64::NAN, |d| d.rms),
+        );
+    }
+    let tree = Tree {
+        mesh: canonical,
+        steps,
+        levels,
+        axis,
+        sorted,
+        keys,
+        rank,
+        prefix,
+        split_bits,
+        half_bits,
+        fixed_bits,
+        splits_at_best: false,
+    };
+    Ok(Built {
+        original: mesh,
+        tree,
+        level_bits,
+        emc_rms,
+    })
+}
+
+type Row = (f64, usize, f64);
+
+/// RMS of a state's mesh, at its representatives or (`true`) at its quadrics' least points.
+type Measure<'a> = dyn Fn(&State, bool) -> f64 + 'a;
+
+/// Every decision of a depth before the next (today's order), measured at the end of each level.
+fn level_order(tree: &Tree, rms: &Measure) -> Vec<(Row, f64)> {
+    let mut rows = Vec::new();
+    let mut state = State::new(tree);
+    for t in 0..tree.steps {
+        for id in 0..state.clusters.len() {
+            let c = state.clusters[id];
+            if c.r != t {
+                continue;
+            }
+            let ops = operations(tree, &c);
+            let extend = ops.iter().find(|o| matches!(o.0, Op::Extend)).map(|o| o.2);
+            state.apply(id, &Op::Extend, extend.unwrap_or(0.0));
+            let c = state.clusters[id];
+            if branch(tree, &c).is_some() {
+                state.apply(id, &Op::Split(t + 1), tree.split_bits[t / 3]);
+            }
+        }
+        if t % 3 == 2 {
+            rows.push((
+                (state.bits, state.clusters.len(), rms(&state, false)),
+                rms(&state, true),
+            ));
+        }
+    }
+    rows
+}
+
+/// The decision of most gain per bit first, measured where the bits reach each of `targets`.
+fn greedy(tree: &Tree, targets: &[f64], rms: &Measure) -> Vec<Row> {
+    let mut state = State::new(tree);
+    let mut version = vec![0u32; 1];
+    let mut heap = BinaryHeap::new();
+    let push = |heap: &mut BinaryHeap<Candidate>, c: &Cluster, id, v| {
+        if let Some((_, gain, bits)) = best(tree, c) {
+            heap.push(Candidate {
+                priority: priority(gain, bits),
+                id,
+                version: v,
+            });
+        }
+    };
+    push(&mut heap, &state.clusters[0], 0, 0);
+    let mut rows = Vec::new();
+    while rows.len() < targets.len() {
+        let Some(top) = heap.pop() else {
+            rows.push((state.bits, state.clusters.len(), rms(&state, false)));
+            continue;
+        };
+        if top.version != version[top.id] {
+            continue;
+        }
+        let c = state.clusters[top.id];
+        let (op, _, bits) = best(tree, &c).expect("a candidate has an operation");
+        while rows.len() < targets.len() && state.bits + bits > targets[rows.len()] {
+            rows.push((state.bits, state.clusters.len(), rms(&state, false)));
+        }
+        let new = state.apply(top.id, &op, bits);
+        version[top.id] += 1;
+        push(&mut heap, &state.clusters[top.id], top.id, version[top.id]);
+        if let Some(new) = new {
+            version.push(0);
+            push(&mut heap, &state.clusters[new], new, 0);
+        }
+    }
+    rows
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut meshes: Vec<String> = std::env::args().skip(1).collect();
+    if meshes.is_empty() {
+        meshes = vec!["bunny".into()];
+    }
+    for name in meshes {
+        let Built {
+            original,
+            mut tree,
+            level_bits,
+            emc_rms,
+        } = build(&name)?;
+        let reference = Reference::new(&original, SampleBudget::default(), DEFAULT_SEED);
+        let n = tree.sorted.len() as f64;
+        let rms = |state: &State, ideal: bool| {
+            reference
+                .compare(&state.mesh(ideal))
+                .map_or(f64::NAN, |d| d.rms)
+        };
+        let levels = level_order(&tree, &rms);
+        let at_representatives = greedy(&tree, &level_bits, &rms);
+        tree.splits_at_best = true;
+        let at_best = greedy(&tree, &level_bits, &rms);
+        println!(
+            "{name} (12 bits, {} vertices); estimated bits: {:.0} before the first decision; a split, by level: {:?}; a which-half bit: {:?}",
+            n,
+            tree.fixed_bits,
+            tree.split_bits.iter().map(|b| (b * 10.0).round() / 10.0).collect::<Vec<_>>(),
+            tree.half_bits.iter().map(|b| (b * 100.0).round() / 100.0).collect::<Vec<_>>()
+        );
+        println!("| level | bits/vertex | `emc` RMS (shown where predicted) | level order at cell centres: vertices, RMS | greedy, gains at the representatives: vertices, RMS | greedy, splits by their quadrics' least values: vertices, RMS | that / level order | level order, each cluster where its quadric is least (position bits not counted): RMS |");
+        println!("|---:|---:|---:|---|---|---|---:|---:|");
+        for l in 0..level_bits.len() {
+            let ((_, lv, lr), ideal) = levels[l];
+            let (_, av, ar) = at_representatives[l];
+            let (_, bv, br) = at_best[l];
+            println!(
+                "| {} | {:.3} | {:.3e} | {}, {:.3e} | {}, {:.3e} | {}, {:.3e} | {:.2} | {:.3e} |",
+                l + 1,
+                level_bits[l] / n,
+                emc_rms[l],
+                lv,
+                lr,
+                av,
+                ar,
+                bv,
+                br,
+                br / lr,
+                ideal
+            );
+        }
+        println!();
+    }
+    Ok(())
+}
