@@ -24,7 +24,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             grid: GridShape::Cubic,
         };
         let canonical = codecs::canonical_for(&mesh, &options)?;
-        eprintln!("encoding {name} x{} to {}", 4u32.pow(subdivisions), path.display());
+        eprintln!(
+            "encoding {name} x{} to {}",
+            4u32.pow(subdivisions),
+            path.display()
+        );
         let stream = codecs::by_name("came")?.encode(&canonical)?.bytes;
         std::fs::write(path, stream)?;
     }
