@@ -7,6 +7,9 @@ whose tolerance is t (a pixel's size at the nearest point in view) gets the fewe
 a rung whose measured Hausdorff distance is within t: the count a mesh that knows nothing of
 the view needs to show within one pixel everywhere in it.
 
+Each view's chosen mesh is also measured on the screen as the view's front is (`meshcodec
+screen-distance`: the same camera, both ways, in pixels).
+
 Writes results/came/vd-meshoptimizer.json, and renders of the meshes chosen for the far and
 near views under results/came/vd/ (the project's rasterizer, `meshcodec render`).
 
@@ -178,16 +181,31 @@ def main():
             log(f"{name}: {mesh['triangles']} triangles, tolerances {min(tolerances):.3e} to {max(tolerances):.3e}")
             rungs, vertices, triangles = ladder(ROOT / mesh["full_mesh"], tolerances, tmp, log)
             views = []
+            size = f"{vd['width']}x{vd['height']}"
             for view in mesh["views"]:
                 rung = within(rungs, view["pixel_at_nearest"])
-                views.append({"view": view["view"], "tolerance": view["pixel_at_nearest"], **(rung or {})})
-                if rung and view["view"] in ("far", "near"):
+                entry = {"view": view["view"], "tolerance": view["pixel_at_nearest"], **(rung or {})}
+                if rung:
                     path = Path(tmp) / "chosen.ply"
                     chosen = triangles if rung.get("full_mesh") else simplify(vertices, triangles, rung["target_error"])
                     write_ply(path, vertices, chosen)
-                    picture = RESULTS / "vd" / f"{name}-{view['view']}-meshoptimizer.png"
-                    render(path, picture, view["render_eye"], view["render_target"],
-                           f"{vd['width']}x{vd['height']}", vd["fov_degrees"])
+                    if rung.get("full_mesh"):
+                        entry.update(screen_max_px=0.0, screen_mean_px=0.0)
+                    else:
+                        # Measured as the view's front is: the same camera, both ways, in pixels.
+                        error = json.loads(meshcodec(
+                            "screen-distance", ROOT / mesh["full_mesh"], path, "--json",
+                            "--eye", ",".join(map(repr, view["eye"])),
+                            "--target", ",".join(map(repr, view["target"])),
+                            "--size", size, "--fov", vd["fov_degrees"],
+                        ))
+                        entry.update(screen_max_px=error["max_px"], screen_mean_px=error["mean_px"])
+                        log(f"  {view['view']}: {entry['triangles']} triangles, "
+                            f"{error['max_px']:.3f} px max, {error['mean_px']:.4f} px mean on the screen")
+                    if view["view"] in ("far", "near"):
+                        picture = RESULTS / "vd" / f"{name}-{view['view']}-meshoptimizer.png"
+                        render(path, picture, view["render_eye"], view["render_target"], size, vd["fov_degrees"])
+                views.append(entry)
             entry = {"mesh": mesh["mesh"], "subdivisions": mesh["subdivisions"], "triangles": mesh["triangles"],
                      "rungs": rungs, "views": views}
             if frames:

@@ -425,6 +425,50 @@ fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
 }
 
 #[test]
+fn screen_distance_measures_a_view_in_pixels_and_refuses_an_empty_frustum() {
+    let dir = scratch();
+    let d = dir.path();
+    let ok = |args: &[&str]| {
+        let out = run(MESHCODEC, args, d);
+        assert_eq!(out.code, Some(0), "{:?}: {}", args, out.stderr);
+        out.stdout
+    };
+    let camera = [
+        "--eye",
+        "-0.05,0.15,1.0",
+        "--target",
+        "-0.02,0.1,0",
+        "--size",
+        "320x240",
+    ];
+    ok(&["encode", "--codec", "came", "bunny", "b.mc"]);
+    ok(&["decode", "b.mc", "full.ply"]);
+    ok(&[&["view", "b.mc", "v.ply", "--two-sided"][..], &camera].concat());
+    let measure = |b: &str, camera: &[&str]| -> serde_json::Value {
+        let out = ok(&[&["screen-distance", "full.ply", b, "--json"][..], camera].concat());
+        serde_json::from_str(&out).unwrap()
+    };
+    // The adapted mesh keeps its promise (one pixel), and is no copy of the full one.
+    let adapted = measure("v.ply", &camera);
+    let (max, mean) = (
+        adapted["max_px"].as_f64().unwrap(),
+        adapted["mean_px"].as_f64().unwrap(),
+    );
+    assert!(max > 0.0 && max <= 1.0 && mean < max, "{adapted}");
+    // (A mesh against itself: the distance search's rounding, millionths of a pixel.)
+    let itself = measure("full.ply", &camera)["max_px"].as_f64().unwrap();
+    assert!(itself < 1e-4, "{itself}");
+    // Looking away from the mesh: nothing to measure.
+    let away = ["--eye", "0,0,5", "--target", "0,0,10"];
+    let out = run(
+        MESHCODEC,
+        &[&["screen-distance", "full.ply", "v.ply"][..], &away].concat(),
+        d,
+    );
+    assert_clean_failure(&out, "frustum");
+}
+
+#[test]
 fn a_codec_that_cannot_carry_appearance_refuses_it_unless_told_to_drop_it() {
     let dir = scratch();
     let d = dir.path();

@@ -176,9 +176,25 @@ enum Command {
         #[arg(long)]
         write_samples: Option<PathBuf>,
     },
+    /// Distance between two meshes' surfaces as a camera sees it, in pixels: both ways, over
+    /// the samples in the frustum (A's vertices and face centroids to B; B's face centroids
+    /// and edge midpoints to A), a distance d at depth z counting d over a pixel's size there,
+    /// with no occlusion test — as paper-tables/came-vd.md measures a front against the full
+    /// mesh.
+    ScreenDistance {
+        /// Reference mesh.
+        a: String,
+        /// Compared mesh.
+        b: String,
+        #[command(flatten)]
+        camera: CameraArgs,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
-/// A camera on the command line (`view`, `render`).
+/// A camera on the command line (`view`, `render`, `screen-distance`).
 #[derive(clap::Args)]
 struct CameraArgs {
     /// Eye position, x,y,z (the mesh's units).
@@ -309,6 +325,7 @@ fn main() -> ExitCode {
             camera,
             level,
         } => render(&input, &output, &camera.perspective(), camera.size, level),
+        Command::ScreenDistance { a, b, camera, json } => screen_distance(&a, &b, &camera, json),
         Command::Distance {
             a,
             b,
@@ -641,6 +658,41 @@ fn view(
         meshcodec_lab::render::render_perspective(&mesh, &camera.perspective(), width, height)
             .save_png(png)?;
         meshcodec_lab::outln!("wrote {}", png.display());
+    }
+    Ok(())
+}
+
+fn screen_distance(a: &str, b: &str, camera: &CameraArgs, json: bool) -> Result<()> {
+    let (path_a, mesh_a) = load_attributed(a)?;
+    let (path_b, mesh_b) = load_attributed(b)?;
+    let view_camera = camera.view_camera();
+    // The tolerance plays no part: only the frustum is used.
+    let view = meshcodec::codecs::came::refine::View::new(&view_camera, 1.0)?;
+    let reference = meshcodec_lab::came::screen_error::FullMesh::new(&mesh_a.mesh);
+    let error = reference.screen_error(&mesh_b.mesh, &view_camera, &view);
+    if error.samples == 0 {
+        anyhow::bail!("no sample of either mesh lies in the camera's frustum");
+    }
+    if json {
+        let report = serde_json::json!({
+            "a": path_a.display().to_string(),
+            "b": path_b.display().to_string(),
+            "samples": error.samples,
+            "max_px": error.max_px,
+            "mean_px": error.mean_px,
+            "worst_at": error.worst_at.to_array(),
+            "worst_on": if error.worst_on_full { "a" } else { "b" },
+        });
+        meshcodec_lab::outln!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        meshcodec_lab::outln!(
+            "{} samples in the frustum: max {:.3} px (a sample of {} at {:.6?}), mean {:.4} px",
+            error.samples,
+            error.max_px,
+            if error.worst_on_full { "A" } else { "B" },
+            error.worst_at.to_array(),
+            error.mean_px
+        );
     }
     Ok(())
 }
