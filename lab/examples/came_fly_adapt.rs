@@ -6,9 +6,6 @@
 //! (when STREAM does not exist, the fly-through's stream — bunny-closed-35k subdivided twice,
 //! `came` at 12 bits — is encoded and written there first: about two minutes.)
 use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
-use meshcodec::codecs::{self, EncodeOptions};
-use meshcodec::mesh::quantize::GridShape;
-use meshcodec_lab::came::extras::{table_mesh, QUANT_BITS, TABLE_MESHES};
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -17,20 +14,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .ok_or("usage: came_fly_adapt STREAM")?;
     let path = std::path::Path::new(&path);
     if !path.exists() {
-        let (name, subdivisions) = TABLE_MESHES[3];
-        let (_, mesh) = table_mesh(name, subdivisions)?;
-        let options = EncodeOptions {
-            quant_bits: QUANT_BITS,
-            grid: GridShape::Cubic,
-        };
-        let canonical = codecs::canonical_for(&mesh, &options)?;
-        eprintln!(
-            "encoding {name} x{} to {}",
-            4u32.pow(subdivisions),
-            path.display()
-        );
-        let stream = codecs::by_name("came")?.encode(&canonical)?.bytes;
-        std::fs::write(path, stream)?;
+        eprintln!("encoding the fly-through's stream to {}", path.display());
+        std::fs::write(path, meshcodec_lab::came::flythrough::encode_stream()?.1)?;
     }
     let mut full = ViewMesh::open_file(path)?;
     full.settle(&View::everything(), Budget::UNLIMITED, 256);

@@ -56,6 +56,23 @@ fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
 const EXPERIMENT: &str = env!("CARGO_BIN_EXE_experiment");
 const MESHCODEC: &str = env!("CARGO_BIN_EXE_meshcodec");
 
+/// A camera that sees bunny whole, 320 pixels wide.
+const BUNNY_CAMERA: [&str; 6] = [
+    "--eye",
+    "-0.05,0.15,1.0",
+    "--target",
+    "-0.02,0.1,0",
+    "--size",
+    "320x240",
+];
+
+/// Runs `meshcodec` with `args` in `dir`, which must succeed; returns what it printed.
+fn succeed(args: &[&str], dir: &Path) -> String {
+    let out = run(MESHCODEC, args, dir);
+    assert_eq!(out.code, Some(0), "{:?}: {}", args, out.stderr);
+    out.stdout
+}
+
 #[test]
 fn bad_meshes_fail_cleanly_and_leave_no_results() {
     let dir = scratch();
@@ -326,19 +343,11 @@ fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
     let dir = scratch();
     let d = dir.path();
     let ok = |args: &[&str]| {
-        let out = run(MESHCODEC, args, d);
-        assert_eq!(out.code, Some(0), "{:?}: {}", args, out.stderr);
+        succeed(args, d);
     };
     ok(&["encode", "--codec", "came", "bunny", "b.mc"]);
     ok(&["encode", "--codec", "emc", "bunny", "e.mc"]);
-    let camera = [
-        "--eye",
-        "-0.05,0.15,1.0",
-        "--target",
-        "-0.02,0.1,0",
-        "--size",
-        "320x240",
-    ];
+    let camera = BUNNY_CAMERA;
     let with = |extra: &[&'static str]| -> Vec<&str> {
         let mut args = vec!["view", "b.mc", "v.ply"];
         args.extend_from_slice(&camera);
@@ -428,19 +437,8 @@ fn view_adapts_a_came_stream_reading_what_it_needs_and_refuses_other_streams() {
 fn screen_distance_measures_a_view_in_pixels_and_refuses_an_empty_frustum() {
     let dir = scratch();
     let d = dir.path();
-    let ok = |args: &[&str]| {
-        let out = run(MESHCODEC, args, d);
-        assert_eq!(out.code, Some(0), "{:?}: {}", args, out.stderr);
-        out.stdout
-    };
-    let camera = [
-        "--eye",
-        "-0.05,0.15,1.0",
-        "--target",
-        "-0.02,0.1,0",
-        "--size",
-        "320x240",
-    ];
+    let ok = |args: &[&str]| succeed(args, d);
+    let camera = BUNNY_CAMERA;
     ok(&["encode", "--codec", "came", "bunny", "b.mc"]);
     ok(&["decode", "b.mc", "full.ply"]);
     ok(&[&["view", "b.mc", "v.ply", "--two-sided"][..], &camera].concat());

@@ -25,7 +25,7 @@ use meshcodec::codecs::{self, EncodeOptions};
 use meshcodec::error::{Error, Result};
 use meshcodec::mesh::io::write_atomically;
 use meshcodec::mesh::quantize::GridShape;
-use meshcodec::mesh::TriMesh;
+use meshcodec::mesh::{CanonicalMesh, TriMesh};
 use plotters::prelude::SeriesLabelPosition;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -251,9 +251,9 @@ fn stream_path() -> PathBuf {
     std::env::temp_dir().join(format!("meshcodec-flythrough-{}.mc", std::process::id()))
 }
 
-/// Runs the fly-through and writes its results under `results/came/`; `log` gets one line per
-/// step and a line every ten frames.
-pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
+/// The fly-through's mesh (bunny-closed-35k subdivided twice) on its grid, and its `came`
+/// stream.
+pub fn encode_stream() -> Result<(CanonicalMesh, Vec<u8>)> {
     let (name, subdivisions) = TABLE_MESHES[3];
     let (_, mesh) = table_mesh(name, subdivisions)?;
     let options = EncodeOptions {
@@ -261,8 +261,16 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
         grid: GridShape::Cubic,
     };
     let canonical = codecs::canonical_for(&mesh, &options)?;
-    let started = Instant::now();
     let stream = codecs::by_name("came")?.encode(&canonical)?.bytes;
+    Ok((canonical, stream))
+}
+
+/// Runs the fly-through and writes its results under `results/came/`; `log` gets one line per
+/// step and a line every ten frames.
+pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
+    let (name, subdivisions) = TABLE_MESHES[3];
+    let started = Instant::now();
+    let (canonical, stream) = encode_stream()?;
     log(format!(
         "{name} x{}: {} triangles, came stream {} bytes in {:.1} s",
         4u32.pow(subdivisions),
