@@ -438,8 +438,8 @@ fn build(name: &str) -> Result<Built, Box<dyn std::error::Error>> {
     }
     // Plus a tenth of each vertex's area times its squared distance from the representative:
     // planes alone let a coarse cluster sit on a plane of its vertices far from them.
-    // (1.0 measured alike; with planes alone the greedy order stalls on clusters no single
-    // decision improves.)
+    // (With 1.0, the greedy order's RMS on bunny at levels 4–7 was 1.1–1.3× higher; with the
+    // planes alone, it stalled on clusters that no single decision improves.)
     let weight = 0.1;
     for (v, q) in per_vertex.iter_mut().enumerate() {
         let area = q.0[0] + q.0[3] + q.0[5];
