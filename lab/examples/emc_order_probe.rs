@@ -34,8 +34,10 @@
 //! BENCHMARKS.md ("`emc`'s intermediate levels", the second probe) has the figures.
 //! Run: cargo run --release --example emc_order_probe -- [mesh…]
 
+use glam::DVec3;
 use meshcodec::codecs::emc::{EmcParams, Syntax};
 use meshcodec::codecs::{self, EncodeOptions, LevelMesh};
+use meshcodec::hierarchy::simplify::quadric::Quadric;
 use meshcodec::mesh::io::{read_mesh, resolve};
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::{CanonicalMesh, TriMesh};
@@ -43,61 +45,9 @@ use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SEED};
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashSet};
 
-/// A quadric: err(p) = pᵀAp + 2bᵀp + c (A symmetric: xx, xy, xz, yy, yz, zz).
-#[derive(Clone, Copy, Default)]
-struct Quadric([f64; 10]);
-
-impl Quadric {
-    fn plane(n: [f64; 3], d: f64, w: f64) -> Quadric {
-        let [a, b, c] = n;
-        Quadric(
-            [
-                a * a,
-                a * b,
-                a * c,
-                b * b,
-                b * c,
-                c * c,
-                a * d,
-                b * d,
-                c * d,
-                d * d,
-            ]
-            .map(|x| x * w),
-        )
-    }
-    fn add(&mut self, o: &Quadric) {
-        for i in 0..10 {
-            self.0[i] += o.0[i];
-        }
-    }
-    fn sub(&self, o: &Quadric) -> Quadric {
-        Quadric(std::array::from_fn(|i| self.0[i] - o.0[i]))
-    }
-    /// Its least value (A is positive definite: every vertex's quadric holds a point term).
-    fn least(&self) -> f64 {
-        self.least_point().map_or(0.0, |p| self.at(p).max(0.0))
-    }
-    /// Where it is least.
-    fn least_point(&self) -> Option<[f64; 3]> {
-        let q = &self.0;
-        let a =
-            glam::DMat3::from_cols_array(&[q[0], q[1], q[2], q[1], q[3], q[4], q[2], q[4], q[5]]);
-        (a.determinant().abs() > 1e-300)
-            .then(|| (a.inverse() * -glam::DVec3::new(q[6], q[7], q[8])).to_array())
-    }
-    fn at(&self, p: [f64; 3]) -> f64 {
-        let q = &self.0;
-        let [x, y, z] = p;
-        q[0] * x * x
-            + 2.0 * q[1] * x * y
-            + 2.0 * q[2] * x * z
-            + q[3] * y * y
-            + 2.0 * q[4] * y * z
-            + q[5] * z * z
-            + 2.0 * (q[6] * x + q[7] * y + q[8] * z)
-            + q[9]
-    }
+/// A quadric's least value (every vertex's quadric here holds a point term, so it has one).
+fn least(q: &Quadric) -> f64 {
+    q.minimizer().map_or(0.0, |p| q.error(p).max(0.0))
 }
 
 /// The octree of one mesh as sorted keys, with per-level costs.
@@ -152,20 +102,20 @@ impl Tree {
             .sum()
     }
     fn quadric(&self, lo: usize, hi: usize) -> Quadric {
-        self.prefix[hi].sub(&self.prefix[lo])
+        Quadric::difference(&self.prefix[hi], &self.prefix[lo])
     }
     /// World position of sorted vertex `lo` known to depth `r`: its cell's centre there.
-    fn position(&self, lo: usize, r: usize) -> [f64; 3] {
+    fn position(&self, lo: usize, r: usize) -> DVec3 {
         let v = self.sorted[lo] as usize;
         let g = &self.mesh.grid;
         let l = self.levels as u32;
-        std::array::from_fn(|a| {
+        DVec3::from_array(std::array::from_fn(|a| {
             let k = (0..r).filter(|&t| self.axis[t] == a).count() as u32;
             let c = self.mesh.cells[v][a];
             let span = 1u64 << (l - k);
             let centre = ((c as u64 >> (l - k)) * span) as f64 + (span as f64 - 1.0) / 2.0;
             g.origin[a] + (centre + 0.5) * g.cell[a]
-        })
+        }))
     }
 }
 
@@ -203,7 +153,7 @@ fn operations(tree: &Tree, c: &Cluster) -> Vec<(Op, f64, f64)> {
         } else {
             tree.half_bits[c.r / 3]
         };
-        let gain = q.at(here) - q.at(tree.position(c.lo, c.r + 1));
+        let gain = q.error(here) - q.error(tree.position(c.lo, c.r + 1));
         out.push((Op::Extend, gain, bits));
     }
     if let Some((b, mid)) = branch(tree, c) {
@@ -213,9 +163,9 @@ fn operations(tree: &Tree, c: &Cluster) -> Vec<(Op, f64, f64)> {
         let best = (b + 1..=c.r)
             .map(|k| {
                 let gain = if tree.splits_at_best {
-                    q.least() - tree.quadric(c.lo, mid).least() - right.least()
+                    least(&q) - least(&tree.quadric(c.lo, mid)) - least(&right)
                 } else {
-                    right.at(here) - right.at(tree.position(mid, k))
+                    right.error(here) - right.error(tree.position(mid, k))
                 };
                 let bits = tree.split_bits[b / 3] + tree.path_bits(mid, c.hi, b + 1, k);
                 (Op::Split(k), gain, bits)
@@ -231,11 +181,11 @@ fn operations(tree: &Tree, c: &Cluster) -> Vec<(Op, f64, f64)> {
             if m > c.lo && m < e {
                 let (left, right) = (tree.quadric(c.lo, m), tree.quadric(m, c.hi));
                 let gain = if tree.splits_at_best {
-                    q.least() - left.least() - right.least()
+                    least(&q) - least(&left) - least(&right)
                 } else {
-                    q.at(here)
-                        - left.at(tree.position(c.lo, t + 1))
-                        - right.at(tree.position(m, t + 1))
+                    q.error(here)
+                        - left.error(tree.position(c.lo, t + 1))
+                        - right.error(tree.position(m, t + 1))
                 };
                 out.push((Op::SplitNext, gain, bits + tree.split_bits[t / 3]));
                 break;
@@ -320,12 +270,11 @@ impl<'a> State<'a> {
             .iter()
             .map(|c| {
                 let coded = self.tree.position(c.lo, c.r);
-                let at = if ideal {
-                    self.tree.quadric(c.lo, c.hi).least_point().unwrap_or(coded)
+                if ideal {
+                    self.tree.quadric(c.lo, c.hi).minimizer().unwrap_or(coded)
                 } else {
                     coded
-                };
-                at.into()
+                }
             })
             .collect();
         let mut seen = HashSet::new();
@@ -423,6 +372,7 @@ fn build(name: &str) -> Result<Built, Box<dyn std::error::Error>> {
     // Area-weighted face planes at the cells' centres.
     let world = canonical.to_mesh();
     let mut per_vertex = vec![Quadric::default(); n];
+    let mut areas = vec![0.0f64; n];
     for f in &canonical.faces {
         let p = f.map(|v| world.positions[v as usize]);
         let cross = (p[1] - p[0]).cross(p[2] - p[0]);
@@ -431,9 +381,10 @@ fn build(name: &str) -> Result<Built, Box<dyn std::error::Error>> {
             continue;
         }
         let normal = cross.normalize();
-        let q = Quadric::plane(normal.to_array(), -normal.dot(p[0]), area);
-        for v in f {
-            per_vertex[*v as usize].add(&q);
+        let q = Quadric::plane(normal, -normal.dot(p[0]), area);
+        for &v in f {
+            per_vertex[v as usize].add(&q);
+            areas[v as usize] += area;
         }
     }
     // Plus a tenth of each vertex's area times its squared distance from the representative:
@@ -442,21 +393,7 @@ fn build(name: &str) -> Result<Built, Box<dyn std::error::Error>> {
     // planes alone, it stalled on clusters that no single decision improves.)
     let weight = 0.1;
     for (v, q) in per_vertex.iter_mut().enumerate() {
-        let area = q.0[0] + q.0[3] + q.0[5];
-        let w = weight * area;
-        let p = world.positions[v].to_array();
-        q.add(&Quadric([
-            w,
-            0.0,
-            0.0,
-            w,
-            0.0,
-            w,
-            -w * p[0],
-            -w * p[1],
-            -w * p[2],
-            w * (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]),
-        ]));
+        q.add(&Quadric::point(world.positions[v], weight * areas[v]));
     }
     let mut prefix = vec![Quadric::default(); n + 1];
     for (i, &v) in sorted.iter().enumerate() {

@@ -25,7 +25,7 @@
 use smallvec::SmallVec;
 
 pub(in crate::hierarchy) mod engine;
-pub(in crate::hierarchy) mod quadric;
+pub mod quadric;
 mod records;
 mod regions;
 mod reorder;

@@ -7,10 +7,11 @@ use rayon::prelude::*;
 
 /// A symmetric 4 × 4 quadric: a2 ab ac ad b2 bc bd c2 cd d2.
 #[derive(Clone, Copy, Debug, Default)]
-pub(in crate::hierarchy) struct Quadric(pub(super) [f64; 10]);
+pub struct Quadric(pub(super) [f64; 10]);
 
 impl Quadric {
-    pub(in crate::hierarchy) fn plane(n: DVec3, d: f64, w: f64) -> Quadric {
+    /// `w` times the squared distance from the plane n·p + d = 0 (`n` of unit length).
+    pub fn plane(n: DVec3, d: f64, w: f64) -> Quadric {
         let (a, b, c) = (n.x, n.y, n.z);
         Quadric(
             [
@@ -28,17 +29,40 @@ impl Quadric {
             .map(|x| x * w),
         )
     }
-    pub(in crate::hierarchy) fn add(&mut self, o: &Quadric) {
+    /// `w` times the squared distance from point `p`.
+    pub fn point(p: DVec3, w: f64) -> Quadric {
+        Quadric(
+            [
+                1.0,
+                0.0,
+                0.0,
+                -p.x,
+                1.0,
+                0.0,
+                -p.y,
+                1.0,
+                -p.z,
+                p.length_squared(),
+            ]
+            .map(|x| x * w),
+        )
+    }
+    pub fn add(&mut self, o: &Quadric) {
         for i in 0..10 {
             self.0[i] += o.0[i];
         }
     }
-    pub(in crate::hierarchy) fn sum(a: &Quadric, b: &Quadric) -> Quadric {
+    pub fn sum(a: &Quadric, b: &Quadric) -> Quadric {
         let mut q = *a;
         q.add(b);
         q
     }
-    pub(in crate::hierarchy) fn error(&self, p: DVec3) -> f64 {
+    /// `a` less `b` (as of prefix sums).
+    pub fn difference(a: &Quadric, b: &Quadric) -> Quadric {
+        Quadric(std::array::from_fn(|i| a.0[i] - b.0[i]))
+    }
+    /// The quadric's value at `p`.
+    pub fn error(&self, p: DVec3) -> f64 {
         let q = &self.0;
         let (x, y, z) = (p.x, p.y, p.z);
         x * x * q[0]
@@ -52,7 +76,8 @@ impl Quadric {
             + 2.0 * z * q[8]
             + q[9]
     }
-    pub(in crate::hierarchy) fn minimizer(&self) -> Option<DVec3> {
+    /// Where it is least, if its 3 × 3 part is not near singular.
+    pub fn minimizer(&self) -> Option<DVec3> {
         let q = &self.0;
         let m = glam::DMat3::from_cols(
             DVec3::new(q[0], q[1], q[2]),
@@ -155,5 +180,22 @@ pub(in crate::hierarchy) fn add_seam_planes(
                 quadrics[w as usize].add(&plane);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_point_quadric_is_the_weighted_squared_distance_and_differences_undo_sums() {
+        let p = DVec3::new(1.0, -2.0, 0.5);
+        let q = Quadric::point(p, 3.0);
+        let x = DVec3::new(0.25, 4.0, -1.0);
+        assert!((q.error(x) - 3.0 * x.distance_squared(p)).abs() < 1e-9);
+        assert!((q.minimizer().unwrap() - p).length() < 1e-12);
+        let plane = Quadric::plane(DVec3::Z, -0.5, 2.0);
+        let back = Quadric::difference(&Quadric::sum(&q, &plane), &plane);
+        assert!((back.error(x) - q.error(x)).abs() < 1e-9);
     }
 }
