@@ -333,6 +333,44 @@ fn came_streams_of_eight_level_meta_nodes_still_decode_and_refine() {
     }
 }
 
+/// `came` streams of syntax 5, whose deviation codes step by 2^(−1/2) below the parent's,
+/// still decode exactly and refine: `came-eight-before-anchored-deviations.mc` is the golden
+/// stream of that build, kept. Today's codes the nodes above depth 11 in quarter steps on a
+/// grid anchored at the root's deviation (docs/FORMAT.md §8.2), so those bound tighter.
+#[test]
+fn came_streams_of_half_step_deviations_still_decode_and_refine() {
+    use meshcodec::codecs::came::decode_tree;
+    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
+    use meshcodec::hierarchy::came::deviation::FINE_DEVIATION_DEPTHS;
+    let (old, new) = kept_came_stream_and_todays("came-eight-before-anchored-deviations.mc");
+    assert_eq!(header_of(&old).syntax, 5);
+    assert!(header_of(&new).syntax >= 6);
+    // The deviations of the nodes above the fine depth, summed: the quarter steps hold them
+    // closer to what was measured.
+    let coarse_sum = |bytes: &[u8]| -> f64 {
+        let (_, tree) = decode_tree(bytes).unwrap();
+        for node in &tree.nodes[1..] {
+            let parent = &tree.nodes[node.parent as usize];
+            assert!(node.deviation <= parent.deviation, "{:?}", node.id);
+        }
+        tree.nodes
+            .iter()
+            .filter(|n| (n.id.len() as usize) < FINE_DEVIATION_DEPTHS)
+            .map(|n| n.deviation as f64)
+            .sum()
+    };
+    let (old_sum, new_sum) = (coarse_sum(&old), coarse_sum(&new));
+    assert!(new_sum < old_sum, "{new_sum} against {old_sum}");
+    let view = View::new(&far_camera_on_eight(), 0.25).unwrap();
+    for bytes in [&old, &new] {
+        let mut front = ViewMesh::from_stream(bytes).unwrap();
+        let adapted = front.settle(&view, Budget::UNLIMITED, 64);
+        assert!(adapted.settled && adapted.unsure == 0, "{adapted:?}");
+        front.check_invariants().unwrap();
+        assert!(front.face_count() > 0);
+    }
+}
+
 #[test]
 fn streams_of_another_format_version_are_refused_in_one_line() {
     let codec = codecs::by_name("raw").unwrap();

@@ -57,7 +57,7 @@ pub const EMC: Naming = Naming {
 pub const CAME: Naming = Naming {
     name: "came",
     id: 6,
-    syntax: 5,
+    syntax: 6,
     reads_from: 1,
 };
 

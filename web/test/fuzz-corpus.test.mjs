@@ -26,7 +26,7 @@ const PREFIX = {
   decode_pm_reordered: [...MAGIC, VERSION, 3, 1],
   decode_emc: [...MAGIC, VERSION, 4, 1],
   decode_came_paper: [...MAGIC, VERSION, 5, 1],
-  decode_came: [...MAGIC, VERSION, 6, 5],
+  decode_came: [...MAGIC, VERSION, 6, 6],
   decode_appearance: [...MAGIC, VERSION],
   decode_pm_wedges: [...MAGIC, VERSION],
 };

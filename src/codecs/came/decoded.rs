@@ -40,6 +40,20 @@ pub struct Node {
     pub split_unit: Option<NodeId>,
 }
 
+// Every field counts: the decoder keeps two nodes a vertex (`limits::DECODE_MEMORY_MULTIPLE`).
+const _: () = assert!(std::mem::size_of::<Node>() == 88);
+
+/// A child's error bounds as a unit decodes them.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Bounds {
+    /// Its error sphere's radius (grid units).
+    pub radius: f64,
+    /// Its deviation (grid units).
+    pub deviation: f32,
+    /// Its deviation's step on the grid anchored at the root's (syntax 6; 0 before).
+    pub deviation_step: u16,
+}
+
 /// A decoded triangle: its corners' leaf paths in face order, the depth of its split, and what
 /// the stream says of its normal.
 #[derive(Clone, Copy, Debug)]
@@ -78,6 +92,9 @@ pub struct DecodedTree {
     pub dependencies: Vec<(NodeId, std::ops::Range<u32>)>,
     /// The dependencies of every split, in decoding order.
     pub dependency_nodes: Vec<NodeId>,
+    /// Per node, its deviation's step on the grid anchored at the root's (`came` syntax 6; 0
+    /// before). Beside the nodes rather than in them: a node's record has no room left for it.
+    pub deviation_steps: Vec<u16>,
     /// Once the hierarchy is checked complete: every triangle's corners as nodes, so that the
     /// full mesh needs no lookup of its own.
     leaf_corners: Option<Vec<[u32; 3]>>,
@@ -98,6 +115,7 @@ impl DecodedTree {
             triangles: Vec::with_capacity(triangles.min(2 * stream_bytes as u64) as usize),
             dependencies: Vec::new(),
             dependency_nodes: Vec::new(),
+            deviation_steps: Vec::with_capacity(expected),
             leaf_corners: None,
             max_nodes: (2 * vertices).saturating_sub(1) as usize,
             max_triangles: triangles as usize,
@@ -130,6 +148,7 @@ impl DecodedTree {
             }
         }
         self.nodes.truncate(mark.nodes);
+        self.deviation_steps.truncate(mark.nodes);
         self.triangles.truncate(mark.triangles);
         self.dependencies.truncate(mark.dependencies);
         self.dependency_nodes.truncate(mark.dependency_nodes);
@@ -150,6 +169,7 @@ impl DecodedTree {
             split_unit: None,
         });
         self.lookup.insert(NodeId::ROOT.packed(), 0);
+        self.deviation_steps.push(0);
     }
 
     /// The node at `id`, if decoded.
@@ -163,15 +183,15 @@ impl DecodedTree {
         status(n.leaf, n.split_unit, n.created_unit, unit)
     }
 
-    /// Splits node `s` into children with the given leaf flags, positions, (radius,
-    /// deviation) pairs and cones, decoded by the unit rooted at `unit`.
+    /// Splits node `s` into children with the given leaf flags, positions, error bounds and
+    /// cones, decoded by the unit rooted at `unit`.
     #[allow(clippy::too_many_arguments)]
     pub fn split(
         &mut self,
         s: u32,
         leaf: [bool; 2],
         positions: [[f64; 3]; 2],
-        spheres: [(f64, f32); 2],
+        bounds: [Bounds; 2],
         cones: [CodedCone; 2],
         unit: NodeId,
         at: usize,
@@ -202,12 +222,13 @@ impl DecodedTree {
                 children: None,
                 parent: s,
                 position: positions[side],
-                radius: spheres[side].0,
-                deviation: spheres[side].1,
+                radius: bounds[side].radius,
+                deviation: bounds[side].deviation,
                 cone: cones[side],
                 created_unit: unit,
                 split_unit: None,
             });
+            self.deviation_steps.push(bounds[side].deviation_step);
         }
         Ok([first, first + 1])
     }

@@ -13,7 +13,7 @@
 //! bound the vertices as decoded. The full level is not the input mesh: it is reported with its
 //! Hausdorff error.
 
-use super::decoded::{CameDecoder, DecodedTree, FaceNormal, Triangle, UnitDecoder};
+use super::decoded::{Bounds, CameDecoder, DecodedTree, FaceNormal, Triangle, UnitDecoder};
 use super::frame::Frame;
 use super::partition::{Partition, Shape, Tails};
 use super::{born_triangles, cut_at, encode_stream, BornTriangle, Layout, Params, META_LEVELS};
@@ -611,9 +611,13 @@ impl UnitDecoder for PaperUnits {
                     radii[side] = decoded_radius(code, base, params.radius_bits);
                 }
             }
-            let spheres = radii.map(|r| (r, round_up(r)));
+            let bounds = radii.map(|radius| Bounds {
+                radius,
+                deviation: round_up(radius),
+                deviation_step: 0,
+            });
             let children =
-                tree.split(s, leaf, positions, spheres, [CodedCone::NONE; 2], unit, at)?;
+                tree.split(s, leaf, positions, bounds, [CodedCone::NONE; 2], unit, at)?;
             for side in 0..2 {
                 if leaf[side] {
                     continue;

@@ -34,19 +34,35 @@
 //! a front can mix depths in more ways than the two fans measured; the tests and the
 //! fly-through measure the adapted mesh against the full one.
 //!
-//! Coded top-down as the parent's deviation times 2^(−j/2) (j = 0..14) or 0, rounded up, so a
-//! decoded deviation never underestimates the measured one and never exceeds its parent's.
+//! Coded top-down, rounded up, so that a decoded deviation never underestimates the measured
+//! one and never exceeds its parent's:
+//! - syntax 6 ([`anchored_step`]): on one grid anchored at the root's deviation ê_root, a node
+//!   standing at step q holding ê_root · 2^(−q/4). A child above depth
+//!   [`FINE_DEVIATION_DEPTHS`] codes how many quarter steps it lies below its parent (0..30,
+//!   5 bits); a deeper child the parent's step or the j-th even step below it (4 bits). The far
+//!   views' fronts hold coarse nodes, which the quarter steps bound 9% tighter on average; the
+//!   deep nodes, most of the stream, keep half steps (quarter steps everywhere cost 0.5 bits a
+//!   triangle, BENCHMARKS.md).
+//! - before: the parent's deviation times 2^(−j/2) (j = 0..14) or 0 ([`decoded_deviation`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::VertexTree;
 
-/// Codes a deviation takes: 0 (none) and 2^(−j/2) of the parent's for j = 14..=0. (Steps of
-/// 2^(−1/4) bound a deviation 9% tighter on average but cost 0.5 bits a triangle more.)
+/// Codes a deviation takes: 0 (none) and 2^(−j/2) of the parent's for j = 14..=0 (syntax 6:
+/// the parent's step for j = 0, else the j-th even step below it). (Steps of 2^(−1/4) bound a
+/// deviation 9% tighter on average but cost 0.5 bits a triangle more.)
 pub const DEVIATION_CODES: u32 = 16;
 /// Bits of a deviation code.
 pub const DEVIATION_BITS: u8 = 4;
+/// Syntax 6: a child at a depth under this codes its deviation in quarter steps (from 11 on,
+/// bunny.ply's and dragon-50k's far views keep their whole gain; BENCHMARKS.md).
+pub const FINE_DEVIATION_DEPTHS: usize = 11;
+/// Codes of a quarter-step deviation: 0 (none) and 30..=0 quarter steps below the parent.
+pub const FINE_DEVIATION_CODES: u32 = 32;
+/// Bits of a quarter-step deviation code.
+pub const FINE_DEVIATION_BITS: u8 = 5;
 /// How many levels finer than a node its neighbours are taken for the mixed-front measures
 /// (each, in turn).
 const FINER: [u8; 2] = [1, 2];
@@ -511,6 +527,64 @@ pub fn decoded_deviation(code: u32, parent: f32) -> f32 {
     round_up(parent as f64 * HALF_STEPS[(j % 2) as usize] / (1u64 << (j / 2)) as f64)
 }
 
+/// 2^(−k/4) for k = 0 … 3, the fractions every step of the anchored grid is made of.
+const QUARTER_STEPS: [f64; 4] = [
+    1.0,
+    0.840_896_415_253_714_5,
+    std::f64::consts::FRAC_1_SQRT_2,
+    0.594_603_557_501_360_5,
+];
+
+/// The step code `code` gives a child whose parent stands at step `parent` of the anchored
+/// grid (syntax 6); `None` for code 0 (no deviation). `fine`: a quarter-step code (the child
+/// lies above [`FINE_DEVIATION_DEPTHS`]).
+pub fn anchored_step(code: u32, parent: u16, fine: bool) -> Option<u16> {
+    if code == 0 {
+        return None;
+    }
+    let down = if fine {
+        FINE_DEVIATION_CODES.saturating_sub(1 + code)
+    } else {
+        match DEVIATION_CODES.saturating_sub(1 + code) {
+            0 => 0,
+            // The j-th even step below the parent: from an odd step the first is one away.
+            j => 2 * j - u32::from(parent % 2),
+        }
+    };
+    Some(parent.saturating_add(down as u16))
+}
+
+/// The deviation at step `step` of the grid anchored at the root's deviation `root`:
+/// root · 2^(−step/4) as an `f32` rounded up (never 0 for a positive root).
+pub fn anchored_deviation(root: f32, step: u16) -> f32 {
+    // Steps are at most 30 a level over at most 52 levels: the power of two stays normal.
+    let halvings = u64::from(step / 4).min(1022);
+    let power = f64::from_bits((1023 - halvings) << 52);
+    let y = round_up(f64::from(root) * QUARTER_STEPS[usize::from(step % 4)] * power);
+    if y == 0.0 && root > 0.0 {
+        f32::from_bits(1)
+    } else {
+        y
+    }
+}
+
+/// The code, and the step it gives, of the smallest anchored deviation at least `deviation`
+/// for a child of a node at step `parent` whose deviation is at least `deviation`.
+pub fn anchored_code(deviation: f64, root: f32, parent: u16, fine: bool) -> (u32, u16) {
+    if deviation <= 0.0 {
+        return (0, parent);
+    }
+    let codes = if fine {
+        FINE_DEVIATION_CODES
+    } else {
+        DEVIATION_CODES
+    };
+    (1..codes)
+        .filter_map(|code| Some((code, anchored_step(code, parent, fine)?)))
+        .find(|&(_, step)| anchored_deviation(root, step) as f64 >= deviation)
+        .unwrap_or((codes - 1, parent))
+}
+
 /// `x` as the nearest `f32` at or above it.
 pub fn round_up(x: f64) -> f32 {
     let y = x as f32;
@@ -537,6 +611,7 @@ mod tests {
     use super::*;
     use crate::hierarchy::came::{build, BuildOptions};
     use crate::mesh::generate;
+    use std::f64::consts::FRAC_1_SQRT_2;
 
     fn measured(cells: &[[u32; 3]], faces: &[[u32; 3]]) -> (VertexTree, Vec<f64>, Vec<f64>) {
         let tree = build(cells, faces, &BuildOptions::default()).unwrap();
@@ -620,6 +695,46 @@ mod tests {
         }
         assert_eq!(deviation_code(0.0, 5.0), 0);
         assert_eq!(decoded_deviation(DEVIATION_CODES - 1, 5.0), 5.0);
+    }
+
+    #[test]
+    fn anchored_codes_round_up_stay_under_the_parent_and_keep_to_their_grid() {
+        for root in [1.0f32, 17.0, 4096.0] {
+            for parent in [0u16, 1, 2, 7, 30, 61] {
+                let above = anchored_deviation(root, parent) as f64;
+                for fine in [false, true] {
+                    for i in 0..=400 {
+                        let e = above * i as f64 / 400.0;
+                        let (code, step) = anchored_code(e, root, parent, fine);
+                        let d = anchored_deviation(root, step) as f64;
+                        assert!(step >= parent, "{step} above {parent}");
+                        if code == 0 {
+                            assert_eq!(e, 0.0);
+                            continue;
+                        }
+                        assert_eq!(anchored_step(code, parent, fine), Some(step));
+                        assert!(d >= e && d <= above, "{e} coded {code} → {d} under {above}");
+                        // Coarse codes take the parent or even steps; every code is within
+                        // one step of the measure, where the grid reaches that far down.
+                        assert!(fine || step == parent || step % 2 == 0, "step {step}");
+                        let ratio = if fine { 1.190 } else { 1.415 };
+                        if e > above / 64.0 {
+                            assert!(d <= e * ratio, "{e} → {d} ({fine})");
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(anchored_step(0, 3, true), None);
+        assert_eq!(anchored_step(15, 3, false), Some(3));
+        assert_eq!(anchored_step(14, 3, false), Some(4));
+        assert_eq!(anchored_step(14, 4, false), Some(6));
+        assert_eq!(anchored_step(31, 5, true), Some(5));
+        assert_eq!(anchored_step(1, 5, true), Some(35));
+        assert_eq!(anchored_deviation(8.0, 8), 2.0);
+        assert_eq!(anchored_deviation(8.0, 2), round_up(8.0 * FRAC_1_SQRT_2));
+        // Far down the grid a positive deviation stays positive.
+        assert!(anchored_deviation(1.0, u16::MAX) > 0.0);
     }
 
     #[test]

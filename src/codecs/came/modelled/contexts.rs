@@ -3,7 +3,7 @@
 
 use crate::coding::arith::{BitContext, IntContext, UintContext};
 use crate::hierarchy::came::cones::{CodedCone, ANGLE_BITS, NO_CONE};
-use crate::hierarchy::came::deviation::DEVIATION_BITS;
+use crate::hierarchy::came::deviation::{DEVIATION_BITS, FINE_DEVIATION_BITS};
 
 /// Bits of a radius ratio.
 pub(super) const RADIUS_BITS: u8 = 4;
@@ -33,6 +33,9 @@ pub(super) struct Contexts {
     /// One tree for both children (two by side, or by the left child's code, cost more:
     /// units are too small to learn them).
     pub(super) deviation: Vec<BitContext>,
+    /// The quarter-step deviation codes' tree (syntax 6; empty before, so that the priors of
+    /// earlier streams list the contexts they did).
+    pub(super) deviation_fine: Vec<BitContext>,
     pub(super) triangles: [UintContext; 4],
     pub(super) up: UintContext,
     pub(super) towards: [BitContext; 4],
@@ -59,7 +62,14 @@ pub(super) struct Contexts {
 }
 
 impl Contexts {
-    pub(super) fn new() -> Contexts {
+    /// Fresh contexts for a unit of a stream with quarter-step deviation codes (syntax 6) or
+    /// without.
+    pub(super) fn new(fine_deviations: bool) -> Contexts {
+        let fine = if fine_deviations {
+            1 << FINE_DEVIATION_BITS
+        } else {
+            0
+        };
         Contexts {
             whole: BitContext::default(),
             leaf_child: vec![[BitContext::default(); 2]; DEPTHS],
@@ -69,6 +79,7 @@ impl Contexts {
                 vec![BitContext::default(); 1 << RADIUS_BITS],
             ],
             deviation: vec![BitContext::default(); 1 << DEVIATION_BITS],
+            deviation_fine: vec![BitContext::default(); fine],
             triangles: Default::default(),
             up: UintContext::default(),
             towards: [BitContext::default(); 4],

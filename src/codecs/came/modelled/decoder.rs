@@ -1,6 +1,6 @@
 //! `came`'s unit decoder: a unit's two passes read back into the decoded tree.
 
-use super::super::decoded::{DecodedTree, FaceNormal, Triangle, UnitDecoder};
+use super::super::decoded::{Bounds, DecodedTree, FaceNormal, Triangle, UnitDecoder};
 use super::super::knowledge::Status;
 use super::super::{cut_at, Params};
 use super::contexts::*;
@@ -9,7 +9,10 @@ use crate::coding::arith::{ArithDecoder, BitContext, UintContext};
 use crate::container::Header;
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self, CodedCone, ANGLE_BITS, NO_CONE};
-use crate::hierarchy::came::deviation::{decoded_deviation, round_up, DEVIATION_BITS};
+use crate::hierarchy::came::deviation::{
+    anchored_deviation, anchored_step, decoded_deviation, round_up, DEVIATION_BITS,
+    FINE_DEVIATION_BITS, FINE_DEVIATION_DEPTHS,
+};
 use crate::hierarchy::came::face_normals::{bound_degrees, decoded, scaled_normal};
 use crate::hierarchy::came::spheres::{decoded_radius, ratio_base};
 use crate::hierarchy::came::NodeId;
@@ -300,8 +303,9 @@ impl UnitDecoder for ModelledUnits {
             .ok_or_else(|| Error::malformed(0, at, "a came unit is not a whole number of words"))?;
         let first = tree.nodes.is_empty();
         if header.syntax < 2 {
-            return self.decode_from(tree, header, params, root, dec, at, Contexts::new());
+            return self.decode_from(tree, header, params, root, dec, at, Contexts::new(false));
         }
+        let fine_deviations = header.syntax >= 6;
         if !first {
             let prior = self.priors.get().ok_or_else(|| {
                 Error::malformed(0, at, "a came unit decoded before the first one")
@@ -310,9 +314,9 @@ impl UnitDecoder for ModelledUnits {
         }
         let cut = || Error::malformed(0, at, "the came unit's priors are cut");
         let prior = if dec.bit(&mut BitContext::default()).ok_or_else(cut)? {
-            get_priors(&mut dec).ok_or_else(cut)?
+            get_priors(&mut dec, fine_deviations).ok_or_else(cut)?
         } else {
-            Priors::default()
+            Priors::even(fine_deviations)
         };
         let children = self.decode_from(tree, header, params, root, dec, at, prior.start())?;
         // A first unit decodes once (a refused one leaves the stream unreadable).
@@ -350,6 +354,9 @@ impl ModelledUnits {
         let whole = r.bit(|c| &mut c.whole)?;
         let with_cones = params.cone_bits > 0;
         let with_deviations = params.deviation_bits > 0;
+        // Syntax 6 codes deviations on one grid anchored at the root's, in quarter steps above
+        // a depth.
+        let anchored = with_deviations && header.syntax >= 6;
         if first {
             let mut p = [0.0; 3];
             for x in &mut p {
@@ -415,7 +422,9 @@ impl ModelledUnits {
             at_node += 1;
             let node = &r.tree.nodes[s as usize];
             let (sid, ps, rs, parent_cone) = (node.id, node.position, node.radius, node.cone);
-            let parent_deviation = node.deviation;
+            let (parent_deviation, parent_step) =
+                (node.deviation, r.tree.deviation_steps[s as usize]);
+            let root_deviation = r.tree.nodes[0].deviation;
             let depth = sid.len() as usize + 1;
             let mut leaf = [false; 2];
             for (side, l) in leaf.iter_mut().enumerate() {
@@ -447,8 +456,7 @@ impl ModelledUnits {
                 ));
             }
             let positions = [ps, pu];
-            let mut radii = [0.0; 2];
-            let mut deviations = [0.0f32; 2];
+            let mut bounds = [Bounds::default(); 2];
             let mut cones = [CodedCone::NONE; 2];
             for side in 0..2 {
                 if leaf[side] {
@@ -457,20 +465,35 @@ impl ModelledUnits {
                 let base = ratio_base(rs, ps, positions[side]);
                 let code = get_symbol(&mut r.dec, &mut r.ctx.ratio[side], RADIUS_BITS)
                     .ok_or_else(|| r.cut())?;
-                radii[side] = decoded_radius(code, base, RADIUS_BITS);
-                deviations[side] = if with_deviations {
+                let b = &mut bounds[side];
+                b.radius = decoded_radius(code, base, RADIUS_BITS);
+                if anchored {
+                    let fine = depth < FINE_DEVIATION_DEPTHS;
+                    let code = if fine {
+                        get_symbol(&mut r.dec, &mut r.ctx.deviation_fine, FINE_DEVIATION_BITS)
+                    } else {
+                        get_symbol(&mut r.dec, &mut r.ctx.deviation, DEVIATION_BITS)
+                    }
+                    .ok_or_else(|| r.cut())?;
+                    // Children of a node without deviation have none.
+                    let step =
+                        anchored_step(code, parent_step, fine).filter(|_| parent_deviation > 0.0);
+                    if let Some(step) = step {
+                        b.deviation = anchored_deviation(root_deviation, step);
+                        b.deviation_step = step;
+                    }
+                } else if with_deviations {
                     let code = get_symbol(&mut r.dec, &mut r.ctx.deviation, DEVIATION_BITS)
                         .ok_or_else(|| r.cut())?;
-                    decoded_deviation(code, parent_deviation)
+                    b.deviation = decoded_deviation(code, parent_deviation);
                 } else {
-                    round_up(radii[side])
-                };
+                    b.deviation = round_up(b.radius);
+                }
                 if with_cones {
                     cones[side] = r.cone(parent_cone)?;
                 }
             }
-            let spheres = [0, 1].map(|side| (radii[side], deviations[side]));
-            let children = r.tree.split(s, leaf, positions, spheres, cones, unit, at)?;
+            let children = r.tree.split(s, leaf, positions, bounds, cones, unit, at)?;
             for side in 0..2 {
                 if leaf[side] {
                     continue;

@@ -10,7 +10,8 @@ use crate::coding::arith::{ArithEncoder, BitContext, UintContext};
 use crate::coding::SyntaxClass;
 use crate::hierarchy::came::cones::{self, coded_cones, CodedCone, ANGLE_BITS, NO_CONE};
 use crate::hierarchy::came::deviation::{
-    decoded_deviation, deviation_code, deviations, round_up, DEVIATION_BITS,
+    anchored_code, anchored_deviation, deviations, round_up, DEVIATION_BITS, FINE_DEVIATION_BITS,
+    FINE_DEVIATION_DEPTHS,
 };
 use crate::hierarchy::came::face_normals::{self, nearest_code, scaled_normal};
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
@@ -97,14 +98,25 @@ impl<'a> Encoder<'a> {
         let measured = deviations(tree, &leaf, &mesh.faces, &positions);
         let mut deviations = vec![0.0f32; tree.node_count()];
         let mut deviation_codes = vec![0; tree.node_count()];
-        deviations[tree.root as usize] = round_up(measured[tree.root as usize].ceil());
+        // Steps on the grid anchored at the root's deviation (docs/FORMAT.md §8.2).
+        let mut steps = vec![0u16; tree.node_count()];
+        let root_deviation = round_up(measured[tree.root as usize].ceil());
+        deviations[tree.root as usize] = root_deviation;
         for s in tree.breadth_first() {
             let [t, u] = tree.children_of(s).expect("inner");
+            let fine = usize::from(tree.ids[s as usize].len()) + 1 < FINE_DEVIATION_DEPTHS;
             for c in [t, u] {
-                if (c as usize) >= n {
-                    let parent = deviations[s as usize];
-                    let code = deviation_code(measured[c as usize], parent);
-                    deviations[c as usize] = decoded_deviation(code, parent);
+                if (c as usize) >= n && deviations[s as usize] > 0.0 {
+                    let (code, step) = anchored_code(
+                        measured[c as usize],
+                        root_deviation,
+                        steps[s as usize],
+                        fine,
+                    );
+                    if code > 0 {
+                        deviations[c as usize] = anchored_deviation(root_deviation, step);
+                    }
+                    steps[c as usize] = step;
                     deviation_codes[c as usize] = code;
                 }
             }
@@ -200,7 +212,7 @@ impl<'a> Encoder<'a> {
     /// before anything else and every unit starts from — unless the stream is smaller without
     /// them (a mesh of a few meta-nodes), which the first unit's first bit says.
     pub(super) fn units(&self) -> Vec<super::super::CodedUnit> {
-        let mut learning = Learning::new();
+        let mut learning = Learning::new(true);
         let mut scratch = ArithEncoder::default();
         for m in 0..self.part.units.len() {
             self.unit(m, &mut scratch, &mut learning.contexts);
@@ -232,7 +244,7 @@ impl<'a> Encoder<'a> {
                         enc.bit(&mut flag, learning.is_some(), g, "priors");
                         match learning {
                             Some(learning) => put_priors(&mut enc, learning),
-                            None => Priors::default(),
+                            None => Priors::even(true),
                         }
                     })
                     .start();
@@ -294,14 +306,12 @@ impl<'a> Encoder<'a> {
                     G,
                     "spheres",
                 );
-                put_symbol(
-                    enc,
-                    &mut ctx.deviation,
-                    deviation,
-                    DEVIATION_BITS,
-                    G,
-                    "deviations",
-                );
+                let (contexts, bits) = if depth < FINE_DEVIATION_DEPTHS {
+                    (&mut ctx.deviation_fine, FINE_DEVIATION_BITS)
+                } else {
+                    (&mut ctx.deviation, DEVIATION_BITS)
+                };
+                put_symbol(enc, contexts, deviation, bits, G, "deviations");
                 let (parent, cone) = (self.cones[s as usize], self.cones[c as usize]);
                 put_cone(enc, ctx, parent, cone);
             }

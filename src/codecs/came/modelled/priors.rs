@@ -55,6 +55,7 @@ fn each_fixed(ctx: &mut Contexts, f: &mut dyn FnMut(&mut BitContext)) {
     ctx.leaf_child.iter_mut().flatten().for_each(&mut *f);
     ctx.ratio.iter_mut().flatten().for_each(&mut *f);
     ctx.deviation.iter_mut().for_each(&mut *f);
+    ctx.deviation_fine.iter_mut().for_each(&mut *f);
     for t in &mut ctx.triangles {
         t.bits_mut().for_each(&mut *f);
     }
@@ -79,9 +80,9 @@ fn each_fixed(ctx: &mut Contexts, f: &mut dyn FnMut(&mut BitContext)) {
 }
 
 /// Binary contexts [`each_fixed`] visits.
-fn fixed_count() -> usize {
+fn fixed_count(fine_deviations: bool) -> usize {
     let mut count = 0;
-    each_fixed(&mut Contexts::new(), &mut |_| count += 1);
+    each_fixed(&mut Contexts::new(fine_deviations), &mut |_| count += 1);
     count
 }
 
@@ -126,8 +127,8 @@ pub(super) struct Learning {
 }
 
 impl Learning {
-    pub(super) fn new() -> Learning {
-        let mut contexts = Contexts::new();
+    pub(super) fn new(fine_deviations: bool) -> Learning {
+        let mut contexts = Contexts::new(fine_deviations);
         let before = flatten(&mut contexts);
         Learning {
             contexts,
@@ -158,16 +159,27 @@ impl Learning {
 
 /// Where every unit's contexts start: per binary context its probability of a 1 (0: even
 /// odds), in the order of [`each_fixed`], then per radius class (empty: even odds throughout).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub(super) struct Priors {
+    /// Whether the units code quarter-step deviations (syntax 6).
+    fine_deviations: bool,
     fixed: Vec<u32>,
     classes: Arc<Vec<Vec<u32>>>,
 }
 
 impl Priors {
+    /// Even odds for every context.
+    pub(super) fn even(fine_deviations: bool) -> Priors {
+        Priors {
+            fine_deviations,
+            fixed: Vec::new(),
+            classes: Arc::default(),
+        }
+    }
+
     /// The contexts a unit starts from.
     pub(super) fn start(&self) -> Contexts {
-        let mut ctx = Contexts::new();
+        let mut ctx = Contexts::new(self.fine_deviations);
         if self.fixed.is_empty() {
             return ctx;
         }
@@ -247,7 +259,8 @@ impl PriorContexts {
 pub(super) fn put_priors(enc: &mut ArithEncoder, learning: &Learning) -> Priors {
     let mut pc = PriorContexts::new();
     let mut previous = false;
-    let count = fixed_count();
+    let fine_deviations = !learning.contexts.deviation_fine.is_empty();
+    let count = fixed_count(fine_deviations);
     let fixed = (0..count)
         .map(|i| pc.put(enc, learning.prior(i), &mut previous))
         .collect();
@@ -266,16 +279,18 @@ pub(super) fn put_priors(enc: &mut ArithEncoder, learning: &Learning) -> Priors 
         })
         .collect();
     Priors {
+        fine_deviations,
         fixed,
         classes: Arc::new(classes),
     }
 }
 
-/// Decodes the priors (`None`: the unit is cut).
-pub(super) fn get_priors(dec: &mut ArithDecoder) -> Option<Priors> {
+/// Decodes the priors of a stream with quarter-step deviations or without (`None`: the unit
+/// is cut).
+pub(super) fn get_priors(dec: &mut ArithDecoder, fine_deviations: bool) -> Option<Priors> {
     let mut pc = PriorContexts::new();
     let mut previous = false;
-    let count = fixed_count();
+    let count = fixed_count(fine_deviations);
     let fixed = (0..count)
         .map(|_| pc.get(dec, &mut previous))
         .collect::<Option<Vec<u32>>>()?;
@@ -291,6 +306,7 @@ pub(super) fn get_priors(dec: &mut ArithDecoder) -> Option<Priors> {
         });
     }
     Some(Priors {
+        fine_deviations,
         fixed,
         classes: Arc::new(classes),
     })
