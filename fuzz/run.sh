@@ -19,7 +19,10 @@ if [ ! -d fuzz/corpus ] && [ -f fuzz/corpus.tar.xz ]; then
   tar -C fuzz -xJf fuzz/corpus.tar.xz
 fi
 export RUSTC_BOOTSTRAP=1 # cargo-fuzz passes -Z flags; this lets the stable toolchain take them
-cargo fuzz build -s none
+if ! cargo fuzz build -s none; then
+  echo "fuzz/run.sh: the targets did not build (cargo-fuzz installed? FUZZING.md)" >&2
+  exit 1
+fi
 # The binaries are run directly, so that editing the sources meanwhile rebuilds nothing.
 bin=fuzz/target/x86_64-unknown-linux-gnu/release
 mkdir -p fuzz/logs

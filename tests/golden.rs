@@ -212,6 +212,20 @@ fn far_camera_on_eight() -> meshcodec::codecs::came::refine::Camera {
     }
 }
 
+/// Each stream's front settles on [`far_camera_on_eight`] at a quarter pixel, sure of every
+/// face, its invariants holding.
+fn settle_far_from_eight(streams: &[&[u8]]) {
+    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
+    let view = View::new(&far_camera_on_eight(), 0.25).unwrap();
+    for bytes in streams {
+        let mut front = ViewMesh::from_stream(bytes).unwrap();
+        let adapted = front.settle(&view, Budget::UNLIMITED, 64);
+        assert!(adapted.settled && adapted.unsure == 0, "{adapted:?}");
+        front.check_invariants().unwrap();
+        assert!(front.face_count() > 0);
+    }
+}
+
 fn header_of(bytes: &[u8]) -> meshcodec::container::Header {
     meshcodec::container::StreamReader::open(bytes)
         .unwrap()
@@ -318,19 +332,11 @@ fn came_streams_without_triangle_normals_still_decode_and_refine_with_the_guard(
 /// units by depth band (docs/FORMAT.md §8.1), a ninth parameter byte giving the regions' levels.
 #[test]
 fn came_streams_of_eight_level_meta_nodes_still_decode_and_refine() {
-    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
     let (old, new) = kept_came_stream_and_todays("came-eight-before-bands.mc");
     let (old_header, new_header) = (header_of(&old), header_of(&new));
     assert_eq!((old_header.syntax, old_header.params.len()), (4, 8));
     assert!(new_header.syntax >= 5 && new_header.params.len() == 9);
-    let view = View::new(&far_camera_on_eight(), 0.25).unwrap();
-    for bytes in [&old, &new] {
-        let mut front = ViewMesh::from_stream(bytes).unwrap();
-        let adapted = front.settle(&view, Budget::UNLIMITED, 64);
-        assert!(adapted.settled && adapted.unsure == 0, "{adapted:?}");
-        front.check_invariants().unwrap();
-        assert!(front.face_count() > 0);
-    }
+    settle_far_from_eight(&[&old, &new]);
 }
 
 /// `came` streams of syntax 5, whose deviation codes step by 2^(−1/2) below the parent's,
@@ -340,7 +346,6 @@ fn came_streams_of_eight_level_meta_nodes_still_decode_and_refine() {
 #[test]
 fn came_streams_of_half_step_deviations_still_decode_and_refine() {
     use meshcodec::codecs::came::decode_tree;
-    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
     use meshcodec::hierarchy::came::deviation::FINE_DEVIATION_DEPTHS;
     let (old, new) = kept_came_stream_and_todays("came-eight-before-anchored-deviations.mc");
     assert_eq!(header_of(&old).syntax, 5);
@@ -361,14 +366,7 @@ fn came_streams_of_half_step_deviations_still_decode_and_refine() {
     };
     let (old_sum, new_sum) = (coarse_sum(&old), coarse_sum(&new));
     assert!(new_sum < old_sum, "{new_sum} against {old_sum}");
-    let view = View::new(&far_camera_on_eight(), 0.25).unwrap();
-    for bytes in [&old, &new] {
-        let mut front = ViewMesh::from_stream(bytes).unwrap();
-        let adapted = front.settle(&view, Budget::UNLIMITED, 64);
-        assert!(adapted.settled && adapted.unsure == 0, "{adapted:?}");
-        front.check_invariants().unwrap();
-        assert!(front.face_count() > 0);
-    }
+    settle_far_from_eight(&[&old, &new]);
 }
 
 #[test]

@@ -8,8 +8,8 @@
 //! comma-separated list of root depths, as 4,8,11, or band:K,B,WHOLE, to try beside the
 //! built-in layouts)
 use meshcodec::codecs::came::decode_tree;
-use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
-use meshcodec_lab::came::vd::{framing, towards, FOV_DEGREES, HEIGHT, VIEWS, WIDTH};
+use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
+use meshcodec_lab::came::vd::{framing, view_camera, VIEWS};
 use std::collections::HashSet;
 
 #[derive(Clone, Debug)]
@@ -187,7 +187,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let mut full = ViewMesh::from_stream(&bytes)?;
     full.settle(&View::everything(), Budget::UNLIMITED, 256);
-    let (centre, diagonal, spot) = framing(&full.mesh())?;
+    let framed = framing(&full.mesh())?;
     let mut rules = vec![
         Rule::Levels(8),
         Rule::Levels(4),
@@ -228,19 +228,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     for (name, diagonals) in VIEWS {
-        let (eye, target) = if name == "near" {
-            (spot + towards() * diagonals * diagonal, spot)
-        } else {
-            (centre + towards() * diagonals * diagonal, centre)
-        };
-        let camera = Camera {
-            eye,
-            target,
-            up: glam::DVec3::Y,
-            fov_degrees: FOV_DEGREES,
-            width: WIDTH,
-            height: HEIGHT,
-        };
+        let camera = view_camera(name, diagonals, framed);
         for guard in [true, false] {
             let view = View::new(&camera, 1.0)?
                 .two_sided(true)

@@ -58,6 +58,24 @@ pub fn framing(mesh: &TriMesh) -> Result<(DVec3, f64, DVec3)> {
         .ok_or_else(empty)?;
     Ok((centre, (bounds.max - bounds.min).length(), spot))
 }
+/// The camera of view `name` (of [`VIEWS`], `diagonals` away) of a mesh whose [`framing`] is
+/// (`centre`, `diagonal`, `spot`).
+pub fn view_camera(
+    name: &str,
+    diagonals: f64,
+    (centre, diagonal, spot): (DVec3, f64, DVec3),
+) -> Camera {
+    let target = if name == "near" { spot } else { centre };
+    Camera {
+        eye: target + towards() * diagonals * diagonal,
+        target,
+        up: DVec3::Y,
+        fov_degrees: FOV_DEGREES,
+        width: WIDTH,
+        height: HEIGHT,
+    }
+}
+
 /// The command that makes it.
 pub const COMMAND: &str = "cargo run --release --bin experiment -- came-vd";
 
@@ -194,25 +212,12 @@ fn one_mesh(
     write_mesh(&full, &full_path)?;
     let stream_path = work.join(format!("{stem}.mc"));
     std::fs::write(&stream_path, &stream)?;
-    let (centre, diagonal, spot) = framing(&full)?;
-    let towards = towards();
+    let framed = framing(&full)?;
     let reference = FullMesh::new(&full);
-    let camera_from = |eye: DVec3, target: DVec3| Camera {
-        eye,
-        target,
-        up: DVec3::Y,
-        fov_degrees: FOV_DEGREES,
-        width: WIDTH,
-        height: HEIGHT,
-    };
-    let middle_eye = centre + towards * VIEWS[1].1 * diagonal;
+    let middle = view_camera(VIEWS[1].0, VIEWS[1].1, framed);
     let mut views = Vec::new();
     for (view_name, diagonals) in VIEWS {
-        let camera = if view_name == "near" {
-            camera_from(spot + towards * diagonals * diagonal, spot)
-        } else {
-            camera_from(centre + towards * diagonals * diagonal, centre)
-        };
+        let camera = view_camera(view_name, diagonals, framed);
         let view = View::new(&camera, TOLERANCE_PX)?.two_sided(true);
         let (front, adapted) = adapt_cold(&stream_path, &view)?;
         let (unguarded, _) = adapt_cold(&stream_path, &view.clone().keep_orientation(false))?;
@@ -222,11 +227,7 @@ fn one_mesh(
             .ok_or_else(|| Error::mesh(format!("{name}: nothing in the {view_name} view")))?;
         let fetched = front.fetched();
         // The far view is drawn from the middle view's eye, where its faces can be told apart.
-        let render_camera = if view_name == "far" {
-            camera_from(middle_eye, centre)
-        } else {
-            camera
-        };
+        let render_camera = if view_name == "far" { middle } else { camera };
         // The middle view is not drawn (the table shows far and near).
         let render = if view_name == "middle" {
             String::new()
@@ -289,7 +290,7 @@ fn one_mesh(
         vertices: canonical.vertex_count(),
         triangles: canonical.face_count(),
         stream_bytes: stream.len() as u64,
-        diagonal,
+        diagonal: framed.1,
         full_mesh: full_path.display().to_string(),
         views,
     })

@@ -67,20 +67,7 @@ impl Codec for Came {
     }
 
     fn encode(&self, mesh: &CanonicalMesh) -> Result<Encoded> {
-        let layout = Layout {
-            naming: self.descriptor().naming,
-            per_node_bounds: true,
-            shape: SHAPE,
-            component_bits: 0,
-            radius_bits: RADIUS_BITS,
-            cone_bits: cones::AXIS_BITS,
-            deviation_bits: DEVIATION_BITS,
-            face_normal_steps: face_normals::STEPS,
-        };
-        encode_stream(mesh, layout, |tree, part| {
-            let encoder = Encoder::new(tree, mesh, part);
-            (encoder.units(), encoder.face_normal_bound())
-        })
+        Ok(encode_with_unit_fields(mesh)?.0)
     }
 
     fn level_ends(&self, stream: &StreamReader) -> Result<Vec<u64>> {
@@ -95,6 +82,32 @@ impl Codec for Came {
             ModelledUnits::default(),
         )?))
     }
+}
+
+/// Bits a field, named as the stream's statistics name them, of each unit of a stream.
+pub type UnitFieldBits = Vec<std::collections::BTreeMap<&'static str, f64>>;
+
+/// `mesh`'s `came` stream, and the bits of each of its units by field, in stream order (the
+/// index's): what a view's units hold, for probes (lab/examples/came_unit_fields.rs).
+pub fn encode_with_unit_fields(mesh: &CanonicalMesh) -> Result<(Encoded, UnitFieldBits)> {
+    let layout = Layout {
+        naming: DESCRIPTOR.naming,
+        per_node_bounds: true,
+        shape: SHAPE,
+        component_bits: 0,
+        radius_bits: RADIUS_BITS,
+        cone_bits: cones::AXIS_BITS,
+        deviation_bits: DEVIATION_BITS,
+        face_normal_steps: face_normals::STEPS,
+    };
+    let mut fields = Vec::new();
+    let encoded = encode_stream(mesh, layout, |tree, part| {
+        let encoder = Encoder::new(tree, mesh, part);
+        let units = encoder.units();
+        fields = units.iter().map(|(_, _, f)| f.clone()).collect();
+        (units, encoder.face_normal_bound())
+    })?;
+    Ok((encoded, fields))
 }
 
 /// How `came` cuts its hierarchy into units (syntax 5): bands of two levels over regions of six
