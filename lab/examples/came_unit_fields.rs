@@ -1,13 +1,20 @@
 //! What the units a view reads hold: a mesh's `came` stream, then for the far, middle and near
 //! views of the came-vd table (1 px, two-sided, guard on) the units the front asks for, and
-//! their bits by field against the whole stream's: where a view's bytes go.
+//! their bits by field against the whole stream's: where a view's bytes go. Then the triangles'
+//! corner paths in the units read: how many of their steps pass nodes the unit does not split
+//! (coded blind, about a bit each), and how many of those lie at nodes split by units the view
+//! does not read — the steps a syntax coding paths only as far as their unit knows would take
+//! out of the view's bytes.
 //! Run: cargo run --release --example came_unit_fields -- MESH (a shared mesh's name or a file)
+use meshcodec::codecs::came::decode_tree;
+use meshcodec::codecs::came::knowledge::Status;
 use meshcodec::codecs::came::modelled::{encode_with_unit_fields, Came};
 use meshcodec::codecs::came::refine::{head_length, Budget, Fetch, View, ViewMesh};
 use meshcodec::codecs::{canonical_for, Codec};
+use meshcodec::hierarchy::came::NodeId;
 use meshcodec::mesh::io;
 use meshcodec_lab::came::vd::{framing, view_camera, TOLERANCE_PX, VIEWS};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = std::env::args()
@@ -19,7 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (encoded, unit_fields) = encode_with_unit_fields(&canonical)?;
     let bytes = encoded.bytes;
     let mut total: BTreeMap<&str, f64> = BTreeMap::new();
-    for fields in &unit_fields {
+    for (_, fields) in &unit_fields {
         for (k, v) in fields {
             *total.entry(k).or_default() += v;
         }
@@ -30,6 +37,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         bytes.len(),
         unit_fields.len(),
         all_bits / 8.0
+    );
+    let (_, tree) = decode_tree(&bytes)?;
+    let every_unit: HashSet<NodeId> = unit_fields.iter().map(|(root, _)| *root).collect();
+    let whole = path_steps(&tree, &every_unit);
+    println!(
+        "corner paths of all {} triangles: {} steps at nodes their unit splits, {} blind ({} of them also a leaf flag)",
+        whole.triangles, whole.known, whole.blind, whole.unknown
     );
     let mut full = ViewMesh::from_stream(&bytes)?;
     full.settle(&View::everything(), Budget::UNLIMITED, 256);
@@ -54,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let mut fields: BTreeMap<&str, f64> = BTreeMap::new();
         for &unit in &read {
-            for (k, v) in &unit_fields[unit] {
+            for (k, v) in &unit_fields[unit].1 {
                 *fields.entry(k).or_default() += v;
             }
         }
@@ -82,6 +96,92 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 100.0 * v / total[k]
             );
         }
+        let roots: HashSet<NodeId> = read.iter().map(|&u| unit_fields[u].0).collect();
+        let steps = path_steps(&tree, &roots);
+        let right = steps.blind_right as f64 / steps.blind.max(1) as f64;
+        println!(
+            "corner paths of the {} triangles born in the units read: {} steps at nodes their unit splits, {} blind ({} of them also a leaf flag; {:.1}% to the right child: {:.2} bits a step), {} of the blind ones at nodes split by units not read",
+            steps.triangles,
+            steps.known,
+            steps.blind,
+            steps.unknown,
+            100.0 * right,
+            entropy(right),
+            steps.blind_unread
+        );
     }
     Ok(())
+}
+
+/// Steps of corner paths (docs/FORMAT.md §8.2, pass 2) of the triangles born in the units
+/// rooted at `read`.
+#[derive(Default)]
+struct PathSteps {
+    triangles: usize,
+    /// At nodes the triangle's unit (or an ancestor) splits: "towards" bits.
+    known: usize,
+    /// At nodes it does not: plain bits.
+    blind: usize,
+    /// Of those, at nodes it does not know the creation of either (a leaf flag too).
+    unknown: usize,
+    /// Blind steps at nodes split by a unit not in `read`.
+    blind_unread: usize,
+    /// Blind steps to the right child (their plain context codes about the entropy of this
+    /// share a step).
+    blind_right: usize,
+}
+
+fn path_steps(
+    tree: &meshcodec::codecs::came::decoded::DecodedTree,
+    read: &HashSet<NodeId>,
+) -> PathSteps {
+    let mut steps = PathSteps::default();
+    for t in &tree.triangles {
+        let c = t.corners;
+        // Two corners part at the birth node.
+        let pairs = [(0, 1), (1, 2), (0, 2)];
+        let Some(birth) = pairs
+            .iter()
+            .map(|&(i, j)| c[i].ancestor(c[i].common_len(c[j])))
+            .find(|b| b.len() == t.birth_depth)
+        else {
+            continue;
+        };
+        let Some(unit) = tree
+            .get(birth)
+            .and_then(|s| tree.nodes[s as usize].split_unit)
+        else {
+            continue;
+        };
+        if !read.contains(&unit) {
+            continue;
+        }
+        steps.triangles += 1;
+        for corner in c {
+            for depth in corner.common_len(birth) + 1..corner.len() {
+                let Some(x) = tree.get(corner.ancestor(depth)) else {
+                    continue;
+                };
+                match tree.status_of(x, unit) {
+                    Status::Inner => steps.known += 1,
+                    status => {
+                        steps.blind += 1;
+                        steps.blind_right += corner.bit(depth) as usize;
+                        steps.unknown += (status == Status::Unknown) as usize;
+                        let split = tree.nodes[x as usize].split_unit;
+                        steps.blind_unread += split.is_some_and(|u| !read.contains(&u)) as usize;
+                    }
+                }
+            }
+        }
+    }
+    steps
+}
+
+/// The entropy of a bit that is 1 with probability `p`, in bits.
+fn entropy(p: f64) -> f64 {
+    if p <= 0.0 || p >= 1.0 {
+        return 0.0;
+    }
+    -(p * p.log2() + (1.0 - p) * (1.0 - p).log2())
 }

@@ -32,6 +32,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self};
 use crate::hierarchy::came::deviation::DEVIATION_BITS;
 use crate::hierarchy::came::face_normals;
+use crate::hierarchy::came::NodeId;
 use crate::mesh::CanonicalMesh;
 
 /// The `came` codec.
@@ -84,11 +85,13 @@ impl Codec for Came {
     }
 }
 
-/// Bits a field, named as the stream's statistics name them, of each unit of a stream.
-pub type UnitFieldBits = Vec<std::collections::BTreeMap<&'static str, f64>>;
+/// Each unit of a stream: its root, and its bits a field, named as the stream's statistics
+/// name them.
+pub type UnitFieldBits = Vec<(NodeId, std::collections::BTreeMap<&'static str, f64>)>;
 
-/// `mesh`'s `came` stream, and the bits of each of its units by field, in stream order (the
-/// index's): what a view's units hold, for probes (lab/examples/came_unit_fields.rs).
+/// `mesh`'s `came` stream, and the root and the bits by field of each of its units, in stream
+/// order (the index's): what a view's units hold, for probes
+/// (lab/examples/came_unit_fields.rs).
 pub fn encode_with_unit_fields(mesh: &CanonicalMesh) -> Result<(Encoded, UnitFieldBits)> {
     let layout = Layout {
         naming: DESCRIPTOR.naming,
@@ -104,7 +107,11 @@ pub fn encode_with_unit_fields(mesh: &CanonicalMesh) -> Result<(Encoded, UnitFie
     let encoded = encode_stream(mesh, layout, |tree, part| {
         let encoder = Encoder::new(tree, mesh, part);
         let units = encoder.units();
-        fields = units.iter().map(|(_, _, f)| f.clone()).collect();
+        let roots = part.units.iter().map(|u| tree.ids[u.root as usize]);
+        fields = roots
+            .zip(&units)
+            .map(|(root, (_, _, f))| (root, f.clone()))
+            .collect();
         (units, encoder.face_normal_bound())
     })?;
     Ok((encoded, fields))
