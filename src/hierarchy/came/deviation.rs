@@ -595,23 +595,24 @@ pub fn round_up(x: f64) -> f32 {
     }
 }
 
-/// The smallest code whose deviation under `parent` is at least `deviation` (which is at most
-/// `parent`: the deviations are monotone).
-pub fn deviation_code(deviation: f64, parent: f32) -> u32 {
-    if deviation <= 0.0 {
-        return 0;
-    }
-    (1..DEVIATION_CODES)
-        .find(|&code| decoded_deviation(code, parent) as f64 >= deviation)
-        .unwrap_or(DEVIATION_CODES - 1)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::hierarchy::came::{build, BuildOptions};
     use crate::mesh::generate;
     use std::f64::consts::FRAC_1_SQRT_2;
+
+    /// The smallest code of syntaxes 1 to 5 whose deviation under `parent` is at least
+    /// `deviation` (which is at most `parent`: the deviations are monotone), as their encoders
+    /// chose it.
+    fn deviation_code(deviation: f64, parent: f32) -> u32 {
+        if deviation <= 0.0 {
+            return 0;
+        }
+        (1..DEVIATION_CODES)
+            .find(|&code| decoded_deviation(code, parent) as f64 >= deviation)
+            .unwrap_or(DEVIATION_CODES - 1)
+    }
 
     fn measured(cells: &[[u32; 3]], faces: &[[u32; 3]]) -> (VertexTree, Vec<f64>, Vec<f64>) {
         let tree = build(cells, faces, &BuildOptions::default()).unwrap();

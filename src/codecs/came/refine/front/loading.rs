@@ -12,6 +12,10 @@ impl ViewMesh {
     pub(super) fn take_in(&mut self, loaded: Loaded) {
         self.loading.outstanding -= 1;
         self.loading.bytes_read += loaded.bytes;
+        // Only a request reads a unit's open nodes (its priority).
+        if let Some(opened) = self.loading.opened.get_mut(loaded.unit) {
+            *opened = Vec::new();
+        }
         match loaded.outcome {
             Ok(delta) => {
                 self.loading.units[loaded.unit] = UnitState::Loaded;
