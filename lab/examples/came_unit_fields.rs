@@ -25,12 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let canonical = canonical_for(&mesh, &codec.default_options())?;
     let (encoded, unit_fields) = encode_with_unit_fields(&canonical)?;
     let bytes = encoded.bytes;
-    let mut total: BTreeMap<&str, f64> = BTreeMap::new();
-    for (_, fields) in &unit_fields {
-        for (k, v) in fields {
-            *total.entry(k).or_default() += v;
-        }
-    }
+    let total = summed(unit_fields.iter().map(|(_, fields)| fields));
     let all_bits: f64 = total.values().sum();
     println!(
         "{name}: {} bytes, {} units, {:.0} bytes of coded fields",
@@ -45,14 +40,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "corner paths of all {} triangles: {} steps at nodes their unit splits, {} blind ({} of them also a leaf flag)",
         whole.triangles, whole.known, whole.blind, whole.unknown
     );
-    let mut full = ViewMesh::from_stream(&bytes)?;
-    full.settle(&View::everything(), Budget::UNLIMITED, 256);
-    let framed = framing(&full.mesh())?;
+    // `came` is lossless: its full decode is the canonical mesh.
+    let framed = framing(&canonical.to_mesh())?;
+    let head = head_length(&bytes)?.ok_or("the stream's head is cut")? as usize;
     for (view_name, diagonals) in VIEWS {
         let camera = view_camera(view_name, diagonals, framed);
         let view = View::new(&camera, TOLERANCE_PX)?.two_sided(true);
         // The caller fetches: every unit the front asks for is listed.
-        let head = head_length(&bytes)?.ok_or("the stream's head is cut")? as usize;
         let mut front = ViewMesh::open(bytes[..head].to_vec(), Fetch::External)?;
         let mut read = vec![0usize];
         for _ in 0..1000 {
@@ -66,12 +60,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 read.push(unit);
             }
         }
-        let mut fields: BTreeMap<&str, f64> = BTreeMap::new();
-        for &unit in &read {
-            for (k, v) in &unit_fields[unit].1 {
-                *fields.entry(k).or_default() += v;
-            }
-        }
+        let fields = summed(read.iter().map(|&unit| &unit_fields[unit].1));
         let read_bits: f64 = fields.values().sum();
         let fetched = front.fetched();
         println!(
@@ -184,4 +173,17 @@ fn entropy(p: f64) -> f64 {
         return 0.0;
     }
     -(p * p.log2() + (1.0 - p) * (1.0 - p).log2())
+}
+
+/// Bits by field, summed over `units`.
+fn summed<'a>(
+    units: impl Iterator<Item = &'a BTreeMap<&'static str, f64>>,
+) -> BTreeMap<&'static str, f64> {
+    let mut total = BTreeMap::new();
+    for fields in units {
+        for (&k, v) in fields {
+            *total.entry(k).or_default() += v;
+        }
+    }
+    total
 }

@@ -416,6 +416,7 @@ impl ModelledUnits {
         }
         let mut children_units: Vec<u32> = Vec::new();
         let mut at_node = 0;
+        let root_deviation = r.tree.nodes[0].deviation;
         // Pass 1.
         while at_node < queue.len() {
             let s = queue[at_node];
@@ -424,7 +425,6 @@ impl ModelledUnits {
             let (sid, ps, rs, parent_cone) = (node.id, node.position, node.radius, node.cone);
             let (parent_deviation, parent_step) =
                 (node.deviation, r.tree.deviation_steps[s as usize]);
-            let root_deviation = r.tree.nodes[0].deviation;
             let depth = sid.len() as usize + 1;
             let mut leaf = [false; 2];
             for (side, l) in leaf.iter_mut().enumerate() {
