@@ -3,8 +3,9 @@
 //! its decode time on one thread and on all (best of N), as one JSON line per slab count.
 //! Run: cargo run --release --example emc_slabs -- MESH [N]
 //! With `--write OUT.mc SLABS LOG2` it writes one stream sliced into SLABS slabs for passes of
-//! 2^LOG2 visits or more instead (the fuzz seeds' sliced streams, from small meshes).
-use meshcodec::codecs::emc::modelled::encode_sliced;
+//! 2^LOG2 visits or more instead (the fuzz seeds' sliced streams, from small meshes), with
+//! `AHEAD` an `emc-ahead` stream taking cells that many levels ahead.
+use meshcodec::codecs::emc::modelled::{encode_sliced, encode_sliced_ahead};
 use meshcodec::codecs::emc::SLICED_VISITS_LOG2;
 use meshcodec::codecs::{self, EncodeOptions, Stop};
 use std::time::Instant;
@@ -14,7 +15,7 @@ type Failure = Box<dyn std::error::Error>;
 fn main() -> Result<(), Failure> {
     let args: Vec<String> = std::env::args().collect();
     let Some(path) = args.get(1) else {
-        return Err("usage: emc_slabs MESH [N] | emc_slabs MESH --write OUT.mc SLABS LOG2".into());
+        return Err("usage: emc_slabs MESH [N] | emc_slabs MESH --write OUT.mc SLABS LOG2 [AHEAD]".into());
     };
     let mesh = meshcodec::mesh::io::read_mesh(std::path::Path::new(path))?;
     let options = EncodeOptions {
@@ -24,9 +25,11 @@ fn main() -> Result<(), Failure> {
     let canonical = codecs::canonical_for(&mesh, &options)?;
     if args.get(2).map(String::as_str) == Some("--write") {
         let (Some(out), Some(slabs), Some(log2)) = (args.get(3), args.get(4), args.get(5)) else {
-            return Err("usage: emc_slabs MESH --write OUT.mc SLABS LOG2".into());
+            return Err("usage: emc_slabs MESH --write OUT.mc SLABS LOG2 [AHEAD]".into());
         };
-        let encoded = encode_sliced(&canonical, slabs.parse()?, log2.parse()?)?;
+        // An optional lookahead: the stream is emc-ahead's.
+        let ahead = args.get(6).map_or(Ok(0), |k| k.parse())?;
+        let encoded = encode_sliced_ahead(&canonical, ahead, slabs.parse()?, log2.parse()?)?;
         std::fs::write(out, &encoded.bytes)?;
         return Ok(());
     }

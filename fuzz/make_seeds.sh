@@ -152,7 +152,7 @@ OBJ
 awk '/^v /{n++} /^f /{f++; if (f == 2) {printf "f"; for (i = NF; i > 1; i--) printf " %s", $i; print ""; next}} {print} END {print "v 0 0 3"; print "f 1 2", n + 1}' \
   $seeds/read_obj/torus.obj | sed 's|/[0-9/]*||g' > $seeds/read_obj/torus-fin.obj
 stream=$(mktemp)
-for codec in raw emc emc-paper pm pm-reordered came came-paper; do
+for codec in raw emc emc-ahead emc-paper pm pm-reordered came came-paper; do
   dir=$seeds/decode_${codec//-/_}
   mkdir -p "$dir"
   for mesh in $seeds/read_obj/torus.obj $seeds/read_off/colour.off $seeds/read_obj/bowtie-fin.obj $seeds/read_obj/torus-fin.obj; do
@@ -168,6 +168,8 @@ for mesh in $seeds/read_obj/torus.obj $seeds/read_obj/torus-fin.obj; do
   name=$(basename "$mesh"); name=${name%.*}
   target/release/examples/emc_slabs "$mesh" --write "$stream" 3 2
   tail -c +8 "$stream" > "$seeds/decode_emc/$name-slabs.body"
+  target/release/examples/emc_slabs "$mesh" --write "$stream" 3 2 2
+  tail -c +8 "$stream" > "$seeds/decode_emc_ahead/$name-slabs.body"
 done
 # Streams with appearance (every codec that carries it, on the seeds with uvs, normals,
 # materials or colours), with the magic and version cut off: decode_appearance's input.

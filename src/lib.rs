@@ -8,6 +8,7 @@
 //! |---|---|---|
 //! | `raw` | the uncompressed indexed face set, 3·Q bits a vertex | the baseline row of every table |
 //! | `emc` | Magnor & Girod's embedded mesh coding, context-modelled: octree splits of positions and connectivity together, any topology, lossless | the smallest progressive stream; levels as the bytes arrive |
+//! | `emc-ahead` | `emc` with every position coded two levels ahead of the octree's splits | streams read in part: better intermediate levels for a larger lossless stream |
 //! | `emc-paper` | the same as published (Table 1) | reproducing the paper |
 //! | `pm`, `pm-reordered` | Hoppe's progressive meshes: QEM collapses, coded vertex splits, wedges in the splits | intermediate levels of the best quality for their bits |
 //! | `came` | Grabner's compressed vertex hierarchy, context-modelled and lossless, meta-nodes read on demand | view-dependent refinement ([`codecs::came::refine`]) |

@@ -35,8 +35,8 @@ fn assert_valid(level: &LevelMesh) {
     assert!(level.mesh.positions.iter().all(|p| p.is_finite()));
 }
 
-/// The two EMC coders.
-const CODERS: [&str; 2] = ["emc", "emc-paper"];
+/// The EMC coders.
+const CODERS: [&str; 3] = ["emc", "emc-ahead", "emc-paper"];
 
 fn encode(
     codec: &str,
@@ -82,8 +82,16 @@ proptest! {
             assert_valid(&full);
             prop_assert_eq!(full.mesh.vertex_count(), record.vertices);
             let (cut, k) = codecs::decode(&encoded.bytes[..record.end_byte], Stop::All).unwrap();
-            prop_assert_eq!(k, decoder.levels_decoded());
-            prop_assert!(cut == full, "cut after level {} differs", k);
+            // Levels after this one that hold no bytes (emc-ahead's last, whose cells all went
+            // ahead) are present in the cut too.
+            let present = encoded.levels.iter().filter(|r| r.end_byte <= record.end_byte).count();
+            prop_assert_eq!(k, present);
+            if k == decoder.levels_decoded() {
+                prop_assert!(cut == full, "cut after level {} differs", k);
+            } else {
+                let (whole, _) = codecs::decode(&encoded.bytes, Stop::Levels(k)).unwrap();
+                prop_assert!(cut == whole, "cut after level {} differs", k);
+            }
         }
         prop_assert!(!decoder.advance().unwrap());
     }
@@ -204,14 +212,15 @@ proptest! {
     /// encoder codes the slabs one after another or at once, lossless, and every level the same
     /// whether the slabs are decoded one after another or at once.
     #[test]
-    fn sliced_streams_are_lossless_and_alike_on_one_thread_and_on_several(seed in any::<u64>(), bits in 1u8..=14, slabs in 2u8..=8, log2 in 0u8..=6) {
+    fn sliced_streams_are_lossless_and_alike_on_one_thread_and_on_several(seed in any::<u64>(), bits in 1u8..=14, slabs in 2u8..=8, log2 in 0u8..=6, ahead in 0u8..=3) {
         let mesh = generate::messy(seed);
         let options = EncodeOptions { quant_bits: bits, grid: GridShape::Cubic };
         let Ok(canonical) = codecs::canonical_for(&mesh, &options) else { return Ok(()) };
-        let encoded = codecs::emc::modelled::encode_sliced(&canonical, slabs, log2).unwrap();
+        let encode = || codecs::emc::modelled::encode_sliced_ahead(&canonical, ahead, slabs, log2).unwrap();
+        let encoded = encode();
         // The encoder codes the slabs at once too, to the same bytes.
         let alone = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-        let encoded_alone = alone.install(|| codecs::emc::modelled::encode_sliced(&canonical, slabs, log2).unwrap());
+        let encoded_alone = alone.install(encode);
         prop_assert!(encoded.bytes == encoded_alone.bytes, "the threads changed the stream");
         let one = levels_on(&encoded.bytes, 1);
         let several = levels_on(&encoded.bytes, 3);
@@ -294,6 +303,36 @@ fn emc_levels_show_vertices_in_their_cells_and_the_mesh_faces_once_all_are_decod
 
 /// A slab table that lies (too long, or more splits than a slab visits) is refused in one line
 /// naming it, and so is a level whose slab streams are not all read.
+/// `emc-ahead` codes the octree `emc` codes, in another order: every level holds as many
+/// vertices and triangles as `emc`'s, on every grid, with and without a lookahead deep enough
+/// to reach the last level; its full level is the mesh.
+#[test]
+fn emc_ahead_levels_hold_the_vertices_and_triangles_of_emcs() {
+    for seed in 0..cases() as u64 {
+        for (bits, ahead) in [(12, 2), (6, 8), (9, 1)] {
+            let Some((canonical, plain)) = encode("emc", seed, bits, seed % 2 == 1) else {
+                continue;
+            };
+            let encoded =
+                codecs::emc::modelled::encode_sliced_ahead(&canonical, ahead, 1, 13).unwrap();
+            let ahead_levels = levels_on(&encoded.bytes, 1);
+            let plain_levels = levels_on(&plain.bytes, 1);
+            assert_eq!(ahead_levels.len(), plain_levels.len());
+            for (l, (a, p)) in ahead_levels.iter().zip(&plain_levels).enumerate() {
+                assert_valid(a);
+                assert_eq!(
+                    (a.mesh.vertex_count(), a.mesh.faces.len()),
+                    (p.mesh.vertex_count(), p.mesh.faces.len()),
+                    "seed {seed}, {bits} bits, {ahead} ahead, level {}",
+                    l + 1
+                );
+            }
+            let (decoded, _) = codecs::decode(&encoded.bytes, Stop::All).unwrap();
+            assert_eq!(canonical.check_lossless(&decoded.mesh), Ok(()));
+        }
+    }
+}
+
 #[test]
 fn a_lying_slab_table_is_refused() {
     let mesh = generate::messy(5);

@@ -15,9 +15,10 @@ use meshcodec::mesh::{generate, io, TriMesh};
 use std::sync::OnceLock;
 
 /// The codecs, in the order of their `decode_*` targets.
-pub const CODECS: [&str; 7] = [
+pub const CODECS: [&str; 8] = [
     "raw",
     "emc",
+    "emc-ahead",
     "emc-paper",
     "pm",
     "pm-reordered",

@@ -260,7 +260,10 @@ pub fn registry() -> Vec<&'static dyn Codec> {
     vec![
         &raw::Raw,
         &emc::paper::EmcPaper,
-        &emc::modelled::Emc,
+        &emc::modelled::Emc { ahead_levels: 0 },
+        &emc::modelled::Emc {
+            ahead_levels: emc::modelled::AHEAD_LEVELS,
+        },
         &pm::Pm {
             ordering: pm::Ordering::Natural,
         },

@@ -52,6 +52,13 @@ pub const EMC: Naming = Naming {
     syntax: 1,
     reads_from: 1,
 };
+/// Embedded mesh coding, context-modelled, every position coded ahead of the octree's splits.
+pub const EMC_AHEAD: Naming = Naming {
+    name: "emc-ahead",
+    id: 7,
+    syntax: 1,
+    reads_from: 1,
+};
 
 /// Compressed adaptive multiresolution encoding, context-modelled and lossless.
 pub const CAME: Naming = Naming {
@@ -70,7 +77,16 @@ pub const CAME_PAPER: Naming = Naming {
 };
 
 /// Every codec of this build.
-pub const ALL: [Naming; 7] = [RAW, EMC_PAPER, PM, PM_REORDERED, EMC, CAME_PAPER, CAME];
+pub const ALL: [Naming; 8] = [
+    RAW,
+    EMC_PAPER,
+    PM,
+    PM_REORDERED,
+    EMC,
+    CAME_PAPER,
+    CAME,
+    EMC_AHEAD,
+];
 
 #[cfg(test)]
 mod tests {

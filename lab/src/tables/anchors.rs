@@ -53,6 +53,7 @@ pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
         let _ = writeln!(md, "|---|---|---:|---:|---:|---|---:|");
         for (codec, progressive) in [
             ("emc", true),
+            ("emc-ahead", true),
             ("emc-paper", true),
             ("pm", true),
             ("raw", false),
@@ -123,7 +124,7 @@ pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
 /// between their levels, where both have levels on either side).
 pub(crate) fn intermediate_levels(results: &Path, md: &mut String) -> Result<()> {
     let _ = writeln!(md, "## Intermediate levels: RMS error at the same bits\n");
-    let _ = writeln!(md, "Each level of `emc` at 12 bits beside `pm`'s and the valence-driven coder's RMS error at the same cumulative bits, interpolated on log–log axes between their own levels (blank where they have no level on one side). RMS is relative to the bounding box's diagonal, both ways between the level and the original (docs/CONTRACT.md §5). `emc` shows each vertex where its neighbours predict it inside its cell (`codecs::emc::modelled::placement`; BENCHMARKS.md compares it with the cell centres). The target of the last column: `emc`'s RMS no higher than the lower of the others'.\n");
+    let _ = writeln!(md, "Each level of `emc` and of `emc-ahead` (every vertex's position coded two levels ahead of the octree's splits: docs/FORMAT.md §7.1) at 12 bits beside `pm`'s and the valence-driven coder's RMS error at the same cumulative bits, interpolated on log–log axes between their own levels (blank where they have no level on one side). RMS is relative to the bounding box's diagonal, both ways between the level and the original (docs/CONTRACT.md §5). `emc` shows each vertex where its neighbours predict it inside its cell (`codecs::emc::modelled::placement`; BENCHMARKS.md compares it with the cell centres). The target of the last column: the level's RMS no higher than the lower of the others'.\n");
     let valence = valence_anchor()?;
     let rms_points = |r: &RunResult| -> Vec<(f64, f64)> {
         r.levels
@@ -132,22 +133,25 @@ pub(crate) fn intermediate_levels(results: &Path, md: &mut String) -> Result<()>
             .filter(|&(_, rms)| rms > 0.0)
             .collect()
     };
-    for mesh in MESHES {
-        let emc = load_at(results, "emc", mesh, 12)?;
+    for (mesh, codec) in MESHES
+        .iter()
+        .flat_map(|&mesh| [(mesh, "emc"), (mesh, "emc-ahead")])
+    {
+        let emc = load_at(results, codec, mesh, 12)?;
         let pm = rms_points(&load_at(results, "pm", mesh, 12)?);
         let others: Vec<(&str, Vec<(f64, f64)>)> = if mesh == "bunny" {
             vec![("pm", pm), ("valence coder", valence.rms.clone())]
         } else {
             vec![("pm", pm)]
         };
-        let _ = writeln!(md, "### {mesh}\n");
-        let mut head = "| level | bits/vertex | `emc` RMS |".to_string();
+        let _ = writeln!(md, "### {mesh}, `{codec}`\n");
+        let mut head = format!("| level | bits/vertex | `{codec}` RMS |");
         let mut rule = "|---:|---:|---:|".to_string();
         for (name, _) in &others {
             head += &format!(" {name} |");
             rule += "---:|";
         }
-        let _ = writeln!(md, "{head} `emc` / lower | met |\n{rule}---:|---|");
+        let _ = writeln!(md, "{head} `{codec}` / lower | met |\n{rule}---:|---|");
         let v = emc.vertices as f64;
         for level in &emc.levels {
             let (Some(rms), x) = (level.rms, level.bits as f64) else {
@@ -268,7 +272,7 @@ pub(crate) fn valence_anchor() -> Result<ValenceAnchor> {
 /// for every level of `emc`, `emc-paper` and `pm` at 12 bits and of the valence-driven coder
 /// (the anchor file's measurement), and Draco's single-rate points at quantization 8 to 16.
 pub fn emc_rate_distortion(results: &Path, out: &Path) -> Result<Vec<PathBuf>> {
-    let runs = ["emc", "emc-paper", "pm"]
+    let runs = ["emc", "emc-ahead", "emc-paper", "pm"]
         .iter()
         .map(|codec| load_at(results, codec, "bunny", 12))
         .collect::<Result<Vec<_>>>()?;

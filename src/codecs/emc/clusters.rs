@@ -32,6 +32,9 @@ pub struct Clusters {
     pub trie: KeyTrie,
     /// Trie range of each list vertex.
     pub ranges: Vec<Range<usize>>,
+    /// Trie range of the cell each list vertex's cell went ahead to (its representative's
+    /// path): its range while it has not gone ahead.
+    paths: Vec<Range<usize>>,
     /// Where each trie position's edges start in [`Self::edges`] (one more entry at the end).
     edge_starts: Vec<u32>,
     /// The mesh's edges: for each trie position in order, the trie positions of its neighbours.
@@ -51,6 +54,7 @@ impl Clusters {
         Clusters {
             trie,
             ranges: std::iter::once(0..n).collect(),
+            paths: std::iter::once(0..n).collect(),
             edge_starts,
             edges,
             cluster_of: vec![0; n],
@@ -70,6 +74,11 @@ impl Clusters {
         self.trie
             .order
             .bit(self.trie.keys[self.ranges[v].start], step)
+    }
+
+    /// The half `v`'s cell takes ahead at `step` (see [`ahead`]).
+    pub fn ahead(&mut self, v: usize, step: usize, predicted: bool) -> bool {
+        ahead(&self.trie, &mut self.paths[v], step, predicted)
     }
 
     /// Works out the split of `v` (whose neighbours are `neighbours`) at `step` (which must be
@@ -110,7 +119,9 @@ impl Clusters {
     pub fn commit(&mut self, v: usize, r: usize, plan: &SplitPlan) {
         if r == self.ranges.len() {
             self.ranges.push(0..0);
+            self.paths.push(0..0);
         }
+        (self.paths[v], self.paths[r]) = split_paths(self.paths[v].clone(), plan);
         self.ranges[v] = plan.lower.clone();
         self.ranges[r] = plan.upper.clone();
     }
@@ -120,6 +131,7 @@ impl Clusters {
     pub fn make_room(&mut self, more: usize) {
         let n = self.ranges.len() + more;
         self.ranges.resize(n, 0..0);
+        self.paths.resize(n, 0..0);
         if self.stamp_lower.len() < n {
             self.stamp_lower.resize(n, 0);
             self.stamp_upper.resize(n, 0);
@@ -166,6 +178,7 @@ impl Clusters {
             edges: self.edges.as_ptr(),
             edge_count: self.edges.len(),
             ranges: self.ranges.as_mut_ptr(),
+            paths: self.paths.as_mut_ptr(),
             vertices: self.ranges.len(),
             cluster_of: self.cluster_of.as_mut_ptr(),
             positions: self.cluster_of.len(),
@@ -192,6 +205,7 @@ pub struct ClusterLanes {
     edges: *const u32,
     edge_count: usize,
     ranges: *mut Range<usize>,
+    paths: *mut Range<usize>,
     vertices: usize,
     cluster_of: *mut u32,
     positions: usize,
@@ -250,6 +264,18 @@ impl ClusterLanes {
         trie.order.bit(trie.keys[self.range(v).start], step)
     }
 
+    /// [`Clusters::ahead`].
+    pub fn ahead(&mut self, v: usize, step: usize, predicted: bool) -> bool {
+        let trie = self.trie;
+        // SAFETY: the trie is only read, and outlives the view (see the type's docs).
+        ahead(
+            unsafe { &*trie },
+            entry!(self.paths, self.vertices, v),
+            step,
+            predicted,
+        )
+    }
+
     /// [`Clusters::plan`], for a split whose new vertex `r` has room.
     pub fn plan(
         &mut self,
@@ -299,8 +325,42 @@ impl ClusterLanes {
 
     /// [`Clusters::commit`], for a split whose new vertex `r` has room.
     pub fn commit(&mut self, v: usize, r: usize, plan: &SplitPlan) {
+        let path = entry!(self.paths, self.vertices, v).clone();
+        let (lower, upper) = split_paths(path, plan);
+        *entry!(self.paths, self.vertices, v) = lower;
+        *entry!(self.paths, self.vertices, r) = upper;
         *entry!(self.ranges, self.vertices, v) = plan.lower.clone();
         *entry!(self.ranges, self.vertices, r) = plan.upper.clone();
+    }
+}
+
+/// The half a cell with trie range `path` takes at `step`, going ahead of its cluster's
+/// splits: the half its vertices keep to, or where they part the `predicted` one (1 = upper);
+/// `path` becomes that half's range.
+fn ahead(trie: &KeyTrie, path: &mut Range<usize>, step: usize, predicted: bool) -> bool {
+    if trie.next_split(path.clone()) == Some(step) {
+        let mid = trie.partition(path.clone(), step);
+        *path = if predicted {
+            mid..path.end
+        } else {
+            path.start..mid
+        };
+        predicted
+    } else {
+        trie.order.bit(trie.keys[path.start], step) == 1
+    }
+}
+
+/// The paths of a split's two halves (lower, upper), from the splitting vertex's `path`: a
+/// path that went ahead stays with the half it lies in, and the other half starts from its
+/// range.
+fn split_paths(path: Range<usize>, plan: &SplitPlan) -> (Range<usize>, Range<usize>) {
+    if path.start == plan.lower.start && path.end == plan.upper.end {
+        (plan.lower.clone(), plan.upper.clone())
+    } else if path.end <= plan.upper.start {
+        (path, plan.upper.clone())
+    } else {
+        (plan.lower.clone(), path)
     }
 }
 

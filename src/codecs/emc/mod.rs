@@ -5,7 +5,10 @@
 //!   STAY / MOVE / DUPLICATE, a fixed Huffman table of split distances;
 //! - [`modelled`] (`emc`): the same octree splits coded by adaptive binary arithmetic coding with
 //!   contexts drawn from what the decoder already knows (neighbour positions, valences, the
-//!   split plane).
+//!   split plane);
+//! - `emc-ahead`, [`modelled`] with a lookahead: every vertex's cell is coded two levels ahead of
+//!   the octree's splits (a cluster's along its representative's path), so that intermediate
+//!   levels show fewer vertices more precisely, for a larger lossless stream.
 //!
 //! Based on: M. Magnor and B. Girod, *Fully Embedded Coding of Triangle Meshes*, Proc. Vision,
 //! Modeling and Visualization (VMV) 1999 (../shared/papers/004_d00e3be26dc15ae5.txt).
@@ -23,6 +26,7 @@
 //! | STAY / MOVE / DUPLICATE | [`paper::syntax::EdgeCode`], one per neighbour of the splitting vertex |
 //! | distance to the next split, fixed Huffman table | [`paper::syntax::SPLIT_DISTANCE_CODE_LENGTHS`]; symbol 0 = "no further split" |
 //! | triangles from edges | `hierarchy::cliques`: every 3-clique of the edge graph |
+//! | (not in the paper) a cluster's representative | `emc-ahead`: the mesh vertex whose path a cluster's cell follows ahead of its splits |
 //!
 //! # The direction order
 //! Top-down, level 1 starts with the longest box side and each level takes the three axes from
@@ -67,6 +71,9 @@ pub struct EmcParams {
     pub slabs: u8,
     /// See [`Self::slabs`].
     pub sliced_visits_log2: u8,
+    /// Levels each level's lookahead pass takes every vertex's cell ahead of the octree's
+    /// splits (docs/FORMAT.md §7); 0: no lookahead (and no seventh parameter byte).
+    pub ahead_levels: u8,
 }
 
 /// Slabs of the `emc` streams that have them: up to four cores decode them at once; each slab
@@ -81,6 +88,9 @@ pub const SLICED_VISITS_LOG2: u8 = 13;
 
 /// The meshes whose `emc` streams have slabs: those of this many vertices or more.
 pub const SLICED_VERTICES: usize = 1 << 16;
+
+/// Most levels a lookahead may take cells ahead (the walker keeps a bit a step ahead in 32).
+pub const MAX_AHEAD_LEVELS: u8 = 8;
 
 /// Most slabs a stream may have.
 const MAX_SLABS: u8 = 64;
@@ -110,6 +120,7 @@ impl EmcParams {
                 1
             },
             sliced_visits_log2: SLICED_VISITS_LOG2,
+            ahead_levels: 0,
         }
     }
 
@@ -119,8 +130,11 @@ impl EmcParams {
         let mut params = self.order.axes.to_vec();
         if syntax == Syntax::Modelled {
             params.extend([u8::from(self.faces_when_settled), self.slabs]);
-            if self.slabs > 1 {
+            if self.slabs > 1 || self.ahead_levels > 0 {
                 params.push(self.sliced_visits_log2);
+            }
+            if self.ahead_levels > 0 {
+                params.push(self.ahead_levels);
             }
         }
         Header {
@@ -147,10 +161,10 @@ impl EmcParams {
         let header = stream.header();
         let bad = |what: &str| Error::malformed(0, 7, what);
         let p = &header.params;
-        let (axes, faces_when_settled, slabs, sliced_visits_log2) = match (syntax, &p[..]) {
-            (Syntax::Paper, &[a, b, c]) => ([a, b, c], 0, 1, SLICED_VISITS_LOG2),
+        let (axes, faces_when_settled, slabs, sliced_visits_log2, ahead_levels) = match (syntax, &p[..]) {
+            (Syntax::Paper, &[a, b, c]) => ([a, b, c], 0, 1, SLICED_VISITS_LOG2, 0),
             (Syntax::Modelled, &[a, b, c, settled, 1]) => {
-                ([a, b, c], settled, 1, SLICED_VISITS_LOG2)
+                ([a, b, c], settled, 1, SLICED_VISITS_LOG2, 0)
             }
             (Syntax::Modelled, &[a, b, c, settled, slabs, log2]) => {
                 if !(2..=MAX_SLABS).contains(&slabs) || log2 >= 32 {
@@ -158,12 +172,23 @@ impl EmcParams {
                         "emc slabs out of range (2 to 64 slabs, passes of under 2^32 visits)",
                     ));
                 }
-                ([a, b, c], settled, slabs, log2)
+                ([a, b, c], settled, slabs, log2, 0)
+            }
+            (Syntax::Modelled, &[a, b, c, settled, slabs, log2, ahead]) => {
+                if !(1..=MAX_SLABS).contains(&slabs) || log2 >= 32 {
+                    return Err(bad(
+                        "emc slabs out of range (1 to 64 slabs, passes of under 2^32 visits)",
+                    ));
+                }
+                if !(1..=MAX_AHEAD_LEVELS).contains(&ahead) {
+                    return Err(bad("emc lookahead out of range (1 to 8 levels)"));
+                }
+                ([a, b, c], settled, slabs, log2, ahead)
             }
             (Syntax::Paper, _) => return Err(bad("emc-paper parameters: 3 bytes expected")),
             (Syntax::Modelled, _) => {
                 return Err(bad(
-                    "emc parameters: 5 bytes expected, 6 with slabs (2 to 64)",
+                    "emc parameters: 5 bytes expected, 6 with slabs (2 to 64), 7 with a lookahead",
                 ))
             }
         };
@@ -190,6 +215,7 @@ impl EmcParams {
             faces_when_settled,
             slabs,
             sliced_visits_log2,
+            ahead_levels,
         })
     }
 }

@@ -40,7 +40,9 @@ const HALF_SPREAD: [f64; 7] = [
     8.0 * 8.0,
 ];
 const HALF_KINDS: usize = 4;
-const HALF_CONTEXTS: usize = HALF_KINDS * (HALF_OFFSET.len() + 1) * (HALF_SPREAD.len() + 1) + 2;
+/// Levels ahead of the octree told apart by the lookahead's contexts.
+pub const AHEAD_DISTANCES: usize = 4;
+pub const HALF_CONTEXTS: usize = HALF_KINDS * (HALF_OFFSET.len() + 1) * (HALF_SPREAD.len() + 1) + 2;
 
 /// Distance of a neighbour from the split plane, in half-widths of the splitting cell (the two
 /// halves' centres are at ±0.5).
@@ -55,6 +57,10 @@ pub const EDGE_PLACES: usize = 2 * (EDGE_ALONG.len() + 1) * (EDGE_ACROSS.len() +
 pub struct Contexts {
     pub split: [BitContext; (OFFSETS + 1) * VALENCES * REMAINING],
     pub half: [BitContext; HALF_CONTEXTS],
+    /// A cluster's "which half" coded ahead of its splits (its representative's path).
+    pub ahead: [BitContext; HALF_CONTEXTS * AHEAD_DISTANCES],
+    /// Does a cluster split at a step its representative's path took ahead, as predicted.
+    pub split_ahead: [BitContext; (OFFSETS + 1) * VALENCES * REMAINING],
     pub connecting: [BitContext; VALENCES * REMAINING],
     pub duplicate: [BitContext; EDGE_PLACES * 8 * 3],
     pub moves: [BitContext; EDGE_PLACES * 8],
@@ -68,6 +74,8 @@ impl Default for Contexts {
         Contexts {
             split: [BitContext::default(); (OFFSETS + 1) * VALENCES * REMAINING],
             half: [BitContext::default(); HALF_CONTEXTS],
+            ahead: [BitContext::default(); HALF_CONTEXTS * AHEAD_DISTANCES],
+            split_ahead: [BitContext::default(); (OFFSETS + 1) * VALENCES * REMAINING],
             connecting: [BitContext::default(); VALENCES * REMAINING],
             duplicate: [BitContext::default(); EDGE_PLACES * 8 * 3],
             moves: [BitContext::default(); EDGE_PLACES * 8],
@@ -93,6 +101,8 @@ impl Contexts {
         }
         each(&mut self.split, slabs, |c| &c.split);
         each(&mut self.half, slabs, |c| &c.half);
+        each(&mut self.ahead, slabs, |c| &c.ahead);
+        each(&mut self.split_ahead, slabs, |c| &c.split_ahead);
         each(&mut self.connecting, slabs, |c| &c.connecting);
         each(&mut self.duplicate, slabs, |c| &c.duplicate);
         each(&mut self.moves, slabs, |c| &c.moves);

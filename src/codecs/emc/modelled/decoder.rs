@@ -113,6 +113,7 @@ impl Side for DecoderSide<'_> {
         flips: [bool; 3],
         _v: usize,
         _first: usize,
+        _ahead: bool,
     ) -> Result<[bool; 3], Stop> {
         let bits = self.coder.bits3(contexts, index).ok_or(Stop::OutOfBits)?;
         Ok([0, 1, 2].map(|k| bits[k] ^ flips[k]))
@@ -216,13 +217,15 @@ pub struct EmcDecoder<'a> {
 impl<'a> EmcDecoder<'a> {
     pub fn new(stream: StreamReader<'a>, params: EmcParams) -> Self {
         let header = stream.header().clone();
+        let mut walker = Walker::new(
+            params.order,
+            header.vertices,
+            params.slabs as usize,
+            1 << params.sliced_visits_log2,
+        );
+        walker.ahead_levels = params.ahead_levels as usize;
         EmcDecoder {
-            walker: Walker::new(
-                params.order,
-                header.vertices,
-                params.slabs as usize,
-                1 << params.sliced_visits_log2,
-            ),
+            walker,
             header,
             params,
             stream,

@@ -42,6 +42,13 @@ impl ClusterAccess {
             ClusterAccess::Slab(lanes) => lanes.bit(v, step),
         }
     }
+
+    fn ahead(&mut self, v: usize, step: usize, predicted: bool) -> bool {
+        match self {
+            ClusterAccess::Owned(clusters) => clusters.ahead(v, step, predicted),
+            ClusterAccess::Slab(lanes) => lanes.ahead(v, step, predicted),
+        }
+    }
 }
 
 struct EncoderSide {
@@ -122,6 +129,8 @@ impl Side for EncoderSide {
         let answer = match question {
             Question::Split => self.clusters.next_split(v) == Some(step),
             Question::Half => self.clusters.bit(v, step) == 1,
+            // 1 ^ flip: the predicted half.
+            Question::Ahead => self.clusters.ahead(v, step, !flip),
             Question::Connecting => self.plan.connecting,
             Question::Duplicate(i) => self.plan.codes[i] == EdgeCode::Duplicate,
             Question::Moves(i) => self.plan.codes[i] == EdgeCode::Move,
@@ -140,6 +149,7 @@ impl Side for EncoderSide {
         flips: [bool; 3],
         v: usize,
         first: usize,
+        ahead: bool,
     ) -> Result<[bool; 3], Stop> {
         let answers = [0, 1, 2].map(|k| self.clusters.bit(v, first + k) == 1);
         let question = Question::Half;
@@ -148,7 +158,11 @@ impl Side for EncoderSide {
             index,
             [0, 1, 2].map(|k| answers[k] ^ flips[k]),
             question.class(),
-            question.field(),
+            if ahead {
+                "leaf_ahead"
+            } else {
+                question.field()
+            },
         );
         Ok(answers)
     }
@@ -283,6 +297,7 @@ fn encode_here(mesh: &CanonicalMesh, params: &EmcParams, header: Header) -> crat
         1 << params.sliced_visits_log2,
     );
     walker.state.reserve(mesh.vertex_count());
+    walker.ahead_levels = params.ahead_levels as usize;
     let mut side = EncoderSide::over(ClusterAccess::Owned(Clusters::new(
         mesh,
         KeyTrie::new(order, &mesh.cells),

@@ -1,7 +1,7 @@
 //! One pass's run over the walker's per-vertex arrays: [`Lanes`], the raw views the slabs of a
 //! sliced pass share (and why that is sound), and [`Run`], which visits a slab's vertices.
 
-use super::super::contexts::{self, Contexts};
+use super::super::contexts::{self, Contexts, AHEAD_DISTANCES};
 use super::*;
 use crate::codecs::emc::state::{
     check_edge_count, split_edges, EdgeCode, NeighbourLists, Neighbours, NO_SPLIT,
@@ -37,6 +37,7 @@ pub(super) struct Lanes {
     pub(super) leaf: *mut bool,
     pub(super) centres: *mut [i32; 3],
     pub(super) marks: *const AtomicU64,
+    pub(super) agree: *mut u32,
     pub(super) len: usize,
 }
 
@@ -190,6 +191,7 @@ impl Run<'_> {
         match work {
             Work::Split(step) => self.pass(side, visits, step),
             Work::Leaves(first) => self.leaf_pass(side, visits, first),
+            Work::Ahead { target, level } => self.ahead_pass(side, visits, target, level),
         }
     }
 
@@ -209,6 +211,31 @@ impl Run<'_> {
             }
             let v = v as usize;
             let valence = self.adjacency(v).len();
+            if self.depth(v) > step {
+                // The cell took this step ahead: no half to code, and a split only where the
+                // step took the predicted half.
+                let depth = self.depth(v);
+                let agreed = (*lane!(self, agree, v) >> (depth - 1 - step)) & 1 == 1;
+                if self.leaf(v) || !agreed {
+                    continue;
+                }
+                let at = self.cell_at(v, step);
+                let (half, _) = self.half_context_at(v, axis, at.centre, at.shifts);
+                let c = contexts::split(half.offset, valence, remaining);
+                let splits = side.code(
+                    &mut self.contexts.split_ahead[c],
+                    Question::Split,
+                    false,
+                    v,
+                    step,
+                )?;
+                if splits {
+                    self.check_room()?;
+                    let r = self.split(side, v, step, axis, remaining, Some(at))?;
+                    self.created.push(r as u32);
+                }
+                continue;
+            }
             let (half, flip) = self.half_context(v, axis);
             let splits = !self.leaf(v) && {
                 let c = contexts::split(half.offset, valence, remaining);
@@ -221,19 +248,104 @@ impl Run<'_> {
                 self.refresh(v);
                 continue;
             }
-            if self.next_id == self.end_id {
-                return Err(Stop::Fault(match self.slab {
-                    None => format!(
-                        "more splits than the {} vertices the header declares",
-                        self.max_vertices
-                    ),
-                    Some((_, slab)) => {
-                        format!("slab {slab} splits more vertices than its table entry says")
-                    }
-                }));
-            }
-            let r = self.split(side, v, step, axis, remaining)?;
+            self.check_room()?;
+            let r = self.split(side, v, step, axis, remaining, None)?;
             self.created.push(r as u32);
+        }
+        Ok(())
+    }
+
+    /// An error if the run has no id left for a split.
+    fn check_room(&self) -> Result<(), Stop> {
+        if self.next_id == self.end_id {
+            return Err(Stop::Fault(match self.slab {
+                None => format!(
+                    "more splits than the {} vertices the header declares",
+                    self.max_vertices
+                ),
+                Some((_, slab)) => {
+                    format!("slab {slab} splits more vertices than its table entry says")
+                }
+            }));
+        }
+        Ok(())
+    }
+
+    /// The cell `v`'s cell lies in after `steps` steps (fewer than its depth): its prefix.
+    pub(super) fn cell_at(&self, v: usize, steps: usize) -> CellAt {
+        let depth = self.depth(v);
+        let (deep, shallow) = (
+            self.order.bits_per_axis(depth),
+            self.order.bits_per_axis(steps),
+        );
+        let cell = *lane!(self, cells, v);
+        let prefix = [0, 1, 2].map(|a| cell[a] >> (deep[a] - shallow[a]));
+        let shifts = self.shifts[steps];
+        CellAt {
+            cell: prefix,
+            centre: cell_centre(prefix, shifts),
+            shifts,
+            steps,
+        }
+    }
+
+    /// Every vertex of `visits` takes its cell ahead to `target` steps, a level at a time over
+    /// all of them (so that each level's bits see their neighbours at the level before), a
+    /// step at a time within it (a leaf's three steps of a level as in [`Self::leaf_pass`]).
+    /// A cluster's cell follows its representative: the half its vertices keep to, or the
+    /// predicted half where they part, so that the split waiting there costs about what it
+    /// would have cost in its own pass. `level` is the octree's level: contexts tell apart how
+    /// far ahead of it a bit is.
+    pub(super) fn ahead_pass<S: Side>(
+        &mut self,
+        side: &mut S,
+        visits: &[u32],
+        target: usize,
+        level: usize,
+    ) -> Result<(), Stop> {
+        for stop in (level + 1..=target / 3).map(|l| 3 * l) {
+            // Bits coded further ahead see coarser neighbours: contexts of their own.
+            let distance = (stop / 3 - level - 1).min(AHEAD_DISTANCES - 1);
+            let base = distance * contexts::HALF_CONTEXTS;
+            for (i, &v) in visits.iter().enumerate() {
+                if let Some(&ahead) = visits.get(i + PREFETCH_AHEAD) {
+                    self.prefetch_ring(ahead as usize, false);
+                }
+                self.take_ahead(side, v as usize, stop, base)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// `v`'s cell taken ahead to `stop` steps (a level's end), its bits under the contexts
+    /// from `base` of [`Contexts::ahead`].
+    fn take_ahead<S: Side>(
+        &mut self,
+        side: &mut S,
+        v: usize,
+        stop: usize,
+        base: usize,
+    ) -> Result<(), Stop> {
+        while self.depth(v) < stop {
+            let step = self.depth(v);
+            if self.leaf(v) && step + 3 == stop {
+                self.leaf_bits(side, v, step, Some(base))?;
+                *lane_mut!(self, agree, v) <<= 3;
+                continue;
+            }
+            let axis = self.order.axis(step);
+            let (half, flip) = self.half_context(v, axis);
+            let question = if self.leaf(v) {
+                Question::Half
+            } else {
+                Question::Ahead
+            };
+            let context = &mut self.contexts.ahead[base + half.index];
+            let bit = side.code(context, question, flip, v, step)?;
+            self.refine(v, step, bit as u32);
+            self.refresh(v);
+            let agree = lane_mut!(self, agree, v);
+            *agree = *agree << 1 | (bit != flip) as u32;
         }
         Ok(())
     }
@@ -245,29 +357,50 @@ impl Run<'_> {
         visits: &[u32],
         first: usize,
     ) -> Result<(), Stop> {
-        let axes = [0, 1, 2].map(|k| self.order.axis(first + k));
         for (i, &v) in visits.iter().enumerate() {
             if let Some(&ahead) = visits.get(i + PREFETCH_AHEAD) {
                 self.prefetch_ring(ahead as usize, false);
             }
             let v = v as usize;
-            let (mut index, mut flips) = ([0; 3], [false; 3]);
-            match self.moments(v) {
-                None => index = [contexts::half_isolated(true).index; 3],
-                Some(m) => {
-                    let shifts = self.shifts[self.depth(v)];
-                    let (by_axis, below) = leaf_contexts(&m, shifts);
-                    for k in 0..3 {
-                        (index[k], flips[k]) = (by_axis[axes[k]], below[axes[k]]);
-                    }
+            if self.depth(v) > first {
+                // Taken ahead already.
+                continue;
+            }
+            self.leaf_bits(side, v, first, None)?;
+        }
+        Ok(())
+    }
+
+    /// A leaf's three bits from step `first` (a level's first), from one look at its
+    /// neighbours, as one symbol.
+    fn leaf_bits<S: Side>(
+        &mut self,
+        side: &mut S,
+        v: usize,
+        first: usize,
+        ahead: Option<usize>,
+    ) -> Result<(), Stop> {
+        let axes = [0, 1, 2].map(|k| self.order.axis(first + k));
+        let (mut index, mut flips) = ([0; 3], [false; 3]);
+        match self.moments(v) {
+            None => index = [contexts::half_isolated(true).index; 3],
+            Some(m) => {
+                let shifts = self.shifts[self.depth(v)];
+                let (by_axis, below) = leaf_contexts(&m, shifts);
+                for k in 0..3 {
+                    (index[k], flips[k]) = (by_axis[axes[k]], below[axes[k]]);
                 }
             }
-            let bits = side.code3(&mut self.contexts.half, index, flips, v, first)?;
-            for (k, bit) in bits.into_iter().enumerate() {
-                self.refine(v, first + k, bit as u32);
-            }
-            self.refresh(v);
         }
+        let contexts = match ahead {
+            None => &mut self.contexts.half[..],
+            Some(base) => &mut self.contexts.ahead[base..base + contexts::HALF_CONTEXTS],
+        };
+        let bits = side.code3(contexts, index, flips, v, first, ahead.is_some())?;
+        for (k, bit) in bits.into_iter().enumerate() {
+            self.refine(v, first + k, bit as u32);
+        }
+        self.refresh(v);
         Ok(())
     }
 
@@ -319,6 +452,33 @@ impl Run<'_> {
         )
     }
 
+    /// [`Self::half_context`] for `v` as if its cell were the one of centre `centre` and
+    /// half-width shifts `shifts` (a cell its own lies in).
+    pub(super) fn half_context_at(
+        &self,
+        v: usize,
+        axis: usize,
+        centre: [i32; 3],
+        shifts: [u8; 3],
+    ) -> (contexts::HalfContext, bool) {
+        match neighbour_moments(centre, self.adjacency(v), |n| self.centre(n)) {
+            None => (contexts::half_isolated(self.leaf(v)), false),
+            Some(m) => {
+                let (prediction, variance) = estimate(&m, axis, shifts);
+                let scale = per_half_width(shifts[axis]);
+                (
+                    contexts::half(
+                        self.leaf(v),
+                        m.k,
+                        prediction.abs() * scale,
+                        variance * scale * scale,
+                    ),
+                    prediction < 0.0,
+                )
+            }
+        }
+    }
+
     /// Context and flip of the half a vertex in the passes takes ([`Self::predict`] from its
     /// neighbours as they are now).
     pub(super) fn half_context(&self, v: usize, axis: usize) -> (contexts::HalfContext, bool) {
@@ -352,6 +512,7 @@ impl Run<'_> {
         step: usize,
         axis: usize,
         remaining: usize,
+        ahead: Option<CellAt>,
     ) -> Result<usize, Stop> {
         let r = self.next_id;
         side.begin_split(self.adjacency(v), v, r, step, self.lanes.len);
@@ -368,8 +529,13 @@ impl Run<'_> {
             v,
             step,
         )?;
-        let centre = self.centre(v);
-        let scale = per_half_width(self.shifts[self.depth(v)][axis]);
+        let (centre, scale) = match &ahead {
+            None => (
+                self.centre(v),
+                per_half_width(self.shifts[self.depth(v)][axis]),
+            ),
+            Some(at) => (at.centre, per_half_width(at.shifts[axis])),
+        };
         let mut codes = std::mem::take(&mut self.codes);
         codes.clear();
         // Marks left by earlier splits are told apart by their serial.
@@ -418,14 +584,36 @@ impl Run<'_> {
         }
         // VS: `v` keeps the lower half, `r` takes the upper.
         self.next_id += 1;
-        let mut cell = *lane!(self, cells, v);
-        lane_mut!(self, cells, v)[axis] = cell[axis] << 1;
-        cell[axis] = (cell[axis] << 1) | 1;
-        *lane_mut!(self, cells, r) = cell;
-        let depth = lane_mut!(self, depth, v);
-        *depth += 1;
-        let depth = *depth;
-        *lane_mut!(self, depth, r) = depth;
+        match ahead {
+            None => {
+                let mut cell = *lane!(self, cells, v);
+                lane_mut!(self, cells, v)[axis] = cell[axis] << 1;
+                cell[axis] = (cell[axis] << 1) | 1;
+                *lane_mut!(self, cells, r) = cell;
+                let depth = lane_mut!(self, depth, v);
+                *depth += 1;
+                let depth = *depth;
+                *lane_mut!(self, depth, r) = depth;
+                *lane_mut!(self, agree, r) = 0;
+            }
+            Some(at) => {
+                // The half the cell went ahead into keeps it; the other starts at the split.
+                let (deep, deep_depth) = (*lane!(self, cells, v), self.depth(v));
+                let below = self.order.bits_per_axis(deep_depth)[axis]
+                    - self.order.bits_per_axis(step + 1)[axis];
+                let went_upper = (deep[axis] >> below) & 1 == 1;
+                let (keeps, starts) = if went_upper { (r, v) } else { (v, r) };
+                let mut fresh = at.cell;
+                fresh[axis] = (fresh[axis] << 1) | (!went_upper) as u32;
+                let agree = *lane!(self, agree, v);
+                *lane_mut!(self, cells, keeps) = deep;
+                *lane_mut!(self, depth, keeps) = deep_depth as u16;
+                *lane_mut!(self, agree, keeps) = agree;
+                *lane_mut!(self, cells, starts) = fresh;
+                *lane_mut!(self, depth, starts) = at.steps as u16 + 1;
+                *lane_mut!(self, agree, starts) = 0;
+            }
+        }
         *lane_mut!(self, next_split, v) = NO_SPLIT;
         *lane_mut!(self, next_split, r) = NO_SPLIT;
         *lane_mut!(self, adjacency, r) = Neighbours::new();
@@ -466,6 +654,16 @@ impl Run<'_> {
         side.end_split(v, r);
         Ok(r)
     }
+}
+
+/// A cell that a vertex's deeper cell lies in: its prefix after `steps` steps, twice its
+/// centre and its half-widths' shifts.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CellAt {
+    pub(super) cell: [u32; 3],
+    pub(super) centre: [i32; 3],
+    pub(super) shifts: [u8; 3],
+    pub(super) steps: usize,
 }
 
 /// The neighbour lists of [`Lanes`], for [`split_edges`], checked as the [`Run`] that makes

@@ -24,6 +24,9 @@ pub enum Question {
     Split,
     /// Which half does it take: 1 = upper.
     Half,
+    /// Which half does the cluster's representative take at a step ahead of the cluster's
+    /// splits: the half the cluster's vertices take if they keep to one, else the predicted one.
+    Ahead,
     /// Do the two halves share an edge?
     Connecting,
     /// Is the edge to the i-th neighbour duplicated?
@@ -40,6 +43,7 @@ impl Question {
         match self {
             Question::Split => "split",
             Question::Half => "half",
+            Question::Ahead => "ahead",
             Question::Connecting => "connecting",
             Question::Duplicate(_) => "edge_duplicate",
             Question::Moves(_) => "edge_moves",
@@ -51,7 +55,7 @@ impl Question {
     pub fn class(self) -> crate::coding::SyntaxClass {
         use crate::coding::SyntaxClass::{Connectivity, Geometry};
         match self {
-            Question::Split | Question::Half | Question::Leaf(_) => Geometry,
+            Question::Split | Question::Half | Question::Ahead | Question::Leaf(_) => Geometry,
             Question::Connecting | Question::Duplicate(_) | Question::Moves(_) => Connectivity,
         }
     }
@@ -89,6 +93,7 @@ pub trait Side: Send {
         flips: [bool; 3],
         v: usize,
         first: usize,
+        ahead: bool,
     ) -> Result<[bool; 3], Stop>;
 
     /// Called when `v`, whose neighbours are `neighbours`, is about to split at `step` into
@@ -173,6 +178,12 @@ pub struct Walker {
     marks: Vec<AtomicU64>,
     /// Serial of the last split (the serials of a sliced pass's slabs interleave).
     split_serial: u64,
+    /// Per vertex, for the steps its cell took ahead of its splits: bit j is set if the step
+    /// `depth - 1 - j` took the predicted half (a split may wait there).
+    agree: Vec<u32>,
+    /// Levels each level's lookahead pass takes every vertex's cell ahead of the octree
+    /// (0: none).
+    pub ahead_levels: usize,
 }
 
 /// What a pass does to the vertices it visits.
@@ -182,6 +193,8 @@ enum Work {
     Split(usize),
     /// The leaves' three bits of the level whose first step is this.
     Leaves(usize),
+    /// Every vertex's cell taken ahead to this many steps, in `level`.
+    Ahead { target: usize, level: usize },
 }
 
 /// How a sliced pass divides its visits: those of each slab whose neighbours all lie in the
@@ -229,6 +242,8 @@ impl Walker {
             resting: Vec::new(),
             marks: vec![AtomicU64::new(0)],
             split_serial: 0,
+            agree: vec![0],
+            ahead_levels: 0,
         };
         walker.centres.push(cell_centre([0; 3], walker.shifts[0]));
         walker
@@ -311,6 +326,17 @@ impl Walker {
             );
             self.resting = resting;
             done?;
+            let target = (level + self.ahead_levels).min(self.state.order.levels as usize) * 3;
+            if target > first + 3 {
+                let all: Vec<u32> = (0..self.state.len() as u32).collect();
+                self.pass(
+                    side,
+                    &all,
+                    Work::Ahead { target, level },
+                    max_vertices,
+                    max_triangles,
+                )?;
+            }
         }
         Ok(())
     }
@@ -335,6 +361,7 @@ impl Walker {
         let (step, level) = match work {
             Work::Split(step) => (Some(step), self.state.order.level(step)),
             Work::Leaves(first) => (None, self.state.order.level(first)),
+            Work::Ahead { level, .. } => (None, level),
         };
         let plan = self.slab_plan(visits, level);
         let counts = side.begin_sliced_pass(&plan.interior, step)?;
@@ -428,6 +455,7 @@ impl Walker {
         self.leaf.resize(n, false);
         self.centres.resize(n, [0; 3]);
         self.marks.resize_with(n, AtomicU64::default);
+        self.agree.resize(n, 0);
     }
 
     /// Drops the entries from `n` on (room [`Self::grow`] made that no split took).
@@ -439,6 +467,7 @@ impl Walker {
         self.leaf.truncate(n);
         self.centres.truncate(n);
         self.marks.truncate(n);
+        self.agree.truncate(n);
     }
 
     /// The arrays a pass reads and writes, for [`Run`]s. Nothing else may touch them while
@@ -452,6 +481,7 @@ impl Walker {
             leaf: self.leaf.as_mut_ptr(),
             centres: self.centres.as_mut_ptr(),
             marks: self.marks.as_ptr(),
+            agree: self.agree.as_mut_ptr(),
             len: self.state.len(),
         }
     }
@@ -471,7 +501,7 @@ impl Walker {
             Work::Split(_) => visits
                 .len()
                 .min(max_vertices.saturating_sub(start as u64) as usize),
-            Work::Leaves(_) => 0,
+            Work::Leaves(_) | Work::Ahead { .. } => 0,
         };
         self.grow(room);
         let lanes = self.lanes();
