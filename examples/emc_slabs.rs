@@ -1,7 +1,7 @@
 //! What `emc`'s slabs cost and buy on a mesh: its stream without slabs and with 2, 4, 8 and 16
 //! (passes of 2^13 visits or more sliced, as `emc` writes large meshes), each stream's bytes and
 //! its decode time on one thread and on all (best of N), as one JSON line per slab count.
-//! Run: cargo run --release --example emc_slabs -- MESH [N]
+//! Run: cargo run --release --example emc_slabs -- MESH [N] (a path, or a name under ../shared/meshes)
 //! With `--write OUT.mc SLABS LOG2` it writes one stream sliced into SLABS slabs for passes of
 //! 2^LOG2 visits or more instead (the fuzz seeds' sliced streams, from small meshes), with
 //! `AHEAD` an `emc-ahead` stream taking cells that many levels ahead.
@@ -15,9 +15,11 @@ type Failure = Box<dyn std::error::Error>;
 fn main() -> Result<(), Failure> {
     let args: Vec<String> = std::env::args().collect();
     let Some(path) = args.get(1) else {
-        return Err("usage: emc_slabs MESH [N] | emc_slabs MESH --write OUT.mc SLABS LOG2 [AHEAD]".into());
+        return Err(
+            "usage: emc_slabs MESH [N] | emc_slabs MESH --write OUT.mc SLABS LOG2 [AHEAD]".into(),
+        );
     };
-    let mesh = meshcodec::mesh::io::read_mesh(std::path::Path::new(path))?;
+    let mesh = meshcodec::mesh::io::read_mesh(&meshcodec::mesh::io::resolve(path)?)?;
     let options = EncodeOptions {
         quant_bits: 12,
         ..codecs::by_name("emc")?.default_options()

@@ -234,8 +234,8 @@ def encode(
     Args:
         vertices: (n, 3) positions, any float or integer dtype.
         faces: (m, 3) vertex indices, any integer dtype, counter-clockwise.
-        codec: a name from :func:`codecs` ("emc", "emc-paper", "pm", "pm-reordered", "came",
-            "came-paper", "raw").
+        codec: a name from :func:`codecs` ("emc", "emc-ahead", "emc-paper", "pm", "pm-reordered",
+            "came", "came-paper", "raw").
         quant_bits: bits per axis of the quantization grid (1 to 24 as the codec allows).
         grid: "cubic" (one cell size on every axis, the default) or "per-axis".
         appearance: an :class:`Appearance` over these faces (e.g. ``load(path).appearance``),

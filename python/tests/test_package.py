@@ -52,7 +52,7 @@ def assert_lossless(original, stream, quant_bits=12):
 
 def test_every_codec_is_listed_with_its_defaults():
     names = {c["name"] for c in meshcodec.codecs()}
-    assert {"raw", "emc", "emc-paper", "pm", "pm-reordered", "came", "came-paper"} <= names
+    assert {"raw", "emc", "emc-ahead", "emc-paper", "pm", "pm-reordered", "came", "came-paper"} <= names
     for c in meshcodec.codecs():
         assert c["quant_bits"] >= 1 and c["summary"]
 

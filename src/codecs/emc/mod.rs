@@ -161,37 +161,36 @@ impl EmcParams {
         let header = stream.header();
         let bad = |what: &str| Error::malformed(0, 7, what);
         let p = &header.params;
-        let (axes, faces_when_settled, slabs, sliced_visits_log2, ahead_levels) = match (syntax, &p[..]) {
-            (Syntax::Paper, &[a, b, c]) => ([a, b, c], 0, 1, SLICED_VISITS_LOG2, 0),
-            (Syntax::Modelled, &[a, b, c, settled, 1]) => {
-                ([a, b, c], settled, 1, SLICED_VISITS_LOG2, 0)
-            }
-            (Syntax::Modelled, &[a, b, c, settled, slabs, log2]) => {
-                if !(2..=MAX_SLABS).contains(&slabs) || log2 >= 32 {
-                    return Err(bad(
-                        "emc slabs out of range (2 to 64 slabs, passes of under 2^32 visits)",
-                    ));
+        let (axes, faces_when_settled, slabs, sliced_visits_log2, ahead_levels) =
+            match (syntax, &p[..]) {
+                (Syntax::Paper, &[a, b, c]) => ([a, b, c], 0, 1, SLICED_VISITS_LOG2, 0),
+                (Syntax::Modelled, &[a, b, c, settled, 1]) => {
+                    ([a, b, c], settled, 1, SLICED_VISITS_LOG2, 0)
                 }
-                ([a, b, c], settled, slabs, log2, 0)
-            }
-            (Syntax::Modelled, &[a, b, c, settled, slabs, log2, ahead]) => {
-                if !(1..=MAX_SLABS).contains(&slabs) || log2 >= 32 {
-                    return Err(bad(
-                        "emc slabs out of range (1 to 64 slabs, passes of under 2^32 visits)",
-                    ));
+                (Syntax::Modelled, &[a, b, c, settled, slabs, log2]) => {
+                    if !(2..=MAX_SLABS).contains(&slabs) || log2 >= 32 {
+                        return Err(bad(
+                            "emc slabs out of range (2 to 64 slabs, passes of under 2^32 visits)",
+                        ));
+                    }
+                    ([a, b, c], settled, slabs, log2, 0)
                 }
-                if !(1..=MAX_AHEAD_LEVELS).contains(&ahead) {
-                    return Err(bad("emc lookahead out of range (1 to 8 levels)"));
+                (Syntax::Modelled, &[a, b, c, settled, slabs, log2, ahead]) => {
+                    if !(1..=MAX_SLABS).contains(&slabs) || log2 >= 32 {
+                        return Err(bad(
+                            "emc slabs out of range (1 to 64 slabs, passes of under 2^32 visits)",
+                        ));
+                    }
+                    if !(1..=MAX_AHEAD_LEVELS).contains(&ahead) {
+                        return Err(bad("emc lookahead out of range (1 to 8 levels)"));
+                    }
+                    ([a, b, c], settled, slabs, log2, ahead)
                 }
-                ([a, b, c], settled, slabs, log2, ahead)
-            }
-            (Syntax::Paper, _) => return Err(bad("emc-paper parameters: 3 bytes expected")),
-            (Syntax::Modelled, _) => {
-                return Err(bad(
+                (Syntax::Paper, _) => return Err(bad("emc-paper parameters: 3 bytes expected")),
+                (Syntax::Modelled, _) => return Err(bad(
                     "emc parameters: 5 bytes expected, 6 with slabs (2 to 64), 7 with a lookahead",
-                ))
-            }
-        };
+                )),
+            };
         let faces_when_settled = match faces_when_settled {
             0 => false,
             1 => true,

@@ -20,12 +20,14 @@ fn the_ownership_check_is_on_in_the_crates_tests() {
         leaf: std::ptr::null_mut(),
         centres: std::ptr::null_mut(),
         marks: std::ptr::null(),
+        agree: std::ptr::null_mut(),
         len: 1,
     };
     check(&lanes, 0, || false);
 }
 
-/// `emc` streams of small meshes, every pass of 4 visits or more sliced into `slabs` slabs.
+/// `emc` and `emc-ahead` streams of small meshes, every pass of 4 visits or more sliced into
+/// `slabs` slabs.
 fn slab_streams() -> Vec<Vec<u8>> {
     let options = EncodeOptions {
         quant_bits: 12,
@@ -36,8 +38,13 @@ fn slab_streams() -> Vec<Vec<u8>> {
     for mesh in &meshes {
         let canonical = codecs::canonical_for(mesh, &options).unwrap();
         for slabs in [2, 3, 4] {
-            let encoded = codecs::emc::modelled::encode_sliced(&canonical, slabs, 2).unwrap();
-            streams.push(encoded.bytes);
+            // `emc`'s and `emc-ahead`'s, whose lookahead passes are sliced too.
+            for ahead in [0, 2] {
+                let encoded =
+                    codecs::emc::modelled::encode_sliced_ahead(&canonical, ahead, slabs, 2)
+                        .unwrap();
+                streams.push(encoded.bytes);
+            }
         }
     }
     streams
@@ -54,7 +61,7 @@ fn sliced_levels(bytes: &[u8]) -> Vec<(usize, usize)> {
             let at = start + unit.offset as usize;
             (at, at + unit.length as usize)
         })
-        .filter(|&(at, _)| bytes[at] > 0)
+        .filter(|&(at, end)| end > at && bytes[at] > 0)
         .collect()
 }
 
