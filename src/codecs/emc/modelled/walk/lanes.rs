@@ -438,7 +438,18 @@ impl Run<'_> {
         axis: usize,
         m: &Moments,
     ) -> (contexts::HalfContext, bool) {
-        let shifts = self.shifts[self.depth(v)];
+        self.predict_in(v, axis, m, self.shifts[self.depth(v)])
+    }
+
+    /// [`Self::predict`] in a cell of half-width shifts `shifts` (`m` relative to its centre).
+    #[inline]
+    fn predict_in(
+        &self,
+        v: usize,
+        axis: usize,
+        m: &Moments,
+        shifts: [u8; 3],
+    ) -> (contexts::HalfContext, bool) {
         let (prediction, variance) = estimate(m, axis, shifts);
         let scale = per_half_width(shifts[axis]);
         (
@@ -463,19 +474,7 @@ impl Run<'_> {
     ) -> (contexts::HalfContext, bool) {
         match neighbour_moments(centre, self.adjacency(v), |n| self.centre(n)) {
             None => (contexts::half_isolated(self.leaf(v)), false),
-            Some(m) => {
-                let (prediction, variance) = estimate(&m, axis, shifts);
-                let scale = per_half_width(shifts[axis]);
-                (
-                    contexts::half(
-                        self.leaf(v),
-                        m.k,
-                        prediction.abs() * scale,
-                        variance * scale * scale,
-                    ),
-                    prediction < 0.0,
-                )
-            }
+            Some(m) => self.predict_in(v, axis, &m, shifts),
         }
     }
 
