@@ -15,15 +15,16 @@ use meshcodec::mesh::{generate, io, TriMesh};
 use std::sync::OnceLock;
 
 /// The codecs, in the order of their `decode_*` targets.
+/// (`emc-ahead`, added last, keeps the indices `decode_mutated`'s saved inputs pick streams by.)
 pub const CODECS: [&str; 8] = [
     "raw",
     "emc",
-    "emc-ahead",
     "emc-paper",
     "pm",
     "pm-reordered",
     "came",
     "came-paper",
+    "emc-ahead",
 ];
 
 /// Decodes `body` as everything after the first seven bytes (magic, version, codec id, syntax)
