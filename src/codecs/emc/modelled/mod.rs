@@ -55,8 +55,11 @@
 //!
 //! On bunny.ply at 12 bits, a lookahead of 1, 2 and 3 levels costs the lossless stream 2.7%,
 //! 7.3% and 11.5%, and the worst level's RMS over `pm`'s at the same bits (levels 4–9) falls from
-//! `emc`'s 2.52 to 1.87, 1.64 and 1.69 (BENCHMARKS.md, "`emc-ahead`"). `emc` stays the smaller
-//! lossless stream; `emc-ahead` is for streams read in part.
+//! `emc`'s 2.52 to 1.87, 1.64 and 1.69 (BENCHMARKS.md, "`emc-ahead`"). The largest error of a
+//! level does not fall: it comes from the level's faces cutting across the surface, which more
+//! precise corners do not change, so at the same bits `emc-ahead`'s Hausdorff error is above
+//! `emc`'s. `emc` stays the smaller lossless stream and the better largest error; `emc-ahead`
+//! is for streams read in part whose average error matters.
 //!
 //! # Slabs: the passes of large meshes on several cores
 //! Every question's context reads the vertex's neighbours as the passes left them, so a pass is
