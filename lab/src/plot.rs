@@ -77,6 +77,22 @@ pub fn rate_distortion(runs: &[RunResult], title: &str) -> Chart {
     }
 }
 
+/// Rate-distortion chart of the RMS error: cumulative bits per vertex vs RMS error, log-log.
+pub fn rate_rms(runs: &[RunResult], title: &str) -> Chart {
+    Chart {
+        title: title.into(),
+        x_desc: "cumulative bits per vertex (log)".into(),
+        y_desc: "RMS error / bounding-box diagonal (log)".into(),
+        x_log: true,
+        y_log: true,
+        // The curves fall from the upper left to the lower right.
+        legend: SeriesLabelPosition::LowerLeft,
+        series: series(runs, |l| {
+            Some((l.bits_per_vertex, l.rms?)).filter(|&(b, r)| b > 0.0 && r > 0.0)
+        }),
+    }
+}
+
 /// One series per run, of the points `point` gives for its levels; a single-level run (a
 /// single-rate codec) is drawn as a point, not a line.
 fn series(runs: &[RunResult], point: impl Fn(&LevelRow) -> Option<(f64, f64)>) -> Vec<Series> {

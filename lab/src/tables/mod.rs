@@ -22,7 +22,7 @@ use crate::came;
 pub use crate::emc::tables::{emc_fig4, emc_fig5, emc_table1, EMC_TABLE1_COMMAND};
 pub use crate::pm::tables::{hoppe_tables, HOPPE_COMMAND};
 pub(crate) use anchors::ANCHORS_COMMAND;
-pub use anchors::{emc_rate_distortion, emc_vs_anchors};
+pub use anchors::{emc_rate_distortion, emc_rms_rate_distortion, emc_vs_anchors};
 pub use attributes::{ATTRIBUTES_COMMAND, ATTRIBUTE_MESHES};
 
 /// A statistic a table reads; one the result lacks is an error naming the file's codec and mesh.
@@ -188,6 +188,10 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
     match emc_rate_distortion(results, out) {
         Ok(p) => written.extend(p),
         Err(e) => missing.push(format!("emc-rate-distortion: {e}")),
+    }
+    match emc_rms_rate_distortion(results, out) {
+        Ok(p) => written.extend(p),
+        Err(e) => missing.push(format!("emc-rms-rate-distortion: {e}")),
     }
     match came::tables::tables(results, out) {
         Ok(p) => written.push(p),
