@@ -112,7 +112,7 @@ pub fn emc_vs_anchors(results: &Path, out: &Path) -> Result<PathBuf> {
     }
     intermediate_levels(results, &mut md)?;
     let _ = writeln!(md, "Connectivity and geometry of our arithmetic-coded streams are split in proportion to the coder's own estimate of each class's bits; `emc` books the split and leaf questions (which cells are occupied) as geometry, the edge questions and the face corrections as connectivity, as the paper books split distances and edge codes.\n");
-    let _ = writeln!(md, "RMS error against bits a vertex on the three meshes (every level of `emc`, `emc-ahead`, `pm` and `pm-reordered` at 12 bits, Draco at quantization 8 to 16, the valence coder on bunny): [emc-rms-rate-distortion.png](emc-rms-rate-distortion.png). Hausdorff error on bunny.ply: [emc-rate-distortion.png](emc-rate-distortion.png). The valence-driven coder's curve is MEPP2's Compression_Valence (commit d977d05, adaptive quantization on, 12 bits, base mesh of at most 100 vertices) measured on this bunny outside the project, read from `../shared/anchors/{VALENCE_ANCHOR}` (its provenance and how each level's bits and errors were measured are in that file).");
+    let _ = writeln!(md, "RMS error against bits a vertex on the three meshes (every level of `emc`, `emc-ahead`, `pm` and `pm-reordered` at 12 bits, Draco at quantization 8 to 16, the valence coder on bunny): [emc-rms-rate-distortion.png](emc-rms-rate-distortion.png). Hausdorff error on bunny.ply: [emc-rate-distortion.png](emc-rate-distortion.png). What a client sees: bunny.ply's `emc` and `emc-ahead` levels nearest 2 and 5 bits a vertex beside `pm` cut at the same bytes, with their RMS errors: [emc-levels-beside-pm.png](emc-levels-beside-pm.png). The valence-driven coder's curve is MEPP2's Compression_Valence (commit d977d05, adaptive quantization on, 12 bits, base mesh of at most 100 vertices) measured on this bunny outside the project, read from `../shared/anchors/{VALENCE_ANCHOR}` (its provenance and how each level's bits and errors were measured are in that file).");
     std::fs::create_dir_all(out)?;
     let path = out.join("emc-vs-anchors.md");
     std::fs::write(&path, md)?;
@@ -282,7 +282,12 @@ pub fn emc_rms_rate_distortion(results: &Path, out: &Path) -> Result<Vec<PathBuf
         let mut chart = plot::rate_rms(&runs, &format!("{mesh}, 12 bits: RMS error"));
         let draco: Vec<(f64, f64)> = (8..=16)
             .filter_map(|q| load_at(results, "draco", mesh, q).ok())
-            .filter_map(|r| Some((r.bytes as f64 * 8.0 / r.vertices as f64, r.levels.last()?.rms?)))
+            .filter_map(|r| {
+                Some((
+                    r.bytes as f64 * 8.0 / r.vertices as f64,
+                    r.levels.last()?.rms?,
+                ))
+            })
             .collect();
         if !draco.is_empty() {
             chart.series.push(plot::Series {

@@ -17,6 +17,7 @@ use std::path::{Path, PathBuf};
 
 mod anchors;
 mod attributes;
+mod emc_renders;
 
 use crate::came;
 pub use crate::emc::tables::{emc_fig4, emc_fig5, emc_table1, EMC_TABLE1_COMMAND};
@@ -24,6 +25,7 @@ pub use crate::pm::tables::{hoppe_tables, HOPPE_COMMAND};
 pub(crate) use anchors::ANCHORS_COMMAND;
 pub use anchors::{emc_rate_distortion, emc_rms_rate_distortion, emc_vs_anchors};
 pub use attributes::{ATTRIBUTES_COMMAND, ATTRIBUTE_MESHES};
+pub use emc_renders::emc_levels_beside_pm;
 
 /// A statistic a table reads; one the result lacks is an error naming the file's codec and mesh.
 pub(crate) fn stat(result: &RunResult, stat: Stat) -> Result<f64> {
@@ -192,6 +194,10 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
     match emc_rms_rate_distortion(results, out) {
         Ok(p) => written.extend(p),
         Err(e) => missing.push(format!("emc-rms-rate-distortion: {e}")),
+    }
+    match emc_levels_beside_pm(results, out) {
+        Ok(p) => written.push(p),
+        Err(e) => missing.push(format!("emc-levels-beside-pm: {e}")),
     }
     match came::tables::tables(results, out) {
         Ok(p) => written.push(p),
