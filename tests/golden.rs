@@ -339,6 +339,41 @@ fn came_streams_of_eight_level_meta_nodes_still_decode_and_refine() {
     settle_far_from_eight(&[&old, &new]);
 }
 
+/// `came` streams of syntax 6, whose hierarchy was built balanced as the paper's (b = 1), still
+/// decode exactly and refine: `came-eight-before-quadric-order.mc` is the golden stream of that
+/// build, kept. Today's is built by quadric error alone (docs/FORMAT.md §8, History), so its
+/// tree is deeper and a far view's front, a simplified mesh, holds fewer faces.
+#[test]
+fn came_streams_of_balanced_hierarchies_still_decode_and_refine() {
+    use meshcodec::codecs::came::decode_tree;
+    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
+    let (old, new) = kept_came_stream_and_todays("came-eight-before-quadric-order.mc");
+    assert_eq!(header_of(&old).syntax, 6);
+    assert!(header_of(&new).syntax >= 7);
+    let depth = |bytes: &[u8]| {
+        let (_, tree) = decode_tree(bytes).unwrap();
+        tree.nodes.iter().map(|n| n.id.len()).max().unwrap()
+    };
+    assert!(
+        depth(&new) > depth(&old),
+        "{} against {}",
+        depth(&new),
+        depth(&old)
+    );
+    let far_faces = |bytes: &[u8]| {
+        let mut front = ViewMesh::from_stream(bytes).unwrap();
+        front.settle(
+            &View::new(&far_camera_on_eight(), 0.25).unwrap(),
+            Budget::UNLIMITED,
+            64,
+        );
+        front.face_count()
+    };
+    let (old_faces, new_faces) = (far_faces(&old), far_faces(&new));
+    assert!(new_faces < old_faces, "{new_faces} against {old_faces}");
+    settle_far_from_eight(&[&old, &new]);
+}
+
 /// `came` streams of syntax 5, whose deviation codes step by 2^(−1/2) below the parent's,
 /// still decode exactly and refine: `came-eight-before-anchored-deviations.mc` is the golden
 /// stream of that build, kept. Today's codes the nodes above depth 11 in quarter steps on a

@@ -333,6 +333,8 @@ pub struct Layout {
     pub naming: crate::codecs::names::Naming,
     /// Whether the syntax's parameters give the bits of cones and deviations (`came`).
     pub per_node_bounds: bool,
+    /// How the hierarchy is built.
+    pub build: BuildOptions,
     /// How the hierarchy is cut into units.
     pub shape: partition::Shape,
     /// Bits per PCA component (0: none).
@@ -357,7 +359,7 @@ pub fn encode_stream(
     code_units: impl FnOnce(&VertexTree, &Partition) -> (Vec<CodedUnit>, u8),
 ) -> Result<crate::codecs::Encoded> {
     let started = std::time::Instant::now();
-    let tree = hierarchy(mesh)?;
+    let tree = hierarchy(mesh, &layout.build)?;
     let seconds = started.elapsed().as_secs_f64();
     let part = partition::partition(&tree, layout.shape);
     let (meta_levels, region_levels) = match layout.shape {
@@ -423,14 +425,14 @@ fn header(layout: Layout, mesh: &CanonicalMesh, params: Params) -> Header {
     }
 }
 
-/// The hierarchy CAME codes, or a refusal for meshes it cannot take.
-pub fn hierarchy(mesh: &CanonicalMesh) -> Result<VertexTree> {
+/// The hierarchy CAME codes, built with `options`, or a refusal for meshes it cannot take.
+pub fn hierarchy(mesh: &CanonicalMesh, options: &BuildOptions) -> Result<VertexTree> {
     if mesh.vertex_count() < 3 || mesh.faces.is_empty() {
         return Err(Error::Unsupported(
             "CAME codes meshes of at least one triangle".into(),
         ));
     }
-    build(&mesh.cells, &mesh.faces, &BuildOptions::default())
+    build(&mesh.cells, &mesh.faces, options)
 }
 
 /// Records what every CAME encoder reports.

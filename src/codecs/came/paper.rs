@@ -27,7 +27,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::CodedCone;
 use crate::hierarchy::came::deviation::round_up;
 use crate::hierarchy::came::spheres::{decoded_radius, exact_radii, ratio_base, ratio_code};
-use crate::hierarchy::came::{NodeId, VertexTree, MAX_DEPTH};
+use crate::hierarchy::came::{BuildOptions, NodeId, VertexTree, MAX_DEPTH};
 use crate::mesh::CanonicalMesh;
 use glam::DVec3;
 use std::cell::OnceCell;
@@ -196,6 +196,7 @@ impl Codec for CamePaper {
         let layout = Layout {
             naming: self.descriptor().naming,
             per_node_bounds: false,
+            build: BuildOptions::PAPER,
             shape: Shape::Levels {
                 levels: META_LEVELS,
                 tails: Tails::Split,

@@ -194,6 +194,7 @@ pub fn partition(tree: &VertexTree, shape: Shape) -> Partition {
 mod tests {
     use super::*;
     use crate::codecs::{came, canonical_for, Codec};
+    use crate::hierarchy::came::BuildOptions;
     use crate::mesh::generate;
 
     #[test]
@@ -201,7 +202,7 @@ mod tests {
         let mesh = generate::icosphere(5);
         let codec = came::modelled::Came;
         let canonical = canonical_for(&mesh, &codec.default_options()).unwrap();
-        let tree = came::hierarchy(&canonical).unwrap();
+        let tree = came::hierarchy(&canonical, &BuildOptions::default()).unwrap();
         let shape = came::modelled::SHAPE;
         let part = partition(&tree, shape);
         let depth = |v: u32| tree.ids[v as usize].len();

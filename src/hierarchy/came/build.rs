@@ -1,6 +1,7 @@
 //! The hierarchy by pair contraction (Garland & Heckbert 1997): valid pairs are the mesh's edges
-//! and vertex pairs closer than a threshold, contracted cheapest first by the balanced cost
-//! E(i) = 2^(b·d(i)) · E_q(i) until one node is left. When the pairs run out with several nodes
+//! and vertex pairs closer than a threshold, contracted cheapest first by the cost
+//! E(i) = 2^(b·d(i)) · E_q(i) until one node is left (b = 1 balances the tree as the paper
+//! does; b = 0 contracts by quadric error alone, [`BuildOptions::QUADRIC_ORDER`]). When the pairs run out with several nodes
 //! left (components farther apart than the threshold), each remaining node is paired with its
 //! nearest remaining neighbour and contraction goes on; every such round at least halves the
 //! nodes left.
@@ -29,12 +30,28 @@ pub struct BuildOptions {
     pub pair_distance: f64,
 }
 
+impl BuildOptions {
+    /// The paper's (its Table 3: b = 1), which `came-paper` builds: a shallow tree, its coarse
+    /// levels made of pairs of about one size whatever the surface's curvature.
+    pub const PAPER: BuildOptions = BuildOptions {
+        balance: 1.0,
+        pair_distance: 0.5,
+    };
+
+    /// By quadric error alone (b = 0), which `came` builds from syntax 7: the pairs contract in a
+    /// simplifier's order, so the front a far view keeps is a simplified mesh, flat regions
+    /// merged and curved ones kept, and holds fewer faces for the same error (dragon-50k from
+    /// 20 diagonals: 972 → 700 faces, from 11.8% → 7.3% of its stream; BENCHMARKS.md, "`came`
+    /// syntax 7"). The tree is 2–10 levels deeper and the streams within ±2.5% of the paper's.
+    pub const QUADRIC_ORDER: BuildOptions = BuildOptions {
+        balance: 0.0,
+        ..BuildOptions::PAPER
+    };
+}
+
 impl Default for BuildOptions {
     fn default() -> Self {
-        BuildOptions {
-            balance: 1.0,
-            pair_distance: 0.5,
-        }
+        BuildOptions::PAPER
     }
 }
 
@@ -686,6 +703,22 @@ mod tests {
         assert!((10..=16).contains(&tree.depth()), "depth {}", tree.depth());
         let per_node = tree.dependencies_per_node();
         assert!((0.5..=4.0).contains(&per_node), "{per_node}");
+    }
+
+    #[test]
+    fn by_quadric_error_alone_the_tree_is_whole_and_deeper_than_balanced() {
+        // A terrain: flat stretches merge early under QEM alone, and the balance no longer
+        // holds the tree near log2 of its vertices.
+        let c = canonical(&generate::terrain(2_000, 7));
+        let balanced = build(&c.cells, &c.faces, &BuildOptions::PAPER).unwrap();
+        let by_error = build(&c.cells, &c.faces, &BuildOptions::QUADRIC_ORDER).unwrap();
+        check_tree(&by_error, &c.faces);
+        assert!(
+            by_error.depth() > balanced.depth(),
+            "{} against {}",
+            by_error.depth(),
+            balanced.depth()
+        );
     }
 
     #[test]

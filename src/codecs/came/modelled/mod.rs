@@ -9,6 +9,11 @@
 //! corner" where both children's positions are known. Every unit's contexts start from priors
 //! the first unit codes, learnt by the encoder over the whole stream (syntax 2, `priors`);
 //! in syntax 1 they started afresh, and such streams still decode.
+//!
+//! The hierarchy is built by quadric error alone (syntax 7, `BuildOptions::QUADRIC_ORDER`), not
+//! balanced as the paper's (b = 1, which `came-paper` keeps): a far view's front is then a
+//! simplified mesh rather than a tree level. Syntax 7 is read as syntax 6; its streams differ in
+//! the tree they hold.
 
 mod contexts;
 mod decoder;
@@ -32,7 +37,7 @@ use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::{self};
 use crate::hierarchy::came::deviation::DEVIATION_BITS;
 use crate::hierarchy::came::face_normals;
-use crate::hierarchy::came::NodeId;
+use crate::hierarchy::came::{BuildOptions, NodeId};
 use crate::mesh::CanonicalMesh;
 
 /// The `came` codec.
@@ -96,6 +101,7 @@ pub fn encode_with_unit_fields(mesh: &CanonicalMesh) -> Result<(Encoded, UnitFie
     let layout = Layout {
         naming: DESCRIPTOR.naming,
         per_node_bounds: true,
+        build: BuildOptions::QUADRIC_ORDER,
         shape: SHAPE,
         component_bits: 0,
         radius_bits: RADIUS_BITS,
