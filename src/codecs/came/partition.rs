@@ -202,7 +202,7 @@ mod tests {
         let mesh = generate::icosphere(5);
         let codec = came::modelled::Came;
         let canonical = canonical_for(&mesh, &codec.default_options()).unwrap();
-        let tree = came::hierarchy(&canonical, &BuildOptions::default()).unwrap();
+        let tree = came::hierarchy(&canonical, &BuildOptions::QUADRIC_ORDER).unwrap();
         let shape = came::modelled::SHAPE;
         let part = partition(&tree, shape);
         let depth = |v: u32| tree.ids[v as usize].len();

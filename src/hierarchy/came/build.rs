@@ -1,10 +1,10 @@
 //! The hierarchy by pair contraction (Garland & Heckbert 1997): valid pairs are the mesh's edges
 //! and vertex pairs closer than a threshold, contracted cheapest first by the cost
 //! E(i) = 2^(b·d(i)) · E_q(i) until one node is left (b = 1 balances the tree as the paper
-//! does; b = 0 contracts by quadric error alone, [`BuildOptions::QUADRIC_ORDER`]). When the pairs run out with several nodes
-//! left (components farther apart than the threshold), each remaining node is paired with its
-//! nearest remaining neighbour and contraction goes on; every such round at least halves the
-//! nodes left.
+//! does; b = 0 contracts by quadric error alone, [`BuildOptions::QUADRIC_ORDER`]). When the
+//! pairs run out with several nodes left (components farther apart than the threshold), each
+//! remaining node is paired with its nearest remaining neighbour and contraction goes on; every
+//! such round at least halves the nodes left.
 //!
 //! Faces carry their current corners; a face whose corners meet in a contraction vanishes there,
 //! and the split that undoes that contraction creates it. Faces never need neighbours, so
