@@ -128,3 +128,46 @@ fn prefixes_decode_the_levels_they_hold_and_the_whole_stream_is_exact() {
     canonical.check_lossless(&whole.mesh).unwrap();
     crate::codecs::came::tests::check_prefixes(&canonical, &bytes);
 }
+
+/// A unit decoded before the units that split its region's nodes above its band (what a lying
+/// index would ask for) is refused in one line before it changes the tree: here a unit rooted
+/// two bands below the first unit, its parent unit skipped.
+#[test]
+fn a_unit_whose_region_holds_a_node_no_unit_above_it_split_is_refused() {
+    use super::super::decoded::{DecodedTree, UnitDecoder};
+    let (_, bytes) = stream(&generate::icosphere(5));
+    let reader = StreamReader::open(&bytes).unwrap();
+    let header = reader.header().clone();
+    let params = params(&header).unwrap();
+    let first = reader.unit(0).unwrap();
+    let units = ModelledUnits::default();
+    let mut tree = DecodedTree::new(header.vertices, header.triangles, bytes.len());
+    let opened = units
+        .decode_unit(&mut tree, &header, &params, 0, first.bytes, first.start)
+        .unwrap();
+    assert!(!opened.is_empty());
+    // The first unit's children are rooted a band down; their own children a band further,
+    // and it is those whose regions reach below what the first unit split.
+    let Shape::Bands { band, .. } = SHAPE else {
+        panic!("came cuts by bands")
+    };
+    let grandchild = (0..tree.nodes.len() as u32)
+        .find(|&v| {
+            let node = &tree.nodes[v as usize];
+            node.id.len() == 2 * band && !node.leaf
+        })
+        .expect("an inner node two bands down");
+    let nodes = tree.nodes.len();
+    let unit = reader.unit(1).unwrap();
+    let refused = units
+        .decode_unit(
+            &mut tree, &header, &params, grandchild, unit.bytes, unit.start,
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(
+        refused.contains("a unit's region holds a node no unit above it split"),
+        "{refused}"
+    );
+    assert_eq!(tree.nodes.len(), nodes);
+}
