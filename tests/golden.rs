@@ -213,17 +213,20 @@ fn far_camera_on_eight() -> meshcodec::codecs::came::refine::Camera {
 }
 
 /// Each stream's front settles on [`far_camera_on_eight`] at a quarter pixel, sure of every
-/// face, its invariants holding.
-fn settle_far_from_eight(streams: &[&[u8]]) {
+/// face, its invariants holding; returns each front's faces.
+fn settle_far_from_eight(streams: &[&[u8]]) -> Vec<usize> {
     use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
     let view = View::new(&far_camera_on_eight(), 0.25).unwrap();
+    let mut faces = Vec::new();
     for bytes in streams {
         let mut front = ViewMesh::from_stream(bytes).unwrap();
         let adapted = front.settle(&view, Budget::UNLIMITED, 64);
         assert!(adapted.settled && adapted.unsure == 0, "{adapted:?}");
         front.check_invariants().unwrap();
         assert!(front.face_count() > 0);
+        faces.push(front.face_count());
     }
+    faces
 }
 
 fn header_of(bytes: &[u8]) -> meshcodec::container::Header {
@@ -346,7 +349,6 @@ fn came_streams_of_eight_level_meta_nodes_still_decode_and_refine() {
 #[test]
 fn came_streams_of_balanced_hierarchies_still_decode_and_refine() {
     use meshcodec::codecs::came::decode_tree;
-    use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
     let (old, new) = kept_came_stream_and_todays("came-eight-before-quadric-order.mc");
     assert_eq!(header_of(&old).syntax, 6);
     assert!(header_of(&new).syntax >= 7);
@@ -354,24 +356,12 @@ fn came_streams_of_balanced_hierarchies_still_decode_and_refine() {
         let (_, tree) = decode_tree(bytes).unwrap();
         tree.nodes.iter().map(|n| n.id.len()).max().unwrap()
     };
-    assert!(
-        depth(&new) > depth(&old),
-        "{} against {}",
-        depth(&new),
-        depth(&old)
-    );
-    let far_faces = |bytes: &[u8]| {
-        let mut front = ViewMesh::from_stream(bytes).unwrap();
-        front.settle(
-            &View::new(&far_camera_on_eight(), 0.25).unwrap(),
-            Budget::UNLIMITED,
-            64,
-        );
-        front.face_count()
+    let (old_depth, new_depth) = (depth(&old), depth(&new));
+    assert!(new_depth > old_depth, "{new_depth} against {old_depth}");
+    let [old_faces, new_faces] = settle_far_from_eight(&[&old, &new])[..] else {
+        unreachable!("one count a stream")
     };
-    let (old_faces, new_faces) = (far_faces(&old), far_faces(&new));
     assert!(new_faces < old_faces, "{new_faces} against {old_faces}");
-    settle_far_from_eight(&[&old, &new]);
 }
 
 /// `came` streams of syntax 5, whose deviation codes step by 2^(−1/2) below the parent's,

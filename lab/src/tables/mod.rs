@@ -167,66 +167,44 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
     let mut written = Vec::new();
     let mut missing = Vec::new();
     plot::ensure_font().ok();
-    match emc_table1(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("emc-table1: {e}")),
-    }
-    match emc_fig4(results, out) {
-        Ok(p) => written.extend(p),
-        Err(e) => missing.push(format!("emc-fig4: {e}")),
-    }
-    match emc_fig5(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("emc-fig5: {e}")),
-    }
-    match hoppe_tables(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("hoppe-pm: {e}")),
-    }
-    match emc_vs_anchors(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("emc-vs-anchors: {e}")),
-    }
-    match emc_rate_distortion(results, out) {
-        Ok(p) => written.extend(p),
-        Err(e) => missing.push(format!("emc-rate-distortion: {e}")),
-    }
-    match emc_rms_rate_distortion(results, out) {
-        Ok(p) => written.extend(p),
-        Err(e) => missing.push(format!("emc-rms-rate-distortion: {e}")),
-    }
-    match emc_levels_beside_pm(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("emc-levels-beside-pm: {e}")),
-    }
-    match came::tables::tables(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("came: {e}")),
-    }
-    match came::tables::fig4(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("came-fig4: {e}")),
-    }
-    match came::tables::rate_distortion(results, out) {
-        Ok(p) => written.extend(p),
-        Err(e) => missing.push(format!("came-rate-distortion: {e}")),
-    }
-    match came::vd_table::table(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("came-vd: {e}")),
-    }
-    match attributes::attributes_table(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("attributes: {e}")),
-    }
-    match attributes::attributes_checker(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("attributes-checker: {e}")),
-    }
-    match attributes::attributes_levels(results, out) {
-        Ok(p) => written.push(p),
-        Err(e) => missing.push(format!("attributes-levels: {e}")),
-    }
+    let mut record = |name: &str, made: Result<Vec<PathBuf>>| match made {
+        Ok(paths) => written.extend(paths),
+        Err(e) => missing.push(format!("{name}: {e}")),
+    };
+    let one = |p: PathBuf| vec![p];
+    record("emc-table1", emc_table1(results, out).map(one));
+    record("emc-fig4", emc_fig4(results, out));
+    record("emc-fig5", emc_fig5(results, out).map(one));
+    record("hoppe-pm", hoppe_tables(results, out).map(one));
+    record("emc-vs-anchors", emc_vs_anchors(results, out).map(one));
+    record("emc-rate-distortion", emc_rate_distortion(results, out));
+    record(
+        "emc-rms-rate-distortion",
+        emc_rms_rate_distortion(results, out),
+    );
+    record(
+        "emc-levels-beside-pm",
+        emc_levels_beside_pm(results, out).map(one),
+    );
+    record("came", came::tables::tables(results, out).map(one));
+    record("came-fig4", came::tables::fig4(results, out).map(one));
+    record(
+        "came-rate-distortion",
+        came::tables::rate_distortion(results, out),
+    );
+    record("came-vd", came::vd_table::table(results, out).map(one));
+    record(
+        "attributes",
+        attributes::attributes_table(results, out).map(one),
+    );
+    record(
+        "attributes-checker",
+        attributes::attributes_checker(results, out).map(one),
+    );
+    record(
+        "attributes-levels",
+        attributes::attributes_levels(results, out).map(one),
+    );
     (written, missing)
 }
 
