@@ -1,12 +1,11 @@
 //! The fly-through's path (`meshcodec_lab::came::flythrough::cameras`) over a `came` stream, with one
-//! front alone: adaptation time per frame with the orientation guard and without, meta-node
-//! waits apart — the fly-through experiment interleaves three fronts and the error measurement,
-//! which leaves each front's data out of the cache.
+//! front alone (`meshcodec_lab::came::flythrough::fly_alone`, as the fly-through experiment times
+//! it): adaptation time per frame with the orientation guard and without, meta-node waits apart.
 //! Run: cargo run --release --example came_fly_adapt -- STREAM
 //! (when STREAM does not exist, the fly-through's stream — bunny-closed-35k subdivided twice,
-//! `came` at 12 bits — is encoded and written there first: about two minutes.)
+//! `came` at 12 bits — is encoded and written there first: about three minutes.)
 use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
-use std::time::Instant;
+use meshcodec_lab::came::flythrough::{cameras, encode_stream, fly_alone};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::env::args()
@@ -15,41 +14,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = std::path::Path::new(&path);
     if !path.exists() {
         eprintln!("encoding the fly-through's stream to {}", path.display());
-        std::fs::write(path, meshcodec_lab::came::flythrough::encode_stream()?.1)?;
+        std::fs::write(path, encode_stream()?.1)?;
     }
     let mut full = ViewMesh::open_file(path)?;
     full.settle(&View::everything(), Budget::UNLIMITED, 256);
-    let cameras = meshcodec_lab::came::flythrough::cameras(&full.mesh())?;
+    let cameras = cameras(&full.mesh())?;
     drop(full);
     for guard in [true, false] {
-        let mut front = ViewMesh::open_file(path)?;
-        let mut adapting = Vec::new();
-        let mut waiting = 0.0;
-        for camera in &cameras {
-            let view = View::new(camera, meshcodec_lab::came::flythrough::TOLERANCE_PX)?
-                .keep_orientation(guard);
-            let mut ms = 0.0;
-            for _ in 0..256 {
-                let started = Instant::now();
-                let done = front.adapt(&view, Budget::UNLIMITED);
-                ms += started.elapsed().as_secs_f64() * 1e3;
-                if done.settled {
-                    break;
-                }
-                let started = Instant::now();
-                front.wait_for_units();
-                waiting += started.elapsed().as_secs_f64() * 1e3;
-            }
-            adapting.push(ms);
-        }
-        let mut sorted = adapting.clone();
+        let frames = fly_alone(path, &cameras, guard)?;
+        let mut sorted: Vec<f64> = frames.iter().map(|f| f.adapt_ms).collect();
         sorted.sort_by(f64::total_cmp);
         let at = |q: f64| sorted[((sorted.len() - 1) as f64 * q).round() as usize];
+        let waiting: f64 = frames.iter().map(|f| f.wait_ms).sum();
         println!(
             "guard {guard}: adaptation median {:.1} ms, 95th percentile {:.1} ms, first frame {:.1} ms; {:.0} ms waiting for meta-nodes",
             at(0.5),
             at(0.95),
-            adapting[0],
+            frames[0].adapt_ms,
             waiting
         );
     }

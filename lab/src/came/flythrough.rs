@@ -4,11 +4,15 @@
 //! faces, splits and collapses, adaptation time, bytes fetched so far, the share of the surface
 //! in view, and the measured screen-space error against the tolerance.
 //!
-//! Beside the path's front, a second front follows the same views two-sided (no back-face
-//! culling), for its faces and bytes, and for the measured error of a frame: the two-sided
-//! front against the full mesh on the screen, both ways, over every sample in the frustum
-//! (`crate::came::screen_error`, docs/CONTRACT.md §8). Fold-overs "in view" are those spanning the
-//! tolerance in the frustum, what the orientation guard promises to leave none of.
+//! The path's front (one-sided, with the orientation guard) and the same front without the
+//! guard are each timed along the whole path alone, as a client adapts its one front: nothing
+//! runs between their frames ([`fly_alone`]). Then both fly the path again beside a third
+//! front that follows the same views two-sided (no back-face culling), for what is measured of
+//! each frame: fold-overs, the two-sided front's faces and bytes, and the measured error of a
+//! frame — the two-sided front against the full mesh on the screen, both ways, over every
+//! sample in the frustum (`crate::came::screen_error`, docs/CONTRACT.md §8). Fold-overs "in
+//! view" are those spanning the tolerance in the frustum, what the orientation guard promises
+//! to leave none of.
 //!
 //! Writes results/came/flythrough.{json,csv}, the series as a chart (flythrough.{png,svg}: faces,
 //! fold-overs, work, the stream fetched so far and the bytes each frame read, the error), and
@@ -323,7 +327,75 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
     Ok(out)
 }
 
-/// Adapts along the path with the stream read from `path`.
+/// One front's frame, adapted with nothing else running between its frames ([`fly_alone`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timed {
+    /// Faces and vertices once settled.
+    pub faces: usize,
+    pub vertices: usize,
+    pub splits: usize,
+    pub collapses: usize,
+    /// Passes over the active nodes, and adaptations (one more after each wait).
+    pub passes: usize,
+    pub adaptations: usize,
+    /// Time in adaptation, and waiting for meta-nodes.
+    pub adapt_ms: f64,
+    pub wait_ms: f64,
+    /// Faces in view left not certain of their orientation.
+    pub unsure: usize,
+    /// Bytes read from the stream's file so far, and meta-nodes decoded.
+    pub bytes_fetched: u64,
+    pub units_loaded: usize,
+}
+
+/// One front along the path, alone: adapt, wait for the meta-nodes it asked for, adapt again,
+/// until it settles, frame after frame, with no other work between — as a client adapts its
+/// front. (Measured between the error measurement and the other fronts, a front's records are
+/// out of the cache when its frame starts, and on two cores the other fronts' loader threads
+/// compete with it: `came_fly_adapt` measured the same front 2–3× faster alone.)
+pub fn fly_alone(path: &Path, cameras: &[Camera], guard: bool) -> Result<Vec<Timed>> {
+    let mut front = ViewMesh::open_file(path)?;
+    let mut frames = Vec::with_capacity(cameras.len());
+    for camera in cameras {
+        let view = View::new(camera, TOLERANCE_PX)?.keep_orientation(guard);
+        let mut timed = Timed::default();
+        for _ in 0..256 {
+            let started = Instant::now();
+            let done = front.adapt(&view, Budget::UNLIMITED);
+            timed.adapt_ms += started.elapsed().as_secs_f64() * 1e3;
+            timed.splits += done.splits;
+            timed.collapses += done.collapses;
+            timed.passes += done.passes;
+            timed.adaptations += 1;
+            timed.unsure = done.unsure;
+            if done.settled {
+                break;
+            }
+            let started = Instant::now();
+            front.wait_for_units();
+            timed.wait_ms += started.elapsed().as_secs_f64() * 1e3;
+        }
+        let fetched = front.fetched();
+        timed.faces = front.face_count();
+        timed.vertices = front.vertex_count();
+        timed.bytes_fetched = fetched.bytes_read;
+        timed.units_loaded = fetched.units_loaded;
+        frames.push(timed);
+    }
+    Ok(frames)
+}
+
+/// Splits plus collapses per second of adaptation over the path.
+fn operations_per_second(frames: &[Timed]) -> f64 {
+    let operations: usize = frames.iter().map(|f| f.splits + f.collapses).sum();
+    let ms: f64 = frames.iter().map(|f| f.adapt_ms).sum();
+    operations as f64 / (ms / 1e3).max(1e-9)
+}
+
+/// Adapts along the path with the stream read from `path`: the front with the orientation
+/// guard and the one without, each timed alone ([`fly_alone`]), then the two again beside the
+/// two-sided front for what is measured of each frame (the fronts are the same: adaptation does
+/// not depend on when meta-nodes arrive, which is checked).
 fn fly(
     results: &Path,
     path: &Path,
@@ -333,6 +405,8 @@ fn fly(
     log: &mut dyn FnMut(String),
 ) -> Result<Flythrough> {
     let cameras = cameras(full)?;
+    let guarded = fly_alone(path, &cameras, true)?;
+    let free = fly_alone(path, &cameras, false)?;
     let at: std::collections::HashMap<u64, DVec3> =
         leaves.iter().map(|&(id, p, _)| (id.packed(), p)).collect();
     let triangles = centroids_and_areas(full);
@@ -340,85 +414,59 @@ fn fly(
     let mut front = ViewMesh::open_file(path)?;
     let mut two_sided = ViewMesh::open_file(path)?;
     let mut unguarded = ViewMesh::open_file(path)?;
-    let (mut operations_unguarded, mut adapting_unguarded) = (0usize, 0.0f64);
     let units = front.fetched().units;
     let mut frames = Vec::with_capacity(FRAMES);
-    let (mut operations, mut adapting) = (0usize, 0.0f64);
     for (i, &camera) in cameras.iter().enumerate() {
         let view = View::new(&camera, TOLERANCE_PX)?;
-        let (mut splits, mut collapses, mut adapt_s, mut wait_s) = (0, 0, 0.0, 0.0);
-        let (mut passes, mut adaptations, mut unsure) = (0, 0, 0);
-        // Adapt, wait for the meta-nodes asked for, adapt again, until the front settles.
-        for _ in 0..256 {
-            let started = Instant::now();
-            let done = front.adapt(&view, Budget::UNLIMITED);
-            adapt_s += started.elapsed().as_secs_f64();
-            splits += done.splits;
-            collapses += done.collapses;
-            passes += done.passes;
-            adaptations += 1;
-            unsure = done.unsure;
-            if done.settled {
-                break;
-            }
-            let started = Instant::now();
-            front.wait_for_units();
-            wait_s += started.elapsed().as_secs_f64();
+        let free_view = view.clone().keep_orientation(false);
+        front.settle(&view, Budget::UNLIMITED, 256);
+        unguarded.settle(&free_view, Budget::UNLIMITED, 256);
+        let (timed, timed_free) = (guarded[i], free[i]);
+        if (front.face_count(), unguarded.face_count()) != (timed.faces, timed_free.faces) {
+            return Err(Error::mesh(format!(
+                "frame {i}: the fronts measured hold {} and {} faces, the timed ones {} and {}",
+                front.face_count(),
+                unguarded.face_count(),
+                timed.faces,
+                timed_free.faces
+            )));
         }
-        operations += splits + collapses;
-        adapting += adapt_s;
+        let (splits, collapses, passes) = (timed.splits, timed.collapses, timed.passes);
         let started = Instant::now();
         two_sided.settle(&view.clone().two_sided(true), Budget::UNLIMITED, 256);
         let settle_ms_two_sided = started.elapsed().as_secs_f64() * 1e3;
-        // The front without the guard, timed alike (adaptation only).
-        let free_view = view.clone().keep_orientation(false);
-        let mut ops_unguarded = 0;
-        let mut ms_unguarded = 0.0;
-        for _ in 0..256 {
-            let started = Instant::now();
-            let done = unguarded.adapt(&free_view, Budget::UNLIMITED);
-            ms_unguarded += started.elapsed().as_secs_f64() * 1e3;
-            ops_unguarded += done.splits + done.collapses;
-            if done.settled {
-                break;
-            }
-            unguarded.wait_for_units();
-        }
-        operations_unguarded += ops_unguarded;
-        adapting_unguarded += ms_unguarded / 1e3;
         let folds = fold_overs(&front, &at, &view);
         let folds_unguarded = fold_overs(&unguarded, &at, &view);
         let error = reference.screen_error(&two_sided.mesh(), &camera, &view);
         let (max_error_px, mean_error_px, error_samples) =
             (error.max_px, error.mean_px, error.samples);
-        let fetched = front.fetched();
         let pixel_at_nearest = nearest_depth(full, &camera, &view)
             .map_or(0.0, |z| pixel_size(&camera, z) * TOLERANCE_PX);
         let frame = Frame {
             frame: i,
             eye: camera.eye.to_array(),
             target: camera.target.to_array(),
-            faces: front.face_count(),
-            vertices: front.vertex_count(),
+            faces: timed.faces,
+            vertices: timed.vertices,
             faces_two_sided: two_sided.face_count(),
             settle_ms_two_sided,
             splits,
             collapses,
             passes,
-            adaptations,
-            adapt_ms: adapt_s * 1e3,
-            wait_ms: wait_s * 1e3,
-            bytes_fetched: fetched.bytes_read,
-            units_loaded: fetched.units_loaded,
+            adaptations: timed.adaptations,
+            adapt_ms: timed.adapt_ms,
+            wait_ms: timed.wait_ms,
+            bytes_fetched: timed.bytes_fetched,
+            units_loaded: timed.units_loaded,
             bytes_fetched_two_sided: two_sided.fetched().bytes_read,
             surface_in_view: surface_in_view(&triangles, &view),
             fold_overs: folds.all,
             fold_overs_facing: folds.facing,
             fold_overs_in_view: folds.in_view,
-            unsure,
-            faces_unguarded: unguarded.face_count(),
-            adapt_ms_unguarded: ms_unguarded,
-            operations_unguarded: ops_unguarded,
+            unsure: timed.unsure,
+            faces_unguarded: timed_free.faces,
+            adapt_ms_unguarded: timed_free.adapt_ms,
+            operations_unguarded: timed_free.splits + timed_free.collapses,
             fold_overs_in_view_unguarded: folds_unguarded.in_view,
             fold_overs_in_view_facing_unguarded: folds_unguarded.in_view_facing,
             error_samples,
@@ -439,7 +487,7 @@ fn fly(
                 splits,
                 collapses,
                 frame.adapt_ms,
-                100.0 * fetched.bytes_read as f64 / stream_bytes as f64,
+                100.0 * timed.bytes_fetched as f64 / stream_bytes as f64,
                 max_error_px,
                 mean_error_px,
                 error_samples
@@ -512,8 +560,8 @@ fn fly(
         width: WIDTH,
         height: HEIGHT,
         fov_degrees: FOV_DEGREES,
-        operations_per_second: operations as f64 / adapting.max(1e-9),
-        operations_per_second_unguarded: operations_unguarded as f64 / adapting_unguarded.max(1e-9),
+        operations_per_second: operations_per_second(&guarded),
+        operations_per_second_unguarded: operations_per_second(&free),
         frames,
         tenth_of_surface,
     })

@@ -3,6 +3,7 @@
 
 use super::super::loader::{Loaded, UnitDelta, NONE};
 use super::orientation::CodedNormal;
+use super::parts::Bounds;
 use super::{Ready, State, Suspicion, UnitState, ViewMesh};
 use smallvec::SmallVec;
 
@@ -48,9 +49,12 @@ impl ViewMesh {
             self.nodes.parent.push(n.parent);
             self.nodes.children.push([NONE; 2]);
             self.nodes.opens.push(NONE);
-            self.nodes.spheres.push((n.center, n.radius));
-            self.nodes.deviations.push(n.deviation);
-            self.nodes.cones.push(n.cone);
+            self.nodes.bounds.push(Bounds {
+                center: n.center,
+                radius: n.radius,
+                deviation: n.deviation,
+                cone: n.cone,
+            });
             self.front.state.push(State::Below);
             self.nodes.born.push(SmallVec::new());
             self.nodes.depends_on.push(SmallVec::new());
@@ -123,13 +127,10 @@ impl ViewMesh {
         self.loading.opened[unit]
             .iter()
             .map(|&v| {
-                let (center, radius) = self.nodes.spheres[v as usize];
-                self.loading.view_now.screen_error(
-                    center,
-                    radius,
-                    self.nodes.deviations[v as usize],
-                    self.scale,
-                )
+                let b = &self.nodes.bounds[v as usize];
+                self.loading
+                    .view_now
+                    .screen_error(b.center, b.radius, b.deviation, self.scale)
             })
             .fold(0.0, f64::max)
     }

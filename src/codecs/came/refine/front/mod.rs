@@ -356,7 +356,7 @@ impl ViewMesh {
     /// Whether a node loaded so far has a normal cone (a `came` stream with cones), so that
     /// back faces can be culled.
     pub fn has_normal_cones(&self) -> bool {
-        self.nodes.cones.iter().any(|c| c.is_some())
+        self.nodes.bounds.iter().any(|b| b.cone.is_some())
     }
 
     /// The meta-nodes refused, and why.

@@ -100,7 +100,7 @@ impl ViewMesh {
     /// Whether the face on active nodes `corners` shows in the view: it meets the frustum and
     /// spans the tolerance on the screen ([`View::shows_triangle`]).
     pub(super) fn in_view(&self, view: &View, corners: [u32; 3]) -> bool {
-        view.shows_triangle(corners.map(|v| self.nodes.spheres[v as usize].0))
+        view.shows_triangle(corners.map(|v| self.nodes.bounds[v as usize].center))
     }
 
     /// Whether triangle `f`, on active nodes `corners`, surely turns the way of its counterpart
@@ -110,8 +110,8 @@ impl ViewMesh {
         if corners.iter().all(|&v| self.is_leaf(v)) {
             return true;
         }
-        let p = corners.map(|v| self.nodes.spheres[v as usize].0);
-        let r = corners.map(|v| self.nodes.spheres[v as usize].1);
+        let p = corners.map(|v| self.nodes.bounds[v as usize].center);
+        let r = corners.map(|v| self.nodes.bounds[v as usize].radius);
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         let area = n.length();
         if !(area > 0.0 && area.is_finite()) {
@@ -129,7 +129,7 @@ impl ViewMesh {
     /// Whether normal `n` (of length `area`) is within 90° − α of the axis of node `v`'s normal
     /// cone, which holds the normal of every face with a corner under `v`.
     fn cone_holds(&self, v: u32, n: DVec3, area: f64) -> bool {
-        let cone = &self.nodes.cones[v as usize];
+        let cone = &self.nodes.bounds[v as usize].cone;
         let axis = DVec3::new(
             cone.axis[0] as f64,
             cone.axis[1] as f64,
@@ -205,8 +205,8 @@ impl ViewMesh {
                 None => return true,
             }
         }
-        let q = deepest.map(|v| self.nodes.spheres[v as usize].0);
-        let r = deepest.map(|v| self.nodes.spheres[v as usize].1);
+        let q = deepest.map(|v| self.nodes.bounds[v as usize].center);
+        let r = deepest.map(|v| self.nodes.bounds[v as usize].radius);
         let Some(cos_gamma) = spheres_hold_orientation(q, r) else {
             return false;
         };
@@ -339,7 +339,7 @@ impl ViewMesh {
             let mut corners = corners;
             if !waits {
                 corners.sort_by(|&a, &b| {
-                    let radius = |v: u32| self.nodes.spheres[v as usize].1;
+                    let radius = |v: u32| self.nodes.bounds[v as usize].radius;
                     radius(b).total_cmp(&radius(a))
                 });
                 // First the coarsest corner whose split alone turns the face the right way

@@ -12,7 +12,7 @@ impl ViewMesh {
     /// active node on its path (`None` if the path leaves the hierarchy above the front).
     pub fn position_of(&self, leaf: NodeId) -> Option<DVec3> {
         self.active_on(leaf)
-            .map(|v| self.nodes.spheres[v as usize].0)
+            .map(|v| self.nodes.bounds[v as usize].center)
     }
 
     /// The front's nodes (the adapted mesh's vertices), by their paths in the hierarchy.
@@ -29,7 +29,7 @@ impl ViewMesh {
         (0..self.faces.present.len())
             .filter(|&t| self.faces.present[t])
             .map(|t| {
-                let at = self.faces.corners[t].map(|v| self.nodes.spheres[v as usize].0);
+                let at = self.faces.corners[t].map(|v| self.nodes.bounds[v as usize].center);
                 (self.faces.leaf_corners[t], at)
             })
     }
@@ -40,7 +40,7 @@ impl ViewMesh {
         let mut positions = Vec::with_capacity(self.front.active.len());
         for &v in &self.front.active {
             index[v as usize] = positions.len() as u32;
-            positions.push(self.nodes.spheres[v as usize].0);
+            positions.push(self.nodes.bounds[v as usize].center);
         }
         let faces = self
             .faces
@@ -60,7 +60,7 @@ impl ViewMesh {
             if !present {
                 continue;
             }
-            let [a, b, c] = self.faces.corners[t].map(|v| self.nodes.spheres[v as usize].0);
+            let [a, b, c] = self.faces.corners[t].map(|v| self.nodes.bounds[v as usize].center);
             if let Some(d) = ray_triangle(origin, direction, a, b, c) {
                 if best.is_none_or(|p| d < p.distance) {
                     best = Some(Pick {

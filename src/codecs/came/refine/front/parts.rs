@@ -23,17 +23,27 @@ pub(super) struct Nodes {
     pub(super) children: Vec<[u32; 2]>,
     /// The meta-node that splits the node, while it is not loaded (else `NONE`).
     pub(super) opens: Vec<u32>,
-    /// Position and error-sphere radius, in world units.
-    /// (One array: the view test of every active node, every pass, reads both.)
-    pub(super) spheres: Vec<(DVec3, f64)>,
-    /// Deviation, in world units: the error the view test projects.
-    pub(super) deviations: Vec<f64>,
-    /// Normal cone, for back-face culling.
-    pub(super) cones: Vec<NormalCone>,
+    /// What the view test reads of each node (one cache line a node: the test of every
+    /// active node and of its parent, every pass, read three arrays before).
+    pub(super) bounds: Vec<Bounds>,
     /// Triangles born at the node's split.
     pub(super) born: Vec<SmallVec<[u32; 2]>>,
     /// Nodes whose splits the node's split needs.
     pub(super) depends_on: Vec<SmallVec<[Dependency; 2]>>,
+}
+
+/// A node's position, error sphere, deviation and normal cone: what the view test reads.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(super) struct Bounds {
+    /// Position, in world units.
+    pub(super) center: DVec3,
+    /// Error-sphere radius, in world units.
+    pub(super) radius: f64,
+    /// Deviation, in world units: the error the view test projects.
+    pub(super) deviation: f64,
+    /// Normal cone, for back-face culling.
+    pub(super) cone: NormalCone,
 }
 
 /// Which nodes are on the front: each node's state, the active ones listed (each with its
@@ -141,9 +151,7 @@ impl Nodes {
             self.parent.len(),
             self.children.len(),
             self.opens.len(),
-            self.spheres.len(),
-            self.deviations.len(),
-            self.cones.len(),
+            self.bounds.len(),
             self.born.len(),
             self.depends_on.len(),
         ];

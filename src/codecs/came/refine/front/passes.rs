@@ -9,15 +9,8 @@ use crate::prefetch::prefetch;
 
 impl ViewMesh {
     pub(super) fn wants(&self, view: &View, v: u32) -> bool {
-        let (center, radius) = self.nodes.spheres[v as usize];
-        let deviation = self.nodes.deviations[v as usize];
-        view.wants_split(
-            center,
-            radius,
-            deviation,
-            &self.nodes.cones[v as usize],
-            self.scale,
-        )
+        let b = &self.nodes.bounds[v as usize];
+        view.wants_split(b.center, b.radius, b.deviation, &b.cone, self.scale)
     }
 
     /// Returns whether it passed over the front (rather than revisiting the splits that
@@ -80,12 +73,12 @@ impl ViewMesh {
                 // its parent's (the active nodes are sparse among all, too far apart for the
                 // processor to foresee).
                 if let Some(&ahead) = pass.get(i + 8) {
-                    prefetch(self.nodes.spheres.as_ptr().wrapping_add(ahead as usize));
+                    prefetch(self.nodes.bounds.as_ptr().wrapping_add(ahead as usize));
                     prefetch(self.nodes.parent.as_ptr().wrapping_add(ahead as usize));
                 }
                 if let Some(&ahead) = pass.get(i + 4) {
                     let p = self.nodes.parent[ahead as usize] as usize;
-                    prefetch(self.nodes.spheres.as_ptr().wrapping_add(p));
+                    prefetch(self.nodes.bounds.as_ptr().wrapping_add(p));
                     prefetch(self.nodes.children.as_ptr().wrapping_add(p));
                     prefetch(self.front.split_dependants.as_ptr().wrapping_add(p));
                 }

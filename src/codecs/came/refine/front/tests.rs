@@ -155,8 +155,8 @@ fn meta_nodes_are_asked_for_most_wanted_first() {
                     let waiting = (0..front.nodes.opens.len())
                         .filter(|&v| front.nodes.opens[v] == unit as u32);
                     let errors = waiting.map(|v| {
-                        let (center, radius) = front.nodes.spheres[v];
-                        view.screen_error(center, radius, front.nodes.deviations[v], front.scale)
+                        let b = &front.nodes.bounds[v];
+                        view.screen_error(b.center, b.radius, b.deviation, front.scale)
                     });
                     errors
                         .reduce(f64::max)
@@ -247,8 +247,8 @@ fn back_faces_stay_coarse_unless_the_view_is_two_sided() {
     );
     // Nodes the two-sided front splits stay on the one-sided front because they face away.
     let faces_away = |v: u32| {
-        let (c, r) = one.nodes.spheres[v as usize];
-        view.faces_away(c, r, &one.nodes.cones[v as usize])
+        let b = &one.nodes.bounds[v as usize];
+        view.faces_away(b.center, b.radius, &b.cone)
     };
     let split_in_two: std::collections::HashSet<NodeId> = (0..two.nodes.ids.len())
         .filter(|&v| two.front.state[v] == State::Split)
@@ -490,7 +490,7 @@ fn fold_overs_in_view(vm: &ViewMesh, full: &HashMap<u64, DVec3>, view: &View) ->
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
     let (mut folded, mut coarse) = (0, 0);
     for t in (0..vm.faces.present.len()).filter(|&t| vm.faces.present[t]) {
-        let at = vm.faces.corners[t].map(|v| vm.nodes.spheres[v as usize].0);
+        let at = vm.faces.corners[t].map(|v| vm.nodes.bounds[v as usize].center);
         let counterpart = vm.faces.leaf_corners[t].map(|l| full[&l.packed()]);
         if at != counterpart {
             coarse += 1;
