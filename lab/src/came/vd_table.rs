@@ -227,7 +227,8 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
         "\n## The fly-through\n\n\
          {} frames around and into {} ×{} ({} triangles, a {}-byte stream), {}x{} pixels, {}° \
          (frames 0–{} orbit at 1.5 diagonals, then the camera flies in); the path's front is \
-         one-sided, a second front follows it two-sided for the faces and the measured error \
+         one-sided and timed along the path alone, nothing else running between its frames; \
+         a second front follows it two-sided for the faces and the measured error \
          (`cargo run --release --bin experiment -- came-fly`; BENCHMARKS.md has the figures \
          per frame).\n\n\
          | figure | median | 5% | 95% | min | max |\n|---|---:|---:|---:|---:|---:|",
