@@ -54,25 +54,13 @@ pub struct Frame {
     pub frame: usize,
     pub eye: [f64; 3],
     pub target: [f64; 3],
-    /// Faces and vertices of the adapted mesh.
-    pub faces: usize,
-    pub vertices: usize,
+    /// The path's front (one-sided, with the orientation guard), timed alone.
+    #[serde(flatten)]
+    pub front: Timed,
     /// Faces of the two-sided front (no back-face culling) in the same view, and its
     /// adaptation time (meta-node waits included).
     pub faces_two_sided: usize,
     pub settle_ms_two_sided: f64,
-    pub splits: usize,
-    pub collapses: usize,
-    /// Passes over the active nodes, and adaptations (one more after each wait for meta-nodes).
-    pub passes: usize,
-    pub adaptations: usize,
-    /// Time in adaptation (splits, collapses, view tests, taking in meta-nodes).
-    pub adapt_ms: f64,
-    /// Time waiting for meta-nodes the view asked for.
-    pub wait_ms: f64,
-    /// Bytes read from the stream's file so far, and meta-nodes decoded.
-    pub bytes_fetched: u64,
-    pub units_loaded: usize,
     /// Bytes the two-sided front has read so far.
     pub bytes_fetched_two_sided: u64,
     /// Share of the full mesh's surface (by area) inside the view frustum.
@@ -84,8 +72,6 @@ pub struct Frame {
     pub fold_overs_facing: usize,
     /// Of those, the ones meeting the view frustum (0 by the guard).
     pub fold_overs_in_view: usize,
-    /// Faces in view the guard left not certain of their orientation (`Adapted::unsure`).
-    pub unsure: usize,
     /// The same front without the orientation guard (`View::keep_orientation(false)`): faces,
     /// adaptation time (meta-node waits excluded), splits + collapses, fold-overs in view and
     /// those of them whose full-mesh triangle faces the eye.
@@ -328,7 +314,7 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
 }
 
 /// One front's frame, adapted with nothing else running between its frames ([`fly_alone`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Timed {
     /// Faces and vertices once settled.
     pub faces: usize,
@@ -341,7 +327,7 @@ pub struct Timed {
     /// Time in adaptation, and waiting for meta-nodes.
     pub adapt_ms: f64,
     pub wait_ms: f64,
-    /// Faces in view left not certain of their orientation.
+    /// Faces in view left not certain of their orientation (`Adapted::unsure`).
     pub unsure: usize,
     /// Bytes read from the stream's file so far, and meta-nodes decoded.
     pub bytes_fetched: u64,
@@ -431,7 +417,6 @@ fn fly(
                 timed_free.faces
             )));
         }
-        let (splits, collapses, passes) = (timed.splits, timed.collapses, timed.passes);
         let started = Instant::now();
         two_sided.settle(&view.clone().two_sided(true), Budget::UNLIMITED, 256);
         let settle_ms_two_sided = started.elapsed().as_secs_f64() * 1e3;
@@ -446,24 +431,14 @@ fn fly(
             frame: i,
             eye: camera.eye.to_array(),
             target: camera.target.to_array(),
-            faces: timed.faces,
-            vertices: timed.vertices,
+            front: timed,
             faces_two_sided: two_sided.face_count(),
             settle_ms_two_sided,
-            splits,
-            collapses,
-            passes,
-            adaptations: timed.adaptations,
-            adapt_ms: timed.adapt_ms,
-            wait_ms: timed.wait_ms,
-            bytes_fetched: timed.bytes_fetched,
-            units_loaded: timed.units_loaded,
             bytes_fetched_two_sided: two_sided.fetched().bytes_read,
             surface_in_view: surface_in_view(&triangles, &view),
             fold_overs: folds.all,
             fold_overs_facing: folds.facing,
             fold_overs_in_view: folds.in_view,
-            unsure: timed.unsure,
             faces_unguarded: timed_free.faces,
             adapt_ms_unguarded: timed_free.adapt_ms,
             operations_unguarded: timed_free.splits + timed_free.collapses,
@@ -476,17 +451,18 @@ fn fly(
         };
         if i % 10 == 0 || i + 1 == FRAMES {
             log(format!(
-                "frame {i}: {} faces ({} two-sided, {} without the orientation guard), {} folded over ({} in view; unguarded {} in view, {} of them facing the eye), {} splits, {} collapses, {passes} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} samples",
-                frame.faces,
+                "frame {i}: {} faces ({} two-sided, {} without the orientation guard), {} folded over ({} in view; unguarded {} in view, {} of them facing the eye), {} splits, {} collapses, {} passes, {:.1} ms, {:.1}% of the stream fetched, error {:.2} px max ({:.2} mean) over {} samples",
+                frame.front.faces,
                 frame.faces_two_sided,
                 frame.faces_unguarded,
                 frame.fold_overs,
                 frame.fold_overs_in_view,
                 frame.fold_overs_in_view_unguarded,
                 frame.fold_overs_in_view_facing_unguarded,
-                splits,
-                collapses,
-                frame.adapt_ms,
+                timed.splits,
+                timed.collapses,
+                timed.passes,
+                timed.adapt_ms,
                 100.0 * timed.bytes_fetched as f64 / stream_bytes as f64,
                 max_error_px,
                 mean_error_px,
@@ -575,23 +551,23 @@ fn csv(report: &Flythrough) -> String {
         out += &format!(
             "{},{},{},{},{},{},{},{},{:.3},{:.3},{},{},{},{:.5},{},{},{},{},{},{:.3},{},{},{},{},{:.4},{:.4},{:.6e}\n",
             f.frame,
-            f.faces,
-            f.vertices,
+            f.front.faces,
+            f.front.vertices,
             f.faces_two_sided,
-            f.splits,
-            f.collapses,
-            f.passes,
-            f.adaptations,
-            f.adapt_ms,
-            f.wait_ms,
-            f.bytes_fetched,
-            f.units_loaded,
+            f.front.splits,
+            f.front.collapses,
+            f.front.passes,
+            f.front.adaptations,
+            f.front.adapt_ms,
+            f.front.wait_ms,
+            f.front.bytes_fetched,
+            f.front.units_loaded,
             f.bytes_fetched_two_sided,
             f.surface_in_view,
             f.fold_overs,
             f.fold_overs_facing,
             f.fold_overs_in_view,
-            f.unsure,
+            f.front.unsure,
             f.faces_unguarded,
             f.adapt_ms_unguarded,
             f.operations_unguarded,
@@ -649,7 +625,7 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
             "faces",
             false,
             vec![
-                series("active faces", &|f| f.faces as f64),
+                series("active faces", &|f| f.front.faces as f64),
                 series("two-sided (no back-face culling)", &|f| {
                     f.faces_two_sided as f64
                 }),
@@ -677,9 +653,9 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
             "operations, or ms (log)",
             true,
             vec![
-                series("splits", &|f| f.splits as f64),
-                series("collapses", &|f| f.collapses as f64),
-                series("adapt time (ms)", &|f| f.adapt_ms),
+                series("splits", &|f| f.front.splits as f64),
+                series("collapses", &|f| f.front.collapses as f64),
+                series("adapt time (ms)", &|f| f.front.adapt_ms),
                 series("adapt time without the guard (ms)", &|f| {
                     f.adapt_ms_unguarded
                 }),
@@ -691,7 +667,7 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
             false,
             vec![
                 series("bytes fetched so far", &|f| {
-                    100.0 * f.bytes_fetched as f64 / report.stream_bytes as f64
+                    100.0 * f.front.bytes_fetched as f64 / report.stream_bytes as f64
                 }),
                 series("two-sided", &|f| {
                     100.0 * f.bytes_fetched_two_sided as f64 / report.stream_bytes as f64
@@ -704,7 +680,7 @@ pub fn chart(report: &Flythrough) -> Vec<Chart> {
             "kB (log)",
             true,
             vec![
-                per_frame("one-sided", &|f| f.bytes_fetched),
+                per_frame("one-sided", &|f| f.front.bytes_fetched),
                 per_frame("two-sided", &|f| f.bytes_fetched_two_sided),
             ],
         ),

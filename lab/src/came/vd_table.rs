@@ -204,7 +204,7 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
         .filter_map(|(f, t)| t.triangles.map(|t| f.faces_two_sided as f64 / t as f64))
         .collect();
     let within = ratios.iter().filter(|&&r| r <= FACE_TARGET).count();
-    let adapt: Vec<f64> = frames.iter().map(|f| f.adapt_ms).collect();
+    let adapt: Vec<f64> = frames.iter().map(|f| f.front.adapt_ms).collect();
     let max_error = frames.iter().map(|f| f.max_error_px).fold(0.0, f64::max);
     let least_mean = frames
         .iter()
@@ -213,14 +213,14 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
     let per_frame: Vec<f64> = frames
         .iter()
         .scan(0u64, |before, f| {
-            let read = f.bytes_fetched.saturating_sub(*before);
-            *before = f.bytes_fetched;
+            let read = f.front.bytes_fetched.saturating_sub(*before);
+            *before = f.front.bytes_fetched;
             Some(read as f64)
         })
         .collect();
     let guard: Vec<f64> = frames
         .iter()
-        .map(|f| f.faces as f64 / f.faces_unguarded.max(1) as f64)
+        .map(|f| f.front.faces as f64 / f.faces_unguarded.max(1) as f64)
         .collect();
     let _ = writeln!(
         md,
@@ -283,7 +283,7 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
     row(
         &mut md,
         "fetch wait ms",
-        &frames.iter().map(|f| f.wait_ms).collect::<Vec<_>>(),
+        &frames.iter().map(|f| f.front.wait_ms).collect::<Vec<_>>(),
         1,
     );
     row(
@@ -296,7 +296,8 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
         md,
         "\nThe first frame reads {:.1}% of the stream; frame {} alone, from a cold start ({:.1}% \
          of the surface in view), {:.1}%.",
-        100.0 * frames.first().map_or(0, |f| f.bytes_fetched) as f64 / fly.stream_bytes as f64,
+        100.0 * frames.first().map_or(0, |f| f.front.bytes_fetched) as f64
+            / fly.stream_bytes as f64,
         fly.tenth_of_surface.frame,
         100.0 * fly.tenth_of_surface.surface_in_view,
         100.0 * fly.tenth_of_surface.share_of_stream
