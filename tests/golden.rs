@@ -364,6 +364,23 @@ fn came_streams_of_balanced_hierarchies_still_decode_and_refine() {
     assert!(new_faces < old_faces, "{new_faces} against {old_faces}");
 }
 
+/// `came` streams of syntax 7, whose bands span regions of six levels, still decode exactly and
+/// refine: `came-eight-before-regions-of-four.mc` is the golden stream of that build, kept.
+/// Today's cuts the same tree into bands over regions of four (docs/FORMAT.md §8.1), so a front
+/// is the same whichever stream it reads.
+#[test]
+fn came_streams_of_six_level_regions_still_decode_and_refine() {
+    let (old, new) = kept_came_stream_and_todays("came-eight-before-regions-of-four.mc");
+    let (old_header, new_header) = (header_of(&old), header_of(&new));
+    assert_eq!((old_header.syntax, old_header.params[8]), (7, 6));
+    assert!(new_header.syntax >= 8);
+    assert_eq!(new_header.params[8], 4);
+    let [old_faces, new_faces] = settle_far_from_eight(&[&old, &new])[..] else {
+        unreachable!("one count a stream")
+    };
+    assert_eq!(old_faces, new_faces);
+}
+
 /// `came` streams of syntax 5, whose deviation codes step by 2^(−1/2) below the parent's,
 /// still decode exactly and refine: `came-eight-before-anchored-deviations.mc` is the golden
 /// stream of that build, kept. Today's codes the nodes above depth 11 in quarter steps on a

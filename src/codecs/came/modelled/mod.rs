@@ -14,6 +14,9 @@
 //! balanced as the paper's (b = 1, which `came-paper` keeps): a far view's front is then a
 //! simplified mesh rather than a tree level. Syntax 7 is read as syntax 6; its streams differ in
 //! the tree they hold.
+//!
+//! Syntax 8 cuts that tree's bands over regions of four levels instead of six ([`SHAPE`]): the
+//! deeper tree's far fronts then read fewer and smaller units, and its streams are smaller too.
 
 mod contexts;
 mod decoder;
@@ -123,16 +126,34 @@ pub fn encode_with_unit_fields(mesh: &CanonicalMesh) -> Result<(Encoded, UnitFie
     Ok((encoded, fields))
 }
 
-/// How `came` cuts its hierarchy into units (syntax 5): bands of two levels over regions of six
-/// (units of up to about 2^6 · 3 splits; 110 on average on dragon-50k and the ×16 mesh), a
-/// unit holding the rest of its subtree when that is at most 256 splits. Regions of five read
-/// dragon-50k's far view in 11.4% of a 2.7% larger stream, of seven in 13.6% of a 1.4% smaller
-/// one (BENCHMARKS.md, "`came` syntax 5: units by depth band").
+/// How `came` cuts its hierarchy into units (syntax 8): bands of two levels over regions of
+/// four, a unit holding the rest of its subtree when that is at most 256 splits. On the tree
+/// built by quadric error alone (syntax 7), regions of six, five, four, three and two read
+/// dragon-50k's far view in 7.3%, 7.1%, 5.8%, 6.1% and 6.3% of its stream, and the streams
+/// shrink with the regions down to three (BENCHMARKS.md, "`came` syntax 8: regions of four
+/// levels").
 pub const SHAPE: Shape = Shape::Bands {
+    region: 4,
+    band: 2,
+    whole: 256,
+};
+
+/// The bands of syntaxes 5 to 7: two levels over regions of six (chosen on the balanced tree
+/// of syntaxes 5 and 6: BENCHMARKS.md, "`came` syntax 5: units by depth band").
+pub const SHAPE_BEFORE_8: Shape = Shape::Bands {
     region: 6,
     band: 2,
     whole: 256,
 };
+
+/// How a stream of `syntax` cuts its bands (syntax 5 on).
+fn shape_of(syntax: u8) -> Shape {
+    if syntax >= 8 {
+        SHAPE
+    } else {
+        SHAPE_BEFORE_8
+    }
+}
 
 /// A `came` stream's parameters, checked.
 pub fn params(header: &Header) -> Result<Params> {
@@ -168,7 +189,7 @@ pub fn params(header: &Header) -> Result<Params> {
             ),
         ));
     }
-    if let (5.., Shape::Bands { region, band, .. }) = (header.syntax, SHAPE) {
+    if let (5.., Shape::Bands { region, band, .. }) = (header.syntax, shape_of(header.syntax)) {
         if params.region_levels != region || params.meta_levels != band {
             return Err(Error::malformed(
                 0,
