@@ -127,6 +127,12 @@ pub struct Flythrough {
     /// The same without the orientation guard.
     pub operations_per_second_unguarded: f64,
     pub frames: Vec<Frame>,
+    /// Frames where the fronts flown again for the measurements hold other face counts than
+    /// the timed ones: a front numbers the nodes of the meta-nodes it takes in in the order the
+    /// loader thread finished them, and its passes follow that order, so two fronts of one path
+    /// may settle a few faces apart (frame 34 of one run: 32,668 against 32,672).
+    #[serde(default)]
+    pub fronts_differ: usize,
     /// The frame whose view holds the share of the surface nearest a tenth, from a cold start.
     pub tenth_of_surface: ColdView,
 }
@@ -380,8 +386,8 @@ fn operations_per_second(frames: &[Timed]) -> f64 {
 
 /// Adapts along the path with the stream read from `path`: the front with the orientation
 /// guard and the one without, each timed alone ([`fly_alone`]), then the two again beside the
-/// two-sided front for what is measured of each frame (the fronts are the same: adaptation does
-/// not depend on when meta-nodes arrive, which is checked).
+/// two-sided front for what is measured of each frame (fold-overs; faces and time are the timed
+/// fronts'). The fronts flown again may differ by a few faces ([`Flythrough::fronts_differ`]).
 fn fly(
     results: &Path,
     path: &Path,
@@ -402,6 +408,7 @@ fn fly(
     let mut unguarded = ViewMesh::open_file(path)?;
     let units = front.fetched().units;
     let mut frames = Vec::with_capacity(FRAMES);
+    let mut fronts_differ = 0;
     for (i, &camera) in cameras.iter().enumerate() {
         let view = View::new(&camera, TOLERANCE_PX)?;
         let free_view = view.clone().keep_orientation(false);
@@ -409,13 +416,14 @@ fn fly(
         unguarded.settle(&free_view, Budget::UNLIMITED, 256);
         let (timed, timed_free) = (guarded[i], free[i]);
         if (front.face_count(), unguarded.face_count()) != (timed.faces, timed_free.faces) {
-            return Err(Error::mesh(format!(
-                "frame {i}: the fronts measured hold {} and {} faces, the timed ones {} and {}",
+            fronts_differ += 1;
+            log(format!(
+                "frame {i}: the fronts flown again hold {} and {} faces, the timed ones {} and {}",
                 front.face_count(),
                 unguarded.face_count(),
                 timed.faces,
                 timed_free.faces
-            )));
+            ));
         }
         let started = Instant::now();
         two_sided.settle(&view.clone().two_sided(true), Budget::UNLIMITED, 256);
@@ -539,6 +547,7 @@ fn fly(
         operations_per_second: operations_per_second(&guarded),
         operations_per_second_unguarded: operations_per_second(&free),
         frames,
+        fronts_differ,
         tenth_of_surface,
     })
 }
