@@ -140,7 +140,7 @@ pub const SHAPE: Shape = Shape::Bands {
 
 /// The bands of syntaxes 5 to 7: two levels over regions of six (chosen on the balanced tree
 /// of syntaxes 5 and 6: BENCHMARKS.md, "`came` syntax 5: units by depth band").
-pub const SHAPE_BEFORE_8: Shape = Shape::Bands {
+const SHAPE_BEFORE_8: Shape = Shape::Bands {
     region: 6,
     band: 2,
     whole: 256,
