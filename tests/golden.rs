@@ -366,8 +366,9 @@ fn came_streams_of_balanced_hierarchies_still_decode_and_refine() {
 
 /// `came` streams of syntax 7, whose bands span regions of six levels, still decode exactly and
 /// refine: `came-eight-before-regions-of-four.mc` is the golden stream of that build, kept.
-/// Today's cuts the same tree into bands over regions of four (docs/FORMAT.md §8.1), so a front
-/// is the same whichever stream it reads.
+/// Today's cuts the same tree into bands over regions of four (docs/FORMAT.md §8.1): the far
+/// front on eight.off is the same from either (on larger meshes fronts may differ by a few
+/// faces, a front's passes following the order its units came in).
 #[test]
 fn came_streams_of_six_level_regions_still_decode_and_refine() {
     let (old, new) = kept_came_stream_and_todays("came-eight-before-regions-of-four.mc");
