@@ -417,7 +417,7 @@ fn streams_of_another_format_version_are_refused_in_one_line() {
     let codec = codecs::by_name("raw").unwrap();
     let [(_, eight)] = read_all(["eight"]);
     let mut bytes = codec.encode(&canonical(codec, &eight)).unwrap().bytes;
-    for version in [0, 1, 2, 3, 4, 5, FORMAT_VERSION + 1, 255] {
+    for version in [0, 1, 2, 3, 4, 5, 6, FORMAT_VERSION + 1, 255] {
         bytes[4] = version;
         match codecs::decode(&bytes, Stop::All) {
             Err(e @ Error::Unsupported(_)) => {

@@ -102,17 +102,32 @@ fn headers_claiming_too_much_are_refused_as_limits() {
             );
             assert!(peak < ONE_MIB, "{codec}, {what}: {peak} bytes allocated");
         }
-        // An index claiming 10^9 units, or more than its bytes can list, allocates nothing.
+        // An index claiming 10^9 units, more than its entry bytes can list, or entry bytes
+        // the stream does not hold, allocates nothing.
         let (_, index, payload_start) = container::read_header_and_index(&bytes).unwrap();
-        for units in [1_000_000_000u64, 1 << 19] {
+        let mut pos = body;
+        let counts: Vec<u64> = (0..3)
+            .map(|_| varint::get(&bytes, &mut pos).unwrap())
+            .collect();
+        let entries = &bytes[pos..payload_start];
+        for (units, entry_bytes) in [
+            (1_000_000_000u64, counts[1]),
+            (1 << 19, counts[1]),
+            (1 << 19, 1 << 20),
+        ] {
             let mut hostile = bytes[..body].to_vec();
             varint::put(&mut hostile, units);
+            varint::put(&mut hostile, entry_bytes);
             varint::put(&mut hostile, index.payload_bytes);
+            hostile.extend_from_slice(entries);
             hostile.extend_from_slice(&bytes[payload_start..]);
             let (outcome, peak) = peak_of(|| codecs::decode(&hostile, Stop::All));
             assert!(
-                matches!(outcome, Err(Error::Limit(_)) | Err(Error::Truncated(_))),
-                "{codec}, {units} units: {:?}",
+                matches!(
+                    outcome,
+                    Err(Error::Limit(_)) | Err(Error::Truncated(_)) | Err(Error::Malformed { .. })
+                ),
+                "{codec}, {units} units in {entry_bytes} bytes: {:?}",
                 outcome.map(|(m, _)| m.mesh.vertex_count())
             );
             assert!(

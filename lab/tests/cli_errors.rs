@@ -195,6 +195,16 @@ fn with_index(stream: &[u8], edit: impl Fn(&mut meshcodec::container::Index)) ->
     out
 }
 
+/// `stream` with its last unit's index entry claiming `children` units (its last byte, a
+/// one-byte count of 0 in every stream of this build).
+fn with_children_of_the_last_unit(stream: &[u8], children: u8) -> Vec<u8> {
+    let (_, _, payload_start) = meshcodec::container::read_header_and_index(stream).unwrap();
+    let mut out = stream.to_vec();
+    assert_eq!(out[payload_start - 1], 0);
+    out[payload_start - 1] = children;
+    out
+}
+
 #[test]
 fn foreign_versions_lying_indexes_and_impossible_stops_fail_cleanly() {
     let dir = scratch();
@@ -205,13 +215,15 @@ fn foreign_versions_lying_indexes_and_impossible_stops_fail_cleanly() {
     let mut old = stream.clone();
     old[4] = 1;
     let past = with_index(&stream, |index| index.units[11].length += 1000);
-    let overlapping = with_index(&stream, |index| {
-        index.units[4].offset = index.units[3].offset;
-    });
+    let childless = with_children_of_the_last_unit(&stream, 1);
     let cases: [(&str, &[u8], &str); 3] = [
         ("old.mc", &old, "format version 1"),
         ("past.mc", &past, "runs past"),
-        ("overlapping.mc", &overlapping, "overlap"),
+        (
+            "children.mc",
+            &childless,
+            "unit 11 has 1 children, 0 units follow",
+        ),
     ];
     for (name, bytes, mentions) in cases {
         write(d, name, bytes);

@@ -179,15 +179,15 @@ mod tests {
     #[test]
     fn streams_describe_themselves() {
         for name in [
-            "v6/raw-eight.mc",
-            "v6/emc-beethoven.mc",
-            "v6/emc-paper-eight.mc",
-            "v6/pm-bunny-res4.mc",
-            "v6/pm-reordered-eight.mc",
-            "v6/came-eight.mc",
-            "v6/came-paper-eight.mc",
-            "v6/emc-spot-appearance.mc",
-            "v6/pm-reordered-spot-appearance-fit.mc",
+            "v7/raw-eight.mc",
+            "v7/emc-beethoven.mc",
+            "v7/emc-paper-eight.mc",
+            "v7/pm-bunny-res4.mc",
+            "v7/pm-reordered-eight.mc",
+            "v7/came-eight.mc",
+            "v7/came-paper-eight.mc",
+            "v7/emc-spot-appearance.mc",
+            "v7/pm-reordered-spot-appearance-fit.mc",
         ] {
             let bytes = golden(name);
             let info = StreamInfo::of(&bytes).unwrap();
@@ -227,7 +227,7 @@ mod tests {
     /// `info`; the WebAssembly package's in camelCase), flattened facts included.
     #[test]
     fn the_serde_form_has_the_documented_keys() {
-        let info = StreamInfo::of(&golden("v6/pm-bunny-res4.mc")).unwrap();
+        let info = StreamInfo::of(&golden("v7/pm-bunny-res4.mc")).unwrap();
         let value = serde_json::to_value(&info).unwrap();
         let keys: Vec<&str> = value
             .as_object()

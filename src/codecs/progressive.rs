@@ -110,12 +110,12 @@ mod tests {
     #[test]
     fn levels_fed_in_chunks_are_the_levels_of_the_prefix() {
         for (name, incremental) in [
-            ("v6/emc-eight.mc", true),
-            ("v6/emc-paper-beethoven.mc", true),
-            ("v6/raw-eight.mc", true),
-            ("v6/pm-eight.mc", false),
-            ("v6/came-eight.mc", false),
-            ("v6/emc-spot-appearance.mc", false),
+            ("v7/emc-eight.mc", true),
+            ("v7/emc-paper-beethoven.mc", true),
+            ("v7/raw-eight.mc", true),
+            ("v7/pm-eight.mc", false),
+            ("v7/came-eight.mc", false),
+            ("v7/emc-spot-appearance.mc", false),
         ] {
             let bytes = golden(name);
             for chunk in [1, 7, 100, 4096] {
@@ -151,15 +151,15 @@ mod tests {
     /// `decode` ends on it whole: in the same error, or the same mesh.
     #[test]
     fn bytes_past_the_end_are_an_error_and_corrupt_streams_end_as_decode_ends() {
-        let bytes = golden("v6/emc-eight.mc");
+        let bytes = golden("v7/emc-eight.mc");
         let mut progressive = Progressive::new();
         progressive.push(&bytes).unwrap();
         let e = progressive.push(&[0]).unwrap_err().to_string();
         assert!(e.contains("after the last unit"), "{e}");
         for (name, at) in [
-            ("v6/emc-eight.mc", 0.9),
-            ("v6/emc-beethoven.mc", 0.5),
-            ("v6/emc-beethoven.mc", 0.1),
+            ("v7/emc-eight.mc", 0.9),
+            ("v7/emc-beethoven.mc", 0.5),
+            ("v7/emc-beethoven.mc", 0.1),
         ] {
             let mut corrupt = golden(name);
             let k = (corrupt.len() as f64 * at) as usize;

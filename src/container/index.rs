@@ -101,88 +101,231 @@ impl Index {
         self.units.is_empty()
     }
 
-    /// Appends the index's bytes to `out`.
+    /// Appends the index's bytes to `out`. The units lie back to back in order and form a
+    /// tree in breadth-first order (FORMAT.md §2): the writers' own layout, checked here.
     pub fn write(&self, out: &mut Vec<u8>) {
-        varint::put(
-            out,
-            (self.units.len() + self.appearance.is_some() as usize) as u64,
-        );
-        varint::put(out, self.payload_bytes);
-        for (i, unit) in self.units.iter().chain(&self.appearance).enumerate() {
-            varint::put(out, unit.offset);
-            varint::put(out, unit.length);
-            varint::put(out, unit.parent.map_or(0, |p| (i - p) as u64));
+        let units: Vec<UnitEntry> = self.units.iter().chain(&self.appearance).copied().collect();
+        let mut children = vec![0u64; units.len()];
+        let mut offset = 0;
+        for unit in &units {
+            assert_eq!(
+                unit.offset, offset,
+                "units are written back to back in order"
+            );
+            offset += unit.length;
+            if let Some(parent) = unit.parent {
+                children[parent] += 1;
+            }
         }
+        let mut entries = Vec::new();
+        for (unit, &count) in units.iter().zip(&children) {
+            varint::put(&mut entries, unit.length);
+            varint::put(&mut entries, count);
+        }
+        let mut read_back = Tree::default();
+        for (i, &count) in children.iter().enumerate() {
+            assert_eq!(
+                read_back.take(i, count, units.len()).ok(),
+                Some(units[i].parent),
+                "units are written in breadth-first order"
+            );
+        }
+        varint::put(out, units.len() as u64);
+        varint::put(out, entries.len() as u64);
+        varint::put(out, self.payload_bytes);
+        out.extend_from_slice(&entries);
     }
 
     /// Reads and checks an index from `bytes` at `pos`.
     pub(super) fn read(bytes: &[u8], pos: &mut usize) -> Result<Index> {
+        let mut partial = PartialIndex::start(bytes, pos)?;
+        if bytes.len() < partial.payload_start {
+            return Err(Error::Truncated("the stream ends inside its index".into()));
+        }
+        partial.read_on(bytes)?;
+        *pos = partial.payload_start;
+        partial.finish()
+    }
+}
+
+/// The parents that the children counts read so far give: unit 0 needs no other; the units
+/// after it are, in order, the children of unit 0, then those of unit 1, and so on, each
+/// unit's after it; a unit no earlier unit counts among its children needs no other.
+#[derive(Clone, Debug, Default)]
+struct Tree {
+    /// The first unit not yet given a parent.
+    next: usize,
+    /// Units given a parent and not yet read: (first, last + 1, parent), in order.
+    waiting: std::collections::VecDeque<(usize, usize, usize)>,
+}
+
+impl Tree {
+    /// Unit `i`'s parent, now that its entry is read and says it has `children` (of `units`
+    /// in all); `Err` with what is wrong when the children run past the last unit.
+    fn take(
+        &mut self,
+        i: usize,
+        children: u64,
+        units: usize,
+    ) -> std::result::Result<Option<usize>, String> {
+        while self.waiting.front().is_some_and(|&(_, end, _)| end <= i) {
+            self.waiting.pop_front();
+        }
+        let parent = self
+            .waiting
+            .front()
+            .filter(|&&(first, _, _)| first <= i)
+            .map(|&(_, _, parent)| parent);
+        if children > 0 {
+            let first = self.next.max(i + 1);
+            if children > (units - first) as u64 {
+                return Err(format!(
+                    "unit {i} has {children} children, {} units follow those listed before",
+                    units - first
+                ));
+            }
+            self.next = first + children as usize;
+            self.waiting.push_back((first, self.next, i));
+        }
+        Ok(parent)
+    }
+}
+
+/// An index read entry by entry, as far as the bytes fetched so far hold it: a client that
+/// fetches units by their byte ranges needs the entries up to the last unit it reads, and the
+/// payload's offset is known from the index's first bytes (FORMAT.md §2). Each entry is
+/// checked as it is read (inside the payload, its children after it and before the last
+/// unit), and the whole index once its last entry is in ([`PartialIndex::finish`]).
+#[derive(Clone, Debug)]
+pub struct PartialIndex {
+    /// Units the index lists.
+    pub listed: usize,
+    /// The entries read so far (the first [`Index::len`] units) and the payload's bytes.
+    pub index: Index,
+    /// Offset of the payload in the stream.
+    pub payload_start: usize,
+    /// Offset in the stream just past the last entry read.
+    end: usize,
+    tree: Tree,
+}
+
+impl PartialIndex {
+    /// The index at `pos` of `bytes`, before its entries: its counts, checked against the
+    /// limits. `pos` moves past them.
+    pub fn start(bytes: &[u8], pos: &mut usize) -> Result<PartialIndex> {
         let units = read_count(bytes, pos, "units", limits::MAX_UNITS)?;
+        let entry_bytes = read_count(bytes, pos, "index bytes", limits::MAX_UNITS * 20)?;
         let payload_bytes = read_count(bytes, pos, "payload bytes", u64::MAX >> 1)?;
         if units == 0 {
             return Err(Error::malformed(0, *pos, "the index lists no unit"));
         }
-        // Nothing is allocated for the entries before the bytes that must hold them are there.
-        if ((bytes.len() - *pos) as u64) < units * MIN_ENTRY_BYTES {
-            return Err(Error::Truncated("the stream ends inside its index".into()));
+        if entry_bytes < units * MIN_ENTRY_BYTES {
+            return Err(Error::malformed(
+                0,
+                *pos,
+                format!("index: {units} units in {entry_bytes} bytes"),
+            ));
         }
-        let mut entries = Vec::with_capacity(units as usize);
-        for i in 0..units as usize {
-            let at = *pos;
-            // Bounded so that their sum cannot overflow; checked against the payload below.
-            let offset = read_count(bytes, pos, "unit offset", u64::MAX >> 2)?;
-            let length = read_count(bytes, pos, "unit length", u64::MAX >> 2)?;
-            let back = read_count(bytes, pos, "parent distance", i as u64)?;
-            if offset + length > payload_bytes {
+        Ok(PartialIndex {
+            listed: units as usize,
+            index: Index {
+                units: Vec::new(),
+                payload_bytes,
+                appearance: None,
+            },
+            payload_start: *pos + entry_bytes as usize,
+            end: *pos,
+            tree: Tree::default(),
+        })
+    }
+
+    /// True once every entry is read.
+    pub fn is_complete(&self) -> bool {
+        self.index.units.len() == self.listed
+    }
+
+    /// Reads on every whole entry that `bytes` (the stream's first bytes, as many as are
+    /// fetched) holds past those read.
+    pub fn read_on(&mut self, bytes: &[u8]) -> Result<()> {
+        let within = &bytes[..bytes.len().min(self.payload_start)];
+        while !self.is_complete() {
+            let i = self.index.units.len();
+            let at = self.end;
+            let mut pos = at;
+            let entry =
+                read_count(within, &mut pos, "unit length", u64::MAX >> 2).and_then(|length| {
+                    Ok((
+                        length,
+                        read_count(within, &mut pos, "children", limits::MAX_UNITS)?,
+                    ))
+                });
+            let (length, children) = match entry {
+                Ok(entry) => entry,
+                // Cut where the index ends: its byte count lied.
+                Err(Error::Truncated(_)) if within.len() == self.payload_start => {
+                    return Err(Error::malformed(
+                        0,
+                        at,
+                        format!("index: entry {i} runs past the index's end"),
+                    ))
+                }
+                // Cut where the bytes fetched end: read on once more are.
+                Err(Error::Truncated(_)) => return Ok(()),
+                Err(e) => return Err(e),
+            };
+            let offset = self.index.units.last().map_or(0, UnitEntry::end);
+            if length > self.index.payload_bytes - offset {
                 return Err(Error::malformed(
                     0,
                     at,
                     format!(
-                        "index: unit {i} (bytes {offset}..{}) runs past the {payload_bytes} payload bytes",
-                        offset + length
+                        "index: unit {i} (bytes {offset}..{}) runs past the {} payload bytes",
+                        offset + length,
+                        self.index.payload_bytes
                     ),
                 ));
             }
-            entries.push(UnitEntry {
+            let parent = self
+                .tree
+                .take(i, children, self.listed)
+                .map_err(|e| Error::malformed(0, at, format!("index: {e}")))?;
+            self.index.units.push(UnitEntry {
                 offset,
                 length,
-                parent: (back > 0).then(|| i - back as usize),
+                parent,
             });
+            self.end = pos;
         }
-        let mut by_offset: Vec<usize> = (0..entries.len()).collect();
-        by_offset.sort_by_key(|&i| (entries[i].offset, entries[i].length));
-        for pair in by_offset.windows(2) {
-            let (a, b) = (entries[pair[0]], entries[pair[1]]);
-            if b.offset < a.end() {
-                return Err(Error::malformed(
-                    0,
-                    *pos,
-                    format!(
-                        "index: units {} (bytes {}..{}) and {} (bytes {}..{}) overlap",
-                        pair[0],
-                        a.offset,
-                        a.end(),
-                        pair[1],
-                        b.offset,
-                        b.end()
-                    ),
-                ));
-            }
-        }
-        let covered: u64 = entries.iter().map(|u| u.length).sum();
-        if covered != payload_bytes {
+        if self.end != self.payload_start && bytes.len() >= self.payload_start {
             return Err(Error::malformed(
                 0,
-                *pos,
+                self.end,
                 format!(
-                    "index: units cover {covered} of the {payload_bytes} payload bytes it declares"
+                    "index: its entries end at byte {}, it says at {}",
+                    self.end, self.payload_start
                 ),
             ));
         }
-        Ok(Index {
-            units: entries,
-            payload_bytes,
-            appearance: None,
-        })
+        Ok(())
+    }
+
+    /// The whole index, once every entry is read: refused if its units leave payload bytes
+    /// uncovered.
+    pub fn finish(self) -> Result<Index> {
+        if !self.is_complete() {
+            return Err(Error::Truncated("the stream ends inside its index".into()));
+        }
+        let covered = self.index.units.last().map_or(0, UnitEntry::end);
+        if covered != self.index.payload_bytes {
+            return Err(Error::malformed(
+                0,
+                self.end,
+                format!(
+                    "index: units cover {covered} of the {} payload bytes it declares",
+                    self.index.payload_bytes
+                ),
+            ));
+        }
+        Ok(self.index)
     }
 }

@@ -7,16 +7,19 @@
 //! grid: bits (u8), origin 3 × f64 LE, cell 3 × f64 LE
 //! vertices (varint)  triangles (varint)                        -- of the full mesh
 //! appearance flags (u8; 0: none), then each attribute's quantization, names
-//! index: units N (varint), payload bytes P (varint),
-//!        N × { offset (varint), length (varint), parent (varint: 0 = none, k = unit i − k) }
-//! payload: P bytes, every byte in exactly one unit
+//! index: units N (varint), entry bytes E (varint), payload bytes P (varint),
+//!        N × { length (varint), children (varint) }             -- E bytes
+//! payload: P bytes, the units back to back in index order
 //! ```
 //! A unit is what a decoder can take on its own once the units it depends on are decoded: a level
 //! for the layered codecs (each level's parent is the level before), a meta-node for a hierarchy
-//! fetched by parts. A reader holding the header and index can fetch any unit by its byte range;
-//! a prefix of the stream decodes to the units wholly inside it. The index is checked whole —
-//! counts against [`crate::limits`] and the bytes that hold them, ranges inside the payload,
-//! no overlaps, no stray bytes — before anything is allocated for what it claims.
+//! fetched by parts. The children counts give each unit's parent: the units after the first are
+//! the children of unit 0, then those of unit 1, and so on (breadth first). A reader holding the
+//! header and index can fetch any unit by its byte range, and one holding the index's first
+//! entries ([`PartialIndex`]) any unit among them; a prefix of the stream decodes to the units
+//! wholly inside it. Counts are checked against [`crate::limits`] and the bytes that hold them
+//! before anything is allocated for what they claim; each entry as it is read (inside the
+//! payload, its children after it); the whole index once read (no stray bytes).
 
 use crate::coding::varint;
 use crate::error::{Error, Result};
@@ -27,11 +30,11 @@ pub const MAGIC: [u8; 4] = *b"MshC";
 /// Version of the stream format: bumped on every change to the bytes any codec writes
 /// (docs/FORMAT.md, "History"). Every stream of this build is written in it, with or without
 /// appearance (the appearance flags say which), and it is the only version this build reads:
-/// version 6 names each codec's syntax in a byte of its own where earlier versions told
-/// syntaxes apart by the length of their parameters.
-pub const FORMAT_VERSION: u8 = 6;
-/// The fewest bytes an index entry takes (three one-byte varints).
-const MIN_ENTRY_BYTES: u64 = 3;
+/// version 7 gives each unit's length and children count where version 6 gave its offset,
+/// length and parent (a version 6 stream re-encodes to the same payload).
+pub const FORMAT_VERSION: u8 = 7;
+/// The fewest bytes an index entry takes (two one-byte varints).
+const MIN_ENTRY_BYTES: u64 = 2;
 
 mod header;
 mod index;
@@ -41,7 +44,7 @@ mod tests;
 mod writer;
 
 pub use header::{AppearanceSpec, Header, MaterialNames};
-pub use index::{Index, UnitEntry};
+pub use index::{Index, PartialIndex, UnitEntry};
 pub use reader::{LevelPayload, LevelSource, OwnedLevel, ReadLevels, StreamReader};
 pub use writer::{LevelCost, LevelRecord, StreamWriter};
 

@@ -122,6 +122,7 @@ fn unknown_versions_are_refused() {
     // Earlier versions told codec syntaxes apart by their parameters' length: refused, with
     // what to do.
     for version in 2..FORMAT_VERSION {
+        // Version 6's index named each unit's offset and parent.
         bytes[4] = version;
         let e = StreamReader::open(&bytes).unwrap_err().to_string();
         assert!(
@@ -144,55 +145,90 @@ fn the_appearance_flags_close_the_header() {
     assert_eq!(bytes[6], 1, "the syntax byte follows the codec id");
 }
 
+/// A stream with `header()`, an index of `units` entries (length, children) in `entry_bytes`
+/// bytes (their own length when `None`) over `payload_bytes`, then the payload's bytes.
+fn with_entries(units: &[(u64, u64)], entry_bytes: Option<u64>, payload_bytes: u64) -> Vec<u8> {
+    let mut entries = Vec::new();
+    for &(length, children) in units {
+        varint::put(&mut entries, length);
+        varint::put(&mut entries, children);
+    }
+    let mut bytes = Vec::new();
+    header().write(&mut bytes);
+    varint::put(&mut bytes, units.len() as u64);
+    varint::put(&mut bytes, entry_bytes.unwrap_or(entries.len() as u64));
+    varint::put(&mut bytes, payload_bytes);
+    bytes.extend_from_slice(&entries);
+    bytes.extend(std::iter::repeat_n(0, payload_bytes as usize));
+    bytes
+}
+
 #[test]
 fn lying_indexes_are_refused() {
-    let entry = |offset, length, parent| UnitEntry {
-        offset,
-        length,
-        parent,
-    };
-    let past = Index {
-        units: vec![entry(0, 4, None), entry(4, 10, Some(0))],
-        payload_bytes: 8,
-        appearance: None,
-    };
-    let e = StreamReader::open(&with_index(&past, &[0; 8])).unwrap_err();
-    assert!(e.to_string().contains("runs past"), "{e}");
-    let overlapping = Index {
-        units: vec![entry(0, 6, None), entry(4, 2, Some(0))],
-        payload_bytes: 8,
-        appearance: None,
-    };
-    let e = StreamReader::open(&with_index(&overlapping, &[0; 8])).unwrap_err();
-    assert!(e.to_string().contains("overlap"), "{e}");
-    let gap = Index {
-        units: vec![entry(0, 2, None), entry(4, 2, Some(0))],
-        payload_bytes: 8,
-        appearance: None,
-    };
-    let e = StreamReader::open(&with_index(&gap, &[0; 8])).unwrap_err();
-    assert!(e.to_string().contains("cover 4 of the 8"), "{e}");
-    // A count of units the bytes cannot hold is refused before any entry is read.
+    let refusal = |bytes: Vec<u8>| StreamReader::open(&bytes).unwrap_err().to_string();
+    let e = refusal(with_entries(&[(4, 1), (10, 0)], None, 8));
+    assert!(e.contains("runs past"), "{e}");
+    let e = refusal(with_entries(&[(2, 1), (2, 0)], None, 8));
+    assert!(e.contains("cover 4 of the 8"), "{e}");
+    // More children than units follow.
+    let e = refusal(with_entries(&[(4, 2), (4, 0)], None, 8));
+    assert!(e.contains("unit 0 has 2 children"), "{e}");
+    // Index bytes that end inside an entry, or after the entries end.
+    let e = refusal(with_entries(&[(200, 1), (200, 0)], Some(5), 400));
+    assert!(e.contains("runs past the index's end"), "{e}");
+    let e = refusal(with_entries(&[(200, 1), (200, 0)], Some(7), 400));
+    assert!(e.contains("it says at"), "{e}");
+    // A count of units its index bytes cannot hold is refused before any entry is read, and
+    // so is a count of index bytes the stream does not hold.
     let mut huge = Vec::new();
     header().write(&mut huge);
     varint::put(&mut huge, limits::MAX_UNITS);
+    varint::put(&mut huge, 8);
+    varint::put(&mut huge, 8);
+    assert!(refusal(huge.clone()).contains("units in 8 bytes"));
+    huge.truncate(huge.len() - 2);
+    varint::put(&mut huge, limits::MAX_UNITS * 2);
     varint::put(&mut huge, 8);
     assert!(matches!(
         StreamReader::open(&huge),
         Err(Error::Truncated(_))
     ));
-    // Units out of order are a valid index, but not the levels of a layered codec.
-    let swapped = Index {
-        units: vec![entry(4, 4, None), entry(0, 4, Some(0))],
-        payload_bytes: 8,
-        appearance: None,
-    };
-    let bytes = with_index(&swapped, &[0; 8]);
-    assert!(StreamReader::open(&bytes).is_ok());
-    assert!(StreamReader::open(&bytes)
-        .unwrap()
-        .require_layered()
-        .is_err());
+    // Two units that both need no other are a valid index, but not the levels of a layered
+    // codec.
+    let bytes = with_entries(&[(4, 0), (4, 0)], None, 8);
+    let reader = StreamReader::open(&bytes).unwrap();
+    assert_eq!(reader.index().units[1].parent, None);
+    assert!(reader.require_layered().is_err());
+}
+
+/// Children counts give each unit's parent breadth first; an index read by parts gives the
+/// same entries as the whole, the payload's offset from its first bytes.
+#[test]
+fn children_counts_give_parents_breadth_first_and_read_by_parts() {
+    // 0 → 1, 2; 1 → 3; 2 → 4, 5; then a unit that needs none.
+    let units = [(3, 2), (1, 1), (2, 2), (1, 0), (1, 0), (1, 0), (2, 0)];
+    let bytes = with_entries(&units, None, 11);
+    let reader = StreamReader::open(&bytes).unwrap();
+    let parents: Vec<Option<usize>> = reader.index().units.iter().map(|u| u.parent).collect();
+    assert_eq!(
+        parents,
+        [None, Some(0), Some(0), Some(1), Some(2), Some(2), None]
+    );
+    let offsets: Vec<u64> = reader.index().units.iter().map(|u| u.offset).collect();
+    assert_eq!(offsets, [0, 3, 4, 6, 7, 8, 9]);
+    // Written back, the same bytes.
+    assert_eq!(with_index(reader.index(), &[0; 11]), bytes);
+    let (_, mut pos) = Header::read(&bytes).unwrap();
+    let mut partial = PartialIndex::start(&bytes, &mut pos).unwrap();
+    assert_eq!(partial.payload_start, reader.payload_start());
+    for cut in pos..=partial.payload_start {
+        partial.read_on(&bytes[..cut]).unwrap();
+        assert_eq!(
+            partial.index.units[..],
+            reader.index().units[..partial.index.len()]
+        );
+    }
+    assert_eq!(partial.finish().unwrap(), *reader.index());
 }
 
 #[test]
