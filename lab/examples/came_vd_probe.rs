@@ -65,8 +65,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let error = reference.screen_error(&front.mesh(), &camera, &view);
         let fetched = front.fetched();
         println!(
-            "guard {guard}: {} faces, {ms:.1} ms, {:.1}% of {} bytes ({} of {} units), {folded} folded in the frustum ({shown} spanning the tolerance), error max {:.3} px, mean {:.3} px",
+            "guard {guard}: {} faces, {ms:.1} ms, {} bytes read, {:.2}% of {} ({} of {} units), {folded} folded in the frustum ({shown} spanning the tolerance), error max {:.3} px, mean {:.3} px",
             front.face_count(),
+            fetched.bytes_read,
             100.0 * fetched.bytes_read as f64 / fetched.stream_bytes as f64,
             fetched.stream_bytes,
             fetched.units_loaded,

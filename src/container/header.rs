@@ -213,6 +213,12 @@ impl AppearanceSpec {
 }
 
 impl Header {
+    /// True when the index's last unit is the appearance unit (docs/FORMAT.md §1.1): the
+    /// stream carries appearance outside its levels.
+    pub fn has_appearance_unit(&self) -> bool {
+        self.appearance.as_ref().is_some_and(|a| !a.in_levels)
+    }
+
     /// Appends the header's bytes to `out`.
     pub fn write(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(&MAGIC);

@@ -125,7 +125,10 @@ impl Index {
         let mut read_back = Tree::default();
         for (i, &count) in children.iter().enumerate() {
             assert_eq!(
-                read_back.take(i, count, units.len()).ok(),
+                read_back
+                    .take(i, count, units.len())
+                    .ok()
+                    .map(|(parent, _)| parent),
                 Some(units[i].parent),
                 "units are written in breadth-first order"
             );
@@ -160,14 +163,15 @@ struct Tree {
 }
 
 impl Tree {
-    /// Unit `i`'s parent, now that its entry is read and says it has `children` (of `units`
-    /// in all); `Err` with what is wrong when the children run past the last unit.
+    /// Unit `i`'s parent and its children, now that its entry is read and says it has
+    /// `children` (of `units` in all); `Err` with what is wrong when the children run past the
+    /// last unit.
     fn take(
         &mut self,
         i: usize,
         children: u64,
         units: usize,
-    ) -> std::result::Result<Option<usize>, String> {
+    ) -> std::result::Result<(Option<usize>, std::ops::Range<usize>), String> {
         while self.waiting.front().is_some_and(|&(_, end, _)| end <= i) {
             self.waiting.pop_front();
         }
@@ -176,18 +180,19 @@ impl Tree {
             .front()
             .filter(|&&(first, _, _)| first <= i)
             .map(|&(_, _, parent)| parent);
-        if children > 0 {
-            let first = self.next.max(i + 1);
-            if children > (units - first) as u64 {
-                return Err(format!(
-                    "unit {i} has {children} children, {} units follow those listed before",
-                    units - first
-                ));
-            }
-            self.next = first + children as usize;
-            self.waiting.push_back((first, self.next, i));
+        let first = self.next.max(i + 1);
+        if children == 0 {
+            return Ok((parent, first..first));
         }
-        Ok(parent)
+        if children > (units - first) as u64 {
+            return Err(format!(
+                "unit {i} has {children} children, {} units follow those listed before",
+                units - first
+            ));
+        }
+        self.next = first + children as usize;
+        self.waiting.push_back((first, self.next, i));
+        Ok((parent, first..self.next))
     }
 }
 
@@ -202,6 +207,8 @@ pub struct PartialIndex {
     pub listed: usize,
     /// The entries read so far (the first [`Index::len`] units) and the payload's bytes.
     pub index: Index,
+    /// Per entry read: the units that need it decoded first (its children, consecutive).
+    pub children: Vec<std::ops::Range<usize>>,
     /// Offset of the payload in the stream.
     pub payload_start: usize,
     /// Offset in the stream just past the last entry read.
@@ -233,6 +240,7 @@ impl PartialIndex {
                 payload_bytes,
                 appearance: None,
             },
+            children: Vec::new(),
             payload_start: *pos + entry_bytes as usize,
             end: *pos,
             tree: Tree::default(),
@@ -285,10 +293,11 @@ impl PartialIndex {
                     ),
                 ));
             }
-            let parent = self
+            let (parent, children) = self
                 .tree
                 .take(i, children, self.listed)
                 .map_err(|e| Error::malformed(0, at, format!("index: {e}")))?;
+            self.children.push(children);
             self.index.units.push(UnitEntry {
                 offset,
                 length,

@@ -73,7 +73,7 @@ fn read_count(bytes: &[u8], pos: &mut usize, what: &str, limit: u64) -> Result<u
 pub fn read_header_and_index(bytes: &[u8]) -> Result<(Header, Index, usize)> {
     let (header, mut pos) = Header::read(bytes)?;
     let mut index = Index::read(bytes, &mut pos)?;
-    if header.appearance.as_ref().is_some_and(|a| !a.in_levels) {
+    if header.has_appearance_unit() {
         if index.units.len() < 2 {
             return Err(Error::malformed(
                 0,

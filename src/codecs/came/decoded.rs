@@ -5,7 +5,7 @@
 use super::knowledge::{status, Status};
 use super::Params;
 use crate::codecs::{LevelDecoder, LevelMesh};
-use crate::container::{Header, Index, StreamReader};
+use crate::container::{Header, Index, PartialIndex, StreamReader};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::CodedCone;
 pub use crate::hierarchy::came::face_normals::FaceNormal;
@@ -362,10 +362,11 @@ pub struct CameDecoder<'a, U: UnitDecoder> {
     tree: DecodedTree,
     /// Per unit: the roots of its child units, once it is decoded.
     child_roots: Vec<Option<Vec<u32>>>,
-    /// Per unit: its rank among its parent's children in the index.
-    rank: Vec<usize>,
-    /// Per unit: its children in the index, in order.
-    unit_children: Vec<Vec<usize>>,
+    /// Per unit: its children in the index (consecutive: the index lists units breadth first).
+    unit_children: Vec<std::ops::Range<usize>>,
+    /// Units the index lists, of which `index` holds those read so far (a detached decoder's
+    /// index grows as a client reads on: [`CameDecoder::extend_index`]).
+    listed: usize,
     /// Per unit: the triangles it decoded (a range of `tree.triangles`).
     unit_triangles: Vec<Option<std::ops::Range<usize>>>,
     /// Units decoded in stream order for levels.
@@ -414,20 +415,18 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                 "a CAME stream codes a mesh of at least one triangle",
             ));
         }
-        if index.units.first().is_some_and(|u| u.parent.is_some()) {
-            return Err(Error::malformed(
-                0,
-                0,
-                "the first unit cannot have a parent",
-            ));
-        }
-        let mut children = vec![Vec::new(); index.len()];
-        let mut rank = vec![0usize; index.len()];
+        let mut children: Vec<std::ops::Range<usize>> = Vec::with_capacity(index.len());
         for (i, unit) in index.units.iter().enumerate() {
+            children.push(i + 1..i + 1);
             match unit.parent {
-                Some(p) => {
-                    rank[i] = children[p].len();
-                    children[p].push(i);
+                Some(p) if children[p].is_empty() => children[p] = i..i + 1,
+                Some(p) if children[p].end == i => children[p].end += 1,
+                Some(_) => {
+                    return Err(Error::malformed(
+                        0,
+                        0,
+                        format!("the index lists unit {i} apart from its parent's other children"),
+                    ))
                 }
                 None if i > 0 => {
                     return Err(Error::malformed(0, 0, "only the first unit has no parent"))
@@ -442,8 +441,8 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         Ok(CameDecoder {
             child_roots: vec![None; index.len()],
             unit_triangles: vec![None; index.len()],
-            rank,
             unit_children: children,
+            listed: index.len(),
             header,
             index,
             payload_start,
@@ -454,6 +453,28 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
             units_in_order: 0,
             levels_decoded: 0,
         })
+    }
+
+    /// Takes the entries of `index` past those this decoder holds: a detached decoder's index
+    /// read entry by entry as a client fetches on (docs/FORMAT.md §2). A unit decodes once its
+    /// own entry is in: its children's numbers come with it. The appearance unit, where the
+    /// header declares one, is not the codec's.
+    pub fn extend_index(&mut self, index: &PartialIndex) -> Result<()> {
+        let codec_units = index.listed - self.header.has_appearance_unit() as usize;
+        for i in self.index.len()..index.index.len().min(codec_units) {
+            let entry = index.index.units[i];
+            if i > 0 && entry.parent.is_none() {
+                return Err(Error::malformed(0, 0, "only the first unit has no parent"));
+            }
+            let children = &index.children[i];
+            self.index.units.push(entry);
+            self.unit_children
+                .push(children.start.min(codec_units)..children.end.min(codec_units));
+            self.child_roots.push(None);
+            self.unit_triangles.push(None);
+        }
+        self.listed = codec_units;
+        Ok(())
     }
 
     /// Everything decoded so far.
@@ -495,7 +516,8 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         let Some(roots) = &self.child_roots[parent] else {
             return Ok(None);
         };
-        roots.get(self.rank[i]).copied().map(Some).ok_or_else(|| {
+        let rank = i - self.unit_children[parent].start;
+        roots.get(rank).copied().map(Some).ok_or_else(|| {
             Error::malformed(
                 i + 1,
                 self.payload_start,
@@ -521,7 +543,14 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
     }
 
     fn no_unit(&self, i: usize) -> Error {
-        Error::Unsupported(format!("no unit {i}: the stream has {}", self.index.len()))
+        if i < self.listed {
+            return Error::Unsupported(format!(
+                "unit {i} is not in the index read so far ({} of {} entries)",
+                self.index.len(),
+                self.listed
+            ));
+        }
+        Error::Unsupported(format!("no unit {i}: the stream has {}", self.listed))
     }
 
     /// Decodes unit `i` from `bytes`, the payload its index entry points to (read from wherever
@@ -586,8 +615,9 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
                     root,
                     since: mark,
                     child_units: self.unit_children[i]
-                        .iter()
-                        .map(|&j| (j, children[self.rank[j]]))
+                        .clone()
+                        .zip(&children)
+                        .map(|(j, &root)| (j, root))
                         .collect(),
                 };
                 check(&unit).map(|checked| (checked, children))

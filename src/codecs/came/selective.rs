@@ -8,7 +8,7 @@
 
 use super::decoded::{CameDecoder, DecodedTree, DecodedUnit, UnitDecoder};
 use super::{modelled, paper};
-use crate::container::{Header, Index, StreamReader};
+use crate::container::{Header, Index, PartialIndex, StreamReader};
 use crate::error::Result;
 
 /// A codec whose units are meta-nodes of a vertex hierarchy.
@@ -36,6 +36,10 @@ pub trait DetachedUnits: Send {
         bytes: &[u8],
         check: &mut dyn FnMut(&DecodedUnit) -> Result<()>,
     ) -> Result<()>;
+
+    /// Takes the entries of `index` read since the last call (see
+    /// [`CameDecoder::extend_index`]).
+    fn extend_index(&mut self, index: &PartialIndex) -> Result<()>;
 }
 
 impl<U: UnitDecoder + Send> DetachedUnits for CameDecoder<'static, U> {
@@ -46,6 +50,10 @@ impl<U: UnitDecoder + Send> DetachedUnits for CameDecoder<'static, U> {
         check: &mut dyn FnMut(&DecodedUnit) -> Result<()>,
     ) -> Result<()> {
         self.decode_unit_checked(i, bytes, check)
+    }
+
+    fn extend_index(&mut self, index: &PartialIndex) -> Result<()> {
+        CameDecoder::extend_index(self, index)
     }
 }
 

@@ -9,7 +9,7 @@
 use crate::codecs::came::decoded::{to_world, DecodedTree, DecodedUnit};
 use crate::codecs::came::refining_codec;
 use crate::codecs::came::selective::DetachedUnits;
-use crate::container::{read_header_and_index, Header, Index};
+use crate::container::{read_header_and_index, Header, Index, PartialIndex};
 use crate::error::{Error, Result};
 use crate::hierarchy::came::cones::NormalCone;
 use crate::hierarchy::came::face_normals::FaceNormal;
@@ -235,30 +235,83 @@ fn delta(decoded: &DecodedUnit, header: &Header) -> Result<UnitDelta> {
     Ok(out)
 }
 
+/// How much of the stream a loader reads at a time before its payload.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Reads {
+    /// The first read: the header and the index's first entries.
+    pub first: u64,
+    /// Each read of the index after it.
+    pub index: u64,
+}
+
+impl Reads {
+    /// 512 bytes each: the header and about 150 entries of a `came` stream's index (the units
+    /// of two or three breadth-first tiers of a coarse view), then as many at a time.
+    pub const DEFAULT: Reads = Reads {
+        first: 512,
+        index: 512,
+    };
+}
+
 /// Reads units from a source and decodes them.
 pub(super) struct Worker {
     source: Box<dyn ByteSource>,
-    /// The stream's first bytes, read with the header and index (the first units are in them).
+    /// The stream's first bytes: the header and the index as far as it is read (and, where a
+    /// read ran on, the payload's first bytes).
     head: Vec<u8>,
     decoder: Box<dyn DetachedUnits>,
     header: Header,
-    index: Index,
+    /// The index, read entry by entry as far as the units asked for need.
+    index: PartialIndex,
     payload_start: u64,
     size: Option<u64>,
+    /// Bytes of the index read at a time.
+    index_read: u64,
 }
 
 impl Worker {
+    /// Reads the index on until it lists `unit` (each unit's entry counts its children, so
+    /// their numbers come with it); returns the bytes read.
+    fn read_index_through(&mut self, unit: usize) -> Result<u64> {
+        let mut read = 0;
+        while self.index.index.len() <= unit {
+            if self.index.is_complete() {
+                return Err(Error::Unsupported(format!(
+                    "no unit {unit}: the stream has {}",
+                    self.index.listed
+                )));
+            }
+            let from = self.head.len() as u64;
+            let to = (from + self.index_read)
+                .min(self.payload_start)
+                .max(from + 1);
+            let more = self.source.read_at(from, to - from)?;
+            if more.is_empty() {
+                return Err(Error::Truncated("the stream ends inside its index".into()));
+            }
+            read += more.len() as u64;
+            self.head.extend_from_slice(&more);
+            self.index.read_on(&self.head)?;
+        }
+        self.decoder.extend_index(&self.index)?;
+        Ok(read)
+    }
+
     fn load(&mut self, unit: usize) -> Loaded {
-        let entry = self.index.units[unit];
-        let start = self.payload_start + entry.offset;
         let refused = |bytes: u64, e: Error| Loaded {
             unit,
             bytes,
             outcome: Err(e),
         };
+        let index_read = match self.read_index_through(unit) {
+            Ok(read) => read,
+            Err(e) => return refused(0, e),
+        };
+        let entry = self.index.index.units[unit];
+        let start = self.payload_start + entry.offset;
         if let Some(size) = self.size.filter(|&size| start + entry.length > size) {
             return refused(
-                0,
+                index_read,
                 Error::Truncated(format!(
                     "unit {unit} ends at byte {}, past the stream's end at {size}",
                     start + entry.length
@@ -277,12 +330,12 @@ impl Worker {
                     read = rest.len() as u64;
                     bytes.extend_from_slice(&rest);
                 }
-                Err(e) => return refused(0, Error::Io(e)),
+                Err(e) => return refused(index_read, Error::Io(e)),
             }
         }
         Loaded {
             unit,
-            bytes: read,
+            bytes: index_read + read,
             outcome: self.decode(unit, &bytes),
         }
     }
@@ -299,12 +352,14 @@ impl Worker {
     }
 }
 
-/// What [`Loader::open`] read before the first unit: the header, the index, the root unit.
+/// What [`Loader::open`] read before the first unit: the header, the index's first entries,
+/// the root unit.
 pub(super) struct Opened {
-    pub index: Index,
+    /// The stream's meta-nodes, as its index counts them.
+    pub units: usize,
     /// The stream's length as the header and index give it.
     pub stream_bytes: u64,
-    /// Bytes read for the header and index.
+    /// Bytes read for the header and the index's first entries.
     pub head_bytes: u64,
     pub root: Loaded,
 }
@@ -366,52 +421,85 @@ pub(super) enum Loader {
 }
 
 impl Loader {
-    /// Reads the header and index of the stream in `source` and its first (root) unit.
-    pub fn open(mut source: Box<dyn ByteSource>, fetch: Fetch) -> Result<(Loader, Opened)> {
+    /// Reads the header of the stream in `source`, the first entries of its index (`reads` at
+    /// a time) and its first (root) unit.
+    pub(super) fn open(
+        mut source: Box<dyn ByteSource>,
+        fetch: Fetch,
+        reads: Reads,
+    ) -> Result<(Loader, Opened)> {
         let size = source.size();
-        // The header's and index's length is known once they parse: read growing prefixes
-        // (an external source's bytes all at once: the caller fetched them for this).
+        // The header's length is known once it parses: read growing prefixes (an external
+        // source's bytes all at once: the caller fetched them for this, the whole index with
+        // them).
         let mut want = match (fetch, size) {
             (Fetch::External, Some(size)) => size.max(1),
-            _ => 4096u64,
+            _ => reads.first.max(1),
         };
         let mut head = Vec::new();
         let mut head_bytes = 0u64;
-        let (header, index, payload_start) = loop {
+        let (header, mut index) = loop {
             // Each try reads on from where the last stopped.
             let more = source.read_at(head.len() as u64, want - head.len() as u64)?;
             head_bytes += more.len() as u64;
             let ended = (more.len() as u64) < want - head.len() as u64;
             head.extend_from_slice(&more);
-            match read_header_and_index(&head) {
+            let parsed = Header::read(&head)
+                .and_then(|(header, mut pos)| Ok((header, PartialIndex::start(&head, &mut pos)?)));
+            match parsed {
                 Ok(parts) => break parts,
                 Err(Error::Truncated(_)) if !ended => want *= 4,
                 Err(e) => return Err(e),
             }
         };
-        let payload_start = payload_start as u64;
-        let stream_bytes = payload_start + index.payload_bytes;
-        // An external source is a prefix: its length says nothing of the stream's.
+        index.read_on(&head)?;
+        let payload_start = index.payload_start as u64;
+        let stream_bytes = payload_start + index.index.payload_bytes;
+        // An external source is a prefix: its length says nothing of the stream's, and it
+        // holds the whole index.
+        if fetch == Fetch::External && !index.is_complete() {
+            return Err(Error::Truncated("the stream ends inside its index".into()));
+        }
         let size = size.filter(|_| fetch != Fetch::External);
+        // The index's bytes must be there before anything is allocated for what it lists.
+        if size.is_some_and(|size| size < payload_start) {
+            return Err(Error::Truncated("the stream ends inside its index".into()));
+        }
         if let Some(extra) = size
             .and_then(|s| s.checked_sub(stream_bytes))
             .filter(|&e| e > 0)
         {
             return Err(Error::malformed(
-                index.len(),
+                index.listed,
                 stream_bytes as usize,
                 format!("{extra} bytes after the last unit"),
             ));
         }
-        let decoder = refining_codec(&header)?.detached(&header, &index, payload_start as usize)?;
+        let units = index.listed - header.has_appearance_unit() as usize;
+        if units == 0 {
+            return Err(Error::malformed(
+                0,
+                payload_start as usize,
+                "index: a stream with appearance needs a unit of geometry and the appearance unit",
+            ));
+        }
+        // The detached decoder starts from no entry and takes them as they are read.
+        let no_entries = Index {
+            units: Vec::new(),
+            payload_bytes: index.index.payload_bytes,
+            appearance: None,
+        };
+        let decoder =
+            refining_codec(&header)?.detached(&header, &no_entries, payload_start as usize)?;
         let mut worker = Box::new(Worker {
             source,
             head,
             decoder,
             header: header.clone(),
-            index: index.clone(),
+            index,
             payload_start,
             size,
+            index_read: reads.index.max(1),
         });
         // The index lists a unit at least (`Index::read` refuses one that lists none).
         let root = worker.load(0);
@@ -455,7 +543,7 @@ impl Loader {
             }
         };
         let opened = Opened {
-            index,
+            units,
             stream_bytes,
             head_bytes,
             root,
@@ -484,7 +572,7 @@ impl Loader {
         };
         std::iter::from_fn(|| wanted.pop())
             .map(|unit| {
-                let entry = worker.index.units[unit];
+                let entry = worker.index.index.units[unit];
                 let start = worker.payload_start + entry.offset;
                 (unit, start..start + entry.length)
             })
@@ -498,7 +586,7 @@ impl Loader {
             worker, supplied, ..
         } = self
         {
-            let length = worker.index.units[unit].length;
+            let length = worker.index.index.units[unit].length;
             let outcome = if bytes.len() as u64 != length {
                 Err(Error::Truncated(format!(
                     "unit {unit} is {length} bytes; {} were supplied",

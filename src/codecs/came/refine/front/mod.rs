@@ -87,7 +87,7 @@ mod passes;
 mod tests;
 mod topology;
 
-use super::loader::{ByteSource, Fetch, Loader, SeekSource};
+use super::loader::{ByteSource, Fetch, Loader, Reads, SeekSource};
 use super::view::View;
 use crate::error::{Error, Result};
 use glam::DVec3;
@@ -245,8 +245,17 @@ impl ViewMesh {
     /// The front at the root of the stream in `source`, having read its header, its index and
     /// its first meta-node only; the others are fetched as views need them.
     pub fn open(source: impl ByteSource + 'static, fetch: Fetch) -> Result<ViewMesh> {
-        let (loader, opened) = Loader::open(Box::new(source), fetch)?;
-        let mut units = vec![UnitState::Idle; opened.index.len()];
+        ViewMesh::open_reading(source, fetch, Reads::DEFAULT)
+    }
+
+    /// [`ViewMesh::open`], reading the stream's header and index `reads` at a time.
+    pub(super) fn open_reading(
+        source: impl ByteSource + 'static,
+        fetch: Fetch,
+        reads: Reads,
+    ) -> Result<ViewMesh> {
+        let (loader, opened) = Loader::open(Box::new(source), fetch, reads)?;
+        let mut units = vec![UnitState::Idle; opened.units];
         units[0] = UnitState::Requested;
         let mut vm = ViewMesh {
             nodes: Nodes::default(),

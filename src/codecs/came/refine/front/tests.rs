@@ -2,7 +2,7 @@
 //! and far, budgets, picking, loading by thread, inline or by the caller, refused meta-nodes,
 //! no cracks and no fold-overs in view, and random views and meta-node orders (proptest).
 
-use super::super::loader::head_length;
+use super::super::loader::{head_length, Reads};
 use super::super::view::Camera;
 use super::*;
 use crate::codecs::{self, EncodeOptions, Stop};
@@ -347,6 +347,56 @@ fn a_view_of_one_part_fetches_only_the_meta_nodes_it_needs() {
     assert!(done.settled && done.loaded > 0, "{done:?}");
     assert!(fetched.units_loaded < fetched.units, "{fetched:?}");
     assert!(fetched.bytes_read < fetched.stream_bytes, "{fetched:?}");
+}
+
+/// A client reads the index only as far as the meta-nodes it fetches. Read a few bytes at a
+/// time, the root's front reads less than the whole index, a view of one part reads less
+/// than it does from the whole index and adapts alike, and everything refined reads every
+/// byte of the stream once.
+#[test]
+fn the_index_is_read_only_as_far_as_the_meta_nodes_fetched() {
+    let (_, index, payload_start) = read_header_and_index(stream()).unwrap();
+    let header_bytes = crate::container::Header::read(stream()).unwrap().1 as u64;
+    let reads = Reads {
+        first: header_bytes + 4,
+        index: 4,
+    };
+    let open = || {
+        let source = SeekSource(std::io::Cursor::new(stream().to_vec()));
+        ViewMesh::open_reading(source, Fetch::Inline, reads).unwrap()
+    };
+    assert!(index.len() >= 8, "{} units", index.len());
+    let root = open();
+    assert!(
+        root.fetched().bytes_read < payload_start as u64 + index.units[0].length,
+        "{:?}",
+        root.fetched()
+    );
+    let torus = Camera {
+        eye: DVec3::new(0.0, 2.5, 3.0),
+        target: DVec3::new(0.0, 2.5, 0.0),
+        fov_degrees: 30.0,
+        ..camera(DVec3::Z)
+    };
+    let view = View::new(&torus, 1.0).unwrap();
+    let mut whole = ViewMesh::from_stream(stream()).unwrap();
+    whole.settle(&view, Budget::UNLIMITED, 64);
+    let mut part = open();
+    part.settle(&view, Budget::UNLIMITED, 64);
+    part.check_invariants().unwrap();
+    assert_eq!(triangles(&part.mesh()), triangles(&whole.mesh()));
+    let (read, whole_read) = (part.fetched(), whole.fetched());
+    assert_eq!(read.units_loaded, whole_read.units_loaded);
+    assert!(
+        read.bytes_read < whole_read.bytes_read,
+        "{read:?} {whole_read:?}"
+    );
+    let mut all = open();
+    all.settle(&View::everything(), Budget::UNLIMITED, 64);
+    all.check_invariants().unwrap();
+    assert_eq!(all.fetched().bytes_read, stream().len() as u64);
+    let (full, _) = codecs::decode(stream(), Stop::All).unwrap();
+    assert_eq!(triangles(&all.mesh()), triangles(&full.mesh));
 }
 
 #[test]
