@@ -573,13 +573,21 @@ pub fn round_trip(input: &GeneratedMesh) {
 }
 
 /// Adapts the front of a `came` stream (the bytes after its first seven, behind up to 16 bytes
-/// that pick four views) to those views, a face budget and the full mesh, its meta-nodes
-/// fetched on demand (inline), checking every invariant after each adaptation: a corrupt or cut
-/// meta-node is refused for its branch while the rest adapts.
+/// that pick four views and how much of the index is read at a time) to those views, a face
+/// budget and the full mesh, its meta-nodes fetched on demand (inline), checking every
+/// invariant after each adaptation: a corrupt or cut meta-node is refused for its branch while
+/// the rest adapts.
 pub fn adapt_came(data: &[u8]) {
-    use meshcodec::codecs::came::refine::{Budget, Camera, View, ViewMesh};
+    use meshcodec::codecs::came::refine::{Budget, Camera, Fetch, Reads, View, ViewMesh};
     let (views, body) = data.split_at(data.len().min(16));
-    let Ok(mut front) = ViewMesh::from_stream(&stream_of("came", body)) else {
+    // The index read a few bytes at a time, as far as the meta-nodes the views fetch.
+    let byte = |i: usize| views.get(i).copied().unwrap_or(0) as u64;
+    let reads = Reads {
+        first: 1 + byte(4) % 96,
+        index: 1 + byte(5) % 16,
+    };
+    let Ok(mut front) = ViewMesh::open_reading(stream_of("came", body), Fetch::Inline, reads)
+    else {
         return;
     };
     for chunk in views.chunks(4) {

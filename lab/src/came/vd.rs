@@ -96,7 +96,8 @@ pub struct VdView {
     pub vertices: usize,
     /// The same view without the orientation guard.
     pub faces_unguarded: usize,
-    /// Bytes read from the stream's file (header, index and meta-nodes), and their share.
+    /// Bytes read from the stream's file (header, the index as far as the meta-nodes read, and
+    /// those meta-nodes), and their share.
     pub bytes_read: u64,
     pub units_loaded: usize,
     pub share_of_stream: f64,

@@ -13,9 +13,9 @@ use std::path::{Path, PathBuf};
 
 /// The command that makes every input of the table.
 pub const COMMAND: &str = "bash experiments/came-vd.sh";
-/// Faces against meshoptimizer's count the issue's target allows.
+/// Faces against meshoptimizer's count the target allows.
 const FACE_TARGET: f64 = 1.5;
-/// Faces with the orientation guard against without it, the most the issue allows.
+/// Faces with the orientation guard against without it, the most the target allows.
 const GUARD_TARGET: f64 = 1.25;
 
 /// A rung of meshoptimizer's ladder chosen for a view.
@@ -109,7 +109,7 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
         md,
         "# CAME view-dependent refinement beside meshoptimizer\n\n\
          Regenerate: `{COMMAND}`. Every `came` stream at {} bits, read from a file meta-node by \
-         meta-node as the view asks; {}x{} pixels, {}° vertical field of view, τ = {} px, \
+         meta-node as the view asks, its index only as far as those meta-nodes; {}x{} pixels, {}° vertical field of view, τ = {} px, \
          two-sided (nothing left coarse for facing away), orientation guard on, each view from \
          a cold start.\n\n\
          **meshoptimizer** ({}): `{}`, the target error lowered a quarter octave at a time; a \

@@ -235,9 +235,10 @@ fn delta(decoded: &DecodedUnit, header: &Header) -> Result<UnitDelta> {
     Ok(out)
 }
 
-/// How much of the stream a loader reads at a time before its payload.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Reads {
+/// How much of the stream a loader reads at a time before its payload: a client trading the
+/// number of its reads against the bytes they carry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Reads {
     /// The first read: the header and the index's first entries.
     pub first: u64,
     /// Each read of the index after it.

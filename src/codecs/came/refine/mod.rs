@@ -40,5 +40,7 @@ mod loader;
 mod view;
 
 pub use front::{Adapted, Budget, Fetched, Pick, ViewMesh};
-pub use loader::{deviation_margin, head_length, ByteSource, Fetch, SeekSource, DEVIATION_MARGIN};
+pub use loader::{
+    deviation_margin, head_length, ByteSource, Fetch, Reads, SeekSource, DEVIATION_MARGIN,
+};
 pub use view::{Camera, View};

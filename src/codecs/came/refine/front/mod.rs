@@ -248,8 +248,9 @@ impl ViewMesh {
         ViewMesh::open_reading(source, fetch, Reads::DEFAULT)
     }
 
-    /// [`ViewMesh::open`], reading the stream's header and index `reads` at a time.
-    pub(super) fn open_reading(
+    /// [`ViewMesh::open`], reading the stream's header and index `reads` at a time (a
+    /// `Fetch::External` source holds the whole index: it is read at once).
+    pub fn open_reading(
         source: impl ByteSource + 'static,
         fetch: Fetch,
         reads: Reads,
