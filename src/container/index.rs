@@ -305,7 +305,8 @@ impl PartialIndex {
             });
             self.end = pos;
         }
-        if self.end != self.payload_start && bytes.len() >= self.payload_start {
+        // Every entry is read: they must end where the index said.
+        if self.end != self.payload_start {
             return Err(Error::malformed(
                 0,
                 self.end,

@@ -176,7 +176,13 @@ fn lying_indexes_are_refused() {
     // Index bytes that end inside an entry, or after the entries end.
     let e = refusal(with_entries(&[(200, 1), (200, 0)], Some(5), 400));
     assert!(e.contains("runs past the index's end"), "{e}");
-    let e = refusal(with_entries(&[(200, 1), (200, 0)], Some(7), 400));
+    let long = with_entries(&[(200, 1), (200, 0)], Some(7), 400);
+    let e = refusal(long.clone());
+    assert!(e.contains("it says at"), "{e}");
+    // Read by parts, the same once the last entry is in, before the index's said end.
+    let (_, mut pos) = Header::read(&long).unwrap();
+    let mut partial = PartialIndex::start(&long, &mut pos).unwrap();
+    let e = partial.read_on(&long[..pos + 6]).unwrap_err().to_string();
     assert!(e.contains("it says at"), "{e}");
     // A count of units its index bytes cannot hold is refused before any entry is read, and
     // so is a count of index bytes the stream does not hold.

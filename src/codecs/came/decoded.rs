@@ -419,6 +419,9 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
         for (i, unit) in index.units.iter().enumerate() {
             children.push(i + 1..i + 1);
             match unit.parent {
+                Some(p) if p >= i => {
+                    return Err(Error::malformed(0, 0, "a unit's parent comes after it"))
+                }
                 Some(p) if children[p].is_empty() => children[p] = i..i + 1,
                 Some(p) if children[p].end == i => children[p].end += 1,
                 Some(_) => {
