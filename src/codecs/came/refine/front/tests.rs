@@ -330,17 +330,21 @@ fn picking_hits_the_front_where_the_ray_meets_it() {
     assert!(vm.pick(DVec3::new(9.0, 9.0, 9.0), DVec3::Z).is_none());
 }
 
-#[test]
-fn a_view_of_one_part_fetches_only_the_meta_nodes_it_needs() {
-    let mut vm = ViewMesh::from_stream(stream()).unwrap();
-    // The torus, close; the spheres below it out of the frustum.
+/// The torus of [`stream`], close; the spheres below it out of the frustum.
+fn torus_view() -> View {
     let torus = Camera {
         eye: DVec3::new(0.0, 2.5, 3.0),
         target: DVec3::new(0.0, 2.5, 0.0),
         fov_degrees: 30.0,
         ..camera(DVec3::Z)
     };
-    let view = View::new(&torus, 1.0).unwrap();
+    View::new(&torus, 1.0).unwrap()
+}
+
+#[test]
+fn a_view_of_one_part_fetches_only_the_meta_nodes_it_needs() {
+    let mut vm = ViewMesh::from_stream(stream()).unwrap();
+    let view = torus_view();
     let done = vm.settle(&view, Budget::UNLIMITED, 64);
     vm.check_invariants().unwrap();
     let fetched = vm.fetched();
@@ -372,13 +376,7 @@ fn the_index_is_read_only_as_far_as_the_meta_nodes_fetched() {
         "{:?}",
         root.fetched()
     );
-    let torus = Camera {
-        eye: DVec3::new(0.0, 2.5, 3.0),
-        target: DVec3::new(0.0, 2.5, 0.0),
-        fov_degrees: 30.0,
-        ..camera(DVec3::Z)
-    };
-    let view = View::new(&torus, 1.0).unwrap();
+    let view = torus_view();
     let mut whole = ViewMesh::from_stream(stream()).unwrap();
     whole.settle(&view, Budget::UNLIMITED, 64);
     let mut part = open();
