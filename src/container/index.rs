@@ -1,5 +1,6 @@
-//! The index of units (FORMAT.md §2): each unit's byte range and parent, checked whole before
-//! anything is allocated for what it claims.
+//! The index of units (FORMAT.md §2): each unit's length and children count, from which its
+//! byte range and parent follow; read whole or entry by entry ([`PartialIndex`]), its counts
+//! checked against the bytes that hold them before anything is allocated for what it claims.
 
 use super::*;
 use crate::coding::varint;
@@ -142,6 +143,7 @@ impl Index {
     /// Reads and checks an index from `bytes` at `pos`.
     pub(super) fn read(bytes: &[u8], pos: &mut usize) -> Result<Index> {
         let mut partial = PartialIndex::start(bytes, pos)?;
+        // Nothing is allocated for the entries before the bytes that must hold them are there.
         if bytes.len() < partial.payload_start {
             return Err(Error::Truncated("the stream ends inside its index".into()));
         }
@@ -221,7 +223,12 @@ impl PartialIndex {
     /// limits. `pos` moves past them.
     pub fn start(bytes: &[u8], pos: &mut usize) -> Result<PartialIndex> {
         let units = read_count(bytes, pos, "units", limits::MAX_UNITS)?;
-        let entry_bytes = read_count(bytes, pos, "index bytes", limits::MAX_UNITS * 20)?;
+        let entry_bytes = read_count(
+            bytes,
+            pos,
+            "index bytes",
+            limits::MAX_UNITS * MAX_ENTRY_BYTES,
+        )?;
         let payload_bytes = read_count(bytes, pos, "payload bytes", u64::MAX >> 1)?;
         if units == 0 {
             return Err(Error::malformed(0, *pos, "the index lists no unit"));
@@ -245,6 +252,12 @@ impl PartialIndex {
             end: *pos,
             tree: Tree::default(),
         })
+    }
+
+    /// The units the index lists for the codec of `header`: all but the appearance unit,
+    /// where the header declares one (it is the last).
+    pub fn codec_units(&self, header: &Header) -> usize {
+        self.listed - header.has_appearance_unit() as usize
     }
 
     /// True once every entry is read.

@@ -35,6 +35,9 @@ pub const MAGIC: [u8; 4] = *b"MshC";
 pub const FORMAT_VERSION: u8 = 7;
 /// The fewest bytes an index entry takes (two one-byte varints).
 const MIN_ENTRY_BYTES: u64 = 2;
+/// The most bytes an index entry takes: a length below 2^62 (nine varint bytes) and a
+/// children count within [`crate::limits::MAX_UNITS`] (three).
+const MAX_ENTRY_BYTES: u64 = 12;
 
 mod header;
 mod index;

@@ -463,7 +463,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
     /// own entry is in: its children's numbers come with it. The appearance unit, where the
     /// header declares one, is not the codec's.
     pub fn extend_index(&mut self, index: &PartialIndex) -> Result<()> {
-        let codec_units = index.listed - self.header.has_appearance_unit() as usize;
+        let codec_units = index.codec_units(&self.header);
         for i in self.index.len()..index.index.len().min(codec_units) {
             let entry = index.index.units[i];
             if i > 0 && entry.parent.is_none() {

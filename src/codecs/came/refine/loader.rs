@@ -476,7 +476,7 @@ impl Loader {
                 format!("{extra} bytes after the last unit"),
             ));
         }
-        let units = index.listed - header.has_appearance_unit() as usize;
+        let units = index.codec_units(&header);
         if units == 0 {
             return Err(Error::malformed(
                 0,
