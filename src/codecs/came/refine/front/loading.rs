@@ -74,7 +74,6 @@ impl ViewMesh {
             self.faces.leaf_corners.push(corners);
             self.faces.normals.push(CodedNormal::from(normal));
             self.faces.corners.push([NONE; 3]);
-            self.faces.present.push(false);
             self.guard.suspected.push(Suspicion::None);
         }
         for (s, deps) in delta.splits {

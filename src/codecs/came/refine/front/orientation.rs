@@ -86,11 +86,15 @@ impl ViewMesh {
     }
 
     /// Lists the collapses that moving, making or removing present triangle `f` may have made
-    /// possible for its orientation (those of its corners' parents) to be tried again.
+    /// possible for its orientation (those of its corners' parents) to be tried again: those
+    /// the guard refused (the passes try every other collapse themselves).
     pub(super) fn retry_around(&mut self, f: u32) {
         for c in self.faces.corners[f as usize] {
             let p = self.nodes.parent[c as usize];
-            if p != NONE && !self.guard.in_retry[p as usize] {
+            if p != NONE
+                && self.guard.refused_listed[p as usize]
+                && !self.guard.in_retry[p as usize]
+            {
                 self.guard.in_retry[p as usize] = true;
                 self.guard.retry.push(p);
             }
@@ -254,7 +258,8 @@ impl ViewMesh {
         // Face `f` once `s` is collapsed: in view and not certain?
         let spoilt = |f: u32| {
             let corners = self.faces.corners[f as usize];
-            if !self.faces.present[f as usize] || corners.contains(&t) && corners.contains(&u) {
+            // (Not present: its corners are NONE.)
+            if corners.contains(&t) && corners.contains(&u) {
                 return false;
             }
             if !corners.contains(&t) && !corners.contains(&u) {
@@ -312,7 +317,7 @@ impl ViewMesh {
             let fu = f as usize;
             let corners = self.faces.corners[fu];
             let certain = match self.guard.suspected[fu] {
-                _ if !self.faces.present[fu] => true,
+                _ if !self.faces.present(fu) => true,
                 Suspicion::Moved => self.orientation_certain(corners, f),
                 _ => false,
             };

@@ -26,8 +26,8 @@ impl ViewMesh {
     /// The present triangles: each one's corners' leaf paths (which name the full mesh's
     /// triangle it stands for) and its corners' positions in the adapted mesh.
     pub fn present_triangles(&self) -> impl Iterator<Item = ([NodeId; 3], [DVec3; 3])> + '_ {
-        (0..self.faces.present.len())
-            .filter(|&t| self.faces.present[t])
+        (0..self.faces.corners.len())
+            .filter(|&t| self.faces.present(t))
             .map(|t| {
                 let at = self.faces.corners[t].map(|v| self.nodes.bounds[v as usize].center);
                 (self.faces.leaf_corners[t], at)
@@ -44,11 +44,10 @@ impl ViewMesh {
         }
         let faces = self
             .faces
-            .present
+            .corners
             .iter()
-            .zip(&self.faces.corners)
-            .filter(|(&p, _)| p)
-            .map(|(_, c)| c.map(|v| index[v as usize]))
+            .filter(|c| c[0] != NONE)
+            .map(|c| c.map(|v| index[v as usize]))
             .collect();
         TriMesh { positions, faces }
     }
@@ -56,8 +55,8 @@ impl ViewMesh {
     /// The nearest present triangle the ray from `origin` along `direction` hits.
     pub fn pick(&self, origin: DVec3, direction: DVec3) -> Option<Pick> {
         let mut best: Option<Pick> = None;
-        for (t, &present) in self.faces.present.iter().enumerate() {
-            if !present {
+        for t in 0..self.faces.corners.len() {
+            if !self.faces.present(t) {
                 continue;
             }
             let [a, b, c] = self.faces.corners[t].map(|v| self.nodes.bounds[v as usize].center);
@@ -132,13 +131,14 @@ impl ViewMesh {
         for v in 0..n {
             for &t in &self.nodes.born[v] {
                 let tu = t as usize;
-                if self.faces.present[tu] != (self.front.state[v] == State::Split) {
+                if self.faces.present(tu) != (self.front.state[v] == State::Split) {
                     return Err(format!(
                         "triangle {t} present {} at a {:?} birth node",
-                        self.faces.present[tu], self.front.state[v]
+                        self.faces.present(tu),
+                        self.front.state[v]
                     ));
                 }
-                if !self.faces.present[tu] {
+                if !self.faces.present(tu) {
                     continue;
                 }
                 faces += 1;
@@ -166,8 +166,8 @@ impl ViewMesh {
                 self.faces.count
             ));
         }
-        if let Some(t) = (0..self.faces.present.len()).find(|&t| {
-            self.faces.present[t]
+        if let Some(t) = (0..self.faces.corners.len()).find(|&t| {
+            self.faces.present(t)
                 && self.guard.suspected[t] == Suspicion::None
                 && !self.orientation_certain(self.faces.corners[t], t as u32)
         }) {

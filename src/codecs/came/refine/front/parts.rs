@@ -69,8 +69,9 @@ pub(super) struct Faces {
     pub(super) leaf_corners: Vec<[NodeId; 3]>,
     /// What the stream says of the counterpart's normal (`came` syntax 4).
     pub(super) normals: Vec<CodedNormal>,
+    /// The active nodes at its corners while present, `[NONE; 3]` while not (so that whether
+    /// a face is present is read with its corners, not from a list of its own).
     pub(super) corners: Vec<[u32; 3]>,
-    pub(super) present: Vec<bool>,
     /// Present triangles.
     pub(super) count: usize,
     /// Present triangles with a corner at the node (per node; active nodes only).
@@ -194,13 +195,24 @@ impl Front {
 }
 
 impl Faces {
+    /// Whether triangle `t` is present.
+    pub(super) fn present(&self, t: usize) -> bool {
+        self.corners[t][0] != NONE
+    }
+
     /// A record a triangle in each list, and the count of those present.
     pub(super) fn check(&self) -> Checked {
         let t = self.leaf_corners.len();
-        if self.corners.len() != t || self.present.len() != t {
+        if self.corners.len() != t || self.normals.len() != t {
             return Err("triangle lists of other lengths".into());
         }
-        let present = self.present.iter().filter(|&&p| p).count();
+        if let Some(t) = (0..t).find(|&t| {
+            let c = self.corners[t];
+            c.contains(&NONE) && c != [NONE; 3]
+        }) {
+            return Err(format!("triangle {t} has some corners and not others"));
+        }
+        let present = (0..t).filter(|&t| self.present(t)).count();
         if present != self.count {
             return Err(format!(
                 "{present} triangles present, {} counted",

@@ -68,6 +68,9 @@ impl ViewMesh {
             let start = pass.partition_point(|&v| v < self.scratch.cursor);
             pass.rotate_left(start);
             self.scratch.cursor = 0;
+            // The parent whose collapse the last visit tried, and the operations made by then:
+            // its other child, visited next with nothing done between, would try it again.
+            let (mut tried, mut tried_at) = (NONE, usize::MAX);
             for (i, &v) in pass.iter().enumerate() {
                 // The records the visit of a node a few visits on reads first: its sphere and
                 // its parent's (the active nodes are sparse among all, too far apart for the
@@ -96,7 +99,12 @@ impl ViewMesh {
                 // Up the tree while the parent may and should go; then the same from each
                 // node those collapses freed of its last split dependant (so that a chain of
                 // dependencies unwinds in one pass, not one pass a link).
-                self.collapse_from(self.nodes.parent[v as usize], view, budget, done, false);
+                let p = self.nodes.parent[v as usize];
+                if p == tried && done.splits + done.collapses == tried_at {
+                    continue;
+                }
+                self.collapse_from(p, view, budget, done, false);
+                (tried, tried_at) = (p, done.splits + done.collapses);
             }
             // Without limits, a pass leaves nothing for the next: a refined node goes down its
             // subtree at once, a collapse goes on up the tree and on from every node it frees of

@@ -498,8 +498,8 @@ fn projection(vm: &ViewMesh, full: &crate::codecs::came::decoded::DecodedTree) -
 
 /// The present triangles' corners, as [`projection`] gives them.
 fn present_corners(vm: &ViewMesh) -> Vec<[u32; 3]> {
-    let mut out: Vec<[u32; 3]> = (0..vm.faces.present.len())
-        .filter(|&t| vm.faces.present[t])
+    let mut out: Vec<[u32; 3]> = (0..vm.faces.corners.len())
+        .filter(|&t| vm.faces.present(t))
         .map(|t| {
             let mut c = vm.faces.corners[t];
             let least = (0..3).min_by_key(|&k| c[k]).unwrap();
@@ -537,7 +537,7 @@ fn the_adapted_mesh_is_the_full_mesh_projected_through_the_front_so_it_has_no_cr
 fn fold_overs_in_view(vm: &ViewMesh, full: &HashMap<u64, DVec3>, view: &View) -> (usize, usize) {
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
     let (mut folded, mut coarse) = (0, 0);
-    for t in (0..vm.faces.present.len()).filter(|&t| vm.faces.present[t]) {
+    for t in (0..vm.faces.corners.len()).filter(|&t| vm.faces.present(t)) {
         let at = vm.faces.corners[t].map(|v| vm.nodes.bounds[v as usize].center);
         let counterpart = vm.faces.leaf_corners[t].map(|l| full[&l.packed()]);
         if at != counterpart {

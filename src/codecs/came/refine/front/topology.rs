@@ -156,7 +156,6 @@ impl ViewMesh {
                 self.faces.faces_at[c as usize].push(f);
             }
             self.faces.corners[f as usize] = corners;
-            self.faces.present[f as usize] = true;
             self.suspect(f);
         }
         self.faces.count += self.nodes.born[su].len();
@@ -194,7 +193,6 @@ impl ViewMesh {
                 }
             }
             self.faces.corners[f as usize] = [NONE; 3];
-            self.faces.present[f as usize] = false;
         }
         self.faces.count -= self.nodes.born[su].len();
         for c in self.nodes.children[su] {
