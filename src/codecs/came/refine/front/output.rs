@@ -42,12 +42,9 @@ impl ViewMesh {
             index[v as usize] = positions.len() as u32;
             positions.push(self.nodes.bounds[v as usize].center);
         }
-        let faces = self
-            .faces
-            .corners
-            .iter()
-            .filter(|c| c[0] != NONE)
-            .map(|c| c.map(|v| index[v as usize]))
+        let faces = (0..self.faces.corners.len())
+            .filter(|&t| self.faces.present(t))
+            .map(|t| self.faces.corners[t].map(|v| index[v as usize]))
             .collect();
         TriMesh { positions, faces }
     }
