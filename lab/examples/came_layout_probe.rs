@@ -1,12 +1,20 @@
 //! How many meta-nodes, and how many of a hierarchy's splits, the far, middle and near views of
 //! the came-vd table touch under other layouts of the same hierarchy: meta-nodes of L levels
 //! (the stream's 8, or 4), meta-nodes rooted at given depths before those of 8 levels, or of as
-//! many levels as keep a unit within S splits (BENCHMARKS.md, "What a meta-node costs"), or
-//! units by depth band (a unit rooted at depth d holds its subtree's splits at depths d + K …
-//! d + K + B − 1).
-//! Run: cargo run --release --example came_layout_probe -- STREAM [DEPTHS…] (each DEPTHS a
-//! comma-separated list of root depths, as 4,8,11, or band:K,B,WHOLE, to try beside the
-//! built-in layouts)
+//! many levels as keep a unit within S splits (BENCHMARKS.md, "What a meta-node costs"), units
+//! by depth band (a unit rooted at depth d holds its subtree's splits at depths d + K …
+//! d + K + B − 1), or units by error band (the same with each node's deviation step in place of
+//! its depth).
+//!
+//! Bytes are estimated from the stream itself: each split costs its unit's bytes over the
+//! unit's splits, and a layout's view reads the splits of the units it touches. The estimate
+//! keeps today's cost per split, so it leaves out what smaller units add (contexts starting
+//! afresh, index entries, flushes: about 21 bytes a unit, BENCHMARKS.md). Beside it, the
+//! needed splits' own bytes: what a view would read if units cost nothing and held only what
+//! it needs.
+//! Run: cargo run --release --example came_layout_probe -- STREAM [LAYOUT…] (each LAYOUT a
+//! comma-separated list of root depths, as 4,8,11; band:K,B,WHOLE; or error:S,K,B,WHOLE,
+//! a node's error level being its deviation step over S, in quarter octaves)
 use meshcodec::codecs::came::decode_tree;
 use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
 use meshcodec_lab::came::vd::{framing, view_camera, VIEWS};
@@ -26,6 +34,78 @@ enum Rule {
         b: u8,
         whole: usize,
     },
+    /// Units by error band: a node's error level is its deviation's step (quarter octaves
+    /// below the root's) over `s`; a unit holds the splits whose level lies in a band of `b`
+    /// levels, of the region under their deepest ancestor at least `k` levels coarser than
+    /// the band's first — or all the splits of a region's subtree when they number at most
+    /// `whole`.
+    ErrorBands {
+        s: u16,
+        k: u16,
+        b: u16,
+        whole: usize,
+    },
+}
+
+/// [`Rule::ErrorBands`]: per inner node, the index of the unit that codes its split.
+fn error_band_partition(
+    tree: &meshcodec::codecs::came::decoded::DecodedTree,
+    inner_below: &[usize],
+    (s, k, b, whole): (u16, u16, u16, usize),
+) -> (Vec<u32>, usize) {
+    let n = tree.nodes.len();
+    let level = |v: usize| tree.deviation_steps[v] / s;
+    let mut unit_of = vec![u32::MAX; n];
+    let mut whole_unit: Vec<bool> = Vec::new();
+    let mut unit_at: std::collections::HashMap<(u32, u16), u32> = Default::default();
+    for v in 0..n {
+        let node = &tree.nodes[v];
+        if node.children.is_none() {
+            continue;
+        }
+        if node.parent != u32::MAX {
+            let pu = unit_of[node.parent as usize];
+            if whole_unit[pu as usize] {
+                unit_of[v] = pu;
+                continue;
+            }
+        }
+        let l = level(v);
+        // The band's first level, and the deepest ancestor k levels coarser than it.
+        let first = if l < k + b {
+            0
+        } else {
+            k + b + (l - k - b) / b * b
+        };
+        // The coarsest band is the root's unit; the others are keyed by their region's root.
+        let mut r = if first > 0 { node.parent } else { u32::MAX };
+        while r != u32::MAX && level(r as usize) + k > first {
+            r = tree.nodes[r as usize].parent;
+        }
+        let r = if r == u32::MAX { 0 } else { r };
+        let unit = *unit_at.entry((r, first)).or_insert_with(|| {
+            // The region's splits from the band's first level down: a whole unit when few.
+            let mut frontier = vec![r];
+            let mut total = 0;
+            while let Some(x) = frontier.pop() {
+                let Some(ch) = tree.nodes[x as usize].children else {
+                    continue;
+                };
+                if level(x as usize) >= first {
+                    total += inner_below[x as usize];
+                } else {
+                    frontier.extend(ch);
+                }
+                if total > whole {
+                    break;
+                }
+            }
+            whole_unit.push(first > 0 && total <= whole);
+            whole_unit.len() as u32 - 1
+        });
+        unit_of[v] = unit;
+    }
+    (unit_of, whole_unit.len())
 }
 
 /// [`Rule::Bands`]: per inner node, the index of the unit that codes its split.
@@ -115,7 +195,7 @@ fn partition(
                 None if height[root as usize] <= 12 => u8::MAX,
                 None => 8,
             },
-            Rule::Bands { .. } => unreachable!("band_partition"),
+            Rule::Bands { .. } | Rule::ErrorBands { .. } => unreachable!("band_partition"),
             Rule::Splits(s) => {
                 if inner_below[root as usize] <= s + s / 2 {
                     u8::MAX
@@ -180,6 +260,48 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     let splits = inner_below[0];
+    // What each split costs in the stream: its unit's bytes over the unit's splits. Units are
+    // decoded in stream order, so the order in which their roots first create nodes is the
+    // stream's.
+    let reader = meshcodec::container::StreamReader::open(&bytes)?;
+    let lengths: Vec<u64> = reader.index().units.iter().map(|u| u.length).collect();
+    let mut stream_unit: std::collections::HashMap<u64, usize> = Default::default();
+    for node in &tree.nodes {
+        let next = stream_unit.len();
+        stream_unit
+            .entry(node.created_unit.packed())
+            .or_insert(next);
+    }
+    let mut per_unit = vec![0usize; lengths.len()];
+    let unit_today: Vec<usize> = tree
+        .nodes
+        .iter()
+        .map(|node| {
+            node.split_unit
+                .map_or(usize::MAX, |u| stream_unit[&u.packed()])
+        })
+        .collect();
+    for &u in &unit_today {
+        if u != usize::MAX {
+            per_unit[u] += 1;
+        }
+    }
+    let cost: Vec<f64> = unit_today
+        .iter()
+        .map(|&u| {
+            if u == usize::MAX {
+                0.0
+            } else {
+                lengths[u] as f64 / per_unit[u] as f64
+            }
+        })
+        .collect();
+    println!(
+        "  units {} in the index, {} met in the tree; payload {} bytes",
+        lengths.len(),
+        stream_unit.len(),
+        lengths.iter().sum::<u64>()
+    );
     println!(
         "{path}: {} bytes, {splits} splits, height {}",
         bytes.len(),
@@ -196,6 +318,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Rule::Splits(64),
     ];
     for depths in std::env::args().skip(2) {
+        if let Some(band) = depths.strip_prefix("error:") {
+            let v: Vec<usize> = band.split(',').map(str::parse).collect::<Result<_, _>>()?;
+            let [s, k, b, whole] = v[..] else {
+                return Err("error:S,K,B,WHOLE".into());
+            };
+            rules.push(Rule::ErrorBands {
+                s: s as u16,
+                k: k as u16,
+                b: b as u16,
+                whole,
+            });
+            continue;
+        }
         if let Some(band) = depths.strip_prefix("band:") {
             let v: Vec<usize> = band.split(',').map(str::parse).collect::<Result<_, _>>()?;
             let [k, b, whole] = v[..] else {
@@ -218,6 +353,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .iter()
         .map(|r| match *r {
             Rule::Bands { k, b, whole } => band_partition(&tree, &inner_below, (k, b, whole)),
+            Rule::ErrorBands { s, k, b, whole } => {
+                error_band_partition(&tree, &inner_below, (s, k, b, whole))
+            }
             _ => partition(&tree, &inner_below, &height, r.clone()),
         })
         .collect();
@@ -246,6 +384,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
             let fetched = front.fetched();
+            let needed_bytes: f64 = split.iter().map(|p| cost[tree.lookup[p] as usize]).sum();
+            println!(
+                "  the needed splits alone: {needed_bytes:.0} bytes ({:.1}%)",
+                100.0 * needed_bytes / bytes.len() as f64
+            );
             println!(
                 "{name} guard {guard}: {} faces, {} splits needed ({:.1}%), read today {:.1}% ({} units)",
                 front.face_count(),
@@ -263,10 +406,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .filter(|&v| tree.nodes[v].children.is_some())
                     .filter(|&v| touched.contains(&unit_of[v]))
                     .count();
+                let held_bytes: f64 = (0..n)
+                    .filter(|&v| tree.nodes[v].children.is_some())
+                    .filter(|&v| touched.contains(&unit_of[v]))
+                    .map(|v| cost[v])
+                    .sum();
                 println!(
-                    "    {rule:?}: {} units, {held} splits ({:.1}%)",
+                    "    {rule:?}: {} units, {held} splits ({:.1}%), {:.0} bytes ({:.1}% of the stream)",
                     touched.len(),
-                    100.0 * held as f64 / splits as f64
+                    100.0 * held as f64 / splits as f64,
+                    held_bytes,
+                    100.0 * held_bytes / bytes.len() as f64
                 );
             }
         }

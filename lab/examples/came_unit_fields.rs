@@ -5,7 +5,9 @@
 //! (coded blind, about a bit each), and how many of those lie at nodes split by units the view
 //! does not read — the steps a syntax coding paths only as far as their unit knows would take
 //! out of the view's bytes.
-//! Run: cargo run --release --example came_unit_fields -- MESH (a shared mesh's name or a file)
+//! Run: cargo run --release --example came_unit_fields -- MESH (a shared mesh's name or a file;
+//! NAME-x4 or NAME-x16 for a shared mesh subdivided once or twice, as the came-vd table's
+//! bunny-closed-35k-x16)
 use meshcodec::codecs::came::decode_tree;
 use meshcodec::codecs::came::knowledge::Status;
 use meshcodec::codecs::came::modelled::{encode_with_unit_fields, Came};
@@ -13,6 +15,7 @@ use meshcodec::codecs::came::refine::{head_length, Budget, Fetch, View, ViewMesh
 use meshcodec::codecs::{canonical_for, Codec};
 use meshcodec::hierarchy::came::NodeId;
 use meshcodec::mesh::io;
+use meshcodec_lab::came::extras::table_mesh;
 use meshcodec_lab::came::vd::{framing, view_camera, TOLERANCE_PX, VIEWS};
 use std::collections::{BTreeMap, HashSet};
 
@@ -20,7 +23,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = std::env::args()
         .nth(1)
         .ok_or("usage: came_unit_fields MESH")?;
-    let mesh = io::read_mesh(&io::resolve(&name)?)?;
+    // NAME-xN: the mesh subdivided until it has N times its triangles (the came-vd table's
+    // bunny-closed-35k-x16).
+    let mesh = match name.rsplit_once("-x") {
+        Some((base, times)) if times.parse::<u32>().is_ok_and(|t| t.is_power_of_two()) => {
+            let subdivisions = times.parse::<u32>()?.trailing_zeros() / 2;
+            table_mesh(base, subdivisions)?.1
+        }
+        _ => io::read_mesh(&io::resolve(&name)?)?,
+    };
     let codec = Came;
     let canonical = canonical_for(&mesh, &codec.default_options())?;
     let (encoded, unit_fields) = encode_with_unit_fields(&canonical)?;
