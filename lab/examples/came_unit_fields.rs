@@ -17,7 +17,7 @@ use meshcodec::hierarchy::came::NodeId;
 use meshcodec::mesh::io;
 use meshcodec_lab::came::extras::table_mesh;
 use meshcodec_lab::came::vd::{framing, view_camera, TOLERANCE_PX, VIEWS};
-use std::collections::{BTreeMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = std::env::args()
@@ -46,10 +46,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     let (_, tree) = decode_tree(&bytes)?;
     let every_unit: HashSet<NodeId> = unit_fields.iter().map(|(root, _)| *root).collect();
-    let whole = path_steps(&tree, &every_unit);
+    // Each unit's parent in the index (the unit it is decoded after), by root.
+    let index = meshcodec::container::StreamReader::open(&bytes)?
+        .index()
+        .clone();
+    let parents: HashMap<NodeId, NodeId> = unit_fields
+        .iter()
+        .zip(&index.units)
+        .filter_map(|((root, _), entry)| Some((*root, unit_fields[entry.parent?].0)))
+        .collect();
+    let whole = path_steps(&tree, &every_unit, &parents);
     println!(
         "corner paths of all {} triangles: {} steps at nodes their unit splits, {} blind ({} of them also a leaf flag)",
         whole.triangles, whole.known, whole.blind, whole.unknown
+    );
+    println!(
+        "  of the blind steps, {} at nodes a descendant of the triangle's unit splits",
+        whole.blind_deferrable
     );
     // `came` is lossless: its full decode is the canonical mesh.
     let framed = framing(&canonical.to_mesh())?;
@@ -97,7 +110,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
         let roots: HashSet<NodeId> = read.iter().map(|&u| unit_fields[u].0).collect();
-        let steps = path_steps(&tree, &roots);
+        let steps = path_steps(&tree, &roots, &parents);
         let right = steps.blind_right as f64 / steps.blind.max(1) as f64;
         println!(
             "corner paths of the {} triangles born in the units read: {} steps at nodes their unit splits, {} blind ({} of them also a leaf flag; {:.1}% to the right child: {:.2} bits a step), {} of the blind ones at nodes split by units not read",
@@ -108,6 +121,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             100.0 * right,
             entropy(right),
             steps.blind_unread
+        );
+        println!(
+            "  of the blind steps at nodes split by units not read, {} on the corners under the birth node; blind steps at nodes a descendant of the triangle's unit splits: {} ({} of them in units not read)",
+            steps.blind_unread_under, steps.blind_deferrable, steps.blind_deferrable_unread
         );
     }
     Ok(())
@@ -126,6 +143,12 @@ struct PathSteps {
     unknown: usize,
     /// Blind steps at nodes split by a unit not in `read`.
     blind_unread: usize,
+    /// Of those, on the two corners under the birth node (n1 and n2).
+    blind_unread_under: usize,
+    /// Blind steps at nodes split by a unit descending from the triangle's (which could code
+    /// them, knowing the triangle), and of those at nodes split by units not in `read`.
+    blind_deferrable: usize,
+    blind_deferrable_unread: usize,
     /// Blind steps to the right child (their plain context codes about the entropy of this
     /// share a step).
     blind_right: usize,
@@ -134,6 +157,7 @@ struct PathSteps {
 fn path_steps(
     tree: &meshcodec::codecs::came::decoded::DecodedTree,
     read: &HashSet<NodeId>,
+    parents: &HashMap<NodeId, NodeId>,
 ) -> PathSteps {
     let mut steps = PathSteps::default();
     for t in &tree.triangles {
@@ -169,13 +193,35 @@ fn path_steps(
                         steps.blind_right += corner.bit(depth) as usize;
                         steps.unknown += (status == Status::Unknown) as usize;
                         let split = tree.nodes[x as usize].split_unit;
-                        steps.blind_unread += split.is_some_and(|u| !read.contains(&u)) as usize;
+                        let unread = split.is_some_and(|u| !read.contains(&u));
+                        steps.blind_unread += unread as usize;
+                        if corner.common_len(birth) == birth.len() {
+                            steps.blind_unread_under += unread as usize;
+                        }
+                        if split.is_some_and(|u| descends(parents, u, unit)) {
+                            steps.blind_deferrable += 1;
+                            steps.blind_deferrable_unread += unread as usize;
+                        }
                     }
                 }
             }
         }
     }
     steps
+}
+
+/// Whether the unit rooted at `u` is `ancestor`'s or one of its descendants' in the index
+/// (`parents`: each unit's parent, by root).
+fn descends(parents: &HashMap<NodeId, NodeId>, mut u: NodeId, ancestor: NodeId) -> bool {
+    loop {
+        if u == ancestor {
+            return true;
+        }
+        match parents.get(&u) {
+            Some(&parent) => u = parent,
+            None => return false,
+        }
+    }
 }
 
 /// The entropy of a bit that is 1 with probability `p`, in bits.
