@@ -382,6 +382,24 @@ fn came_streams_of_six_level_regions_still_decode_and_refine() {
     assert_eq!(old_faces, new_faces);
 }
 
+/// `came` streams of syntax 8, whose corner paths run down to their leaves in the meta-node
+/// that codes their triangle, still decode exactly and refine:
+/// `came-eight-before-waiting-paths.mc` is the golden stream of that build, kept. Today's
+/// codes a path only as far as its meta-node knows the hierarchy and carries it on in the
+/// meta-node splitting the node it stops at (docs/FORMAT.md §8.2): the same tree, fronts and
+/// faces, in a smaller stream.
+#[test]
+fn came_streams_of_paths_to_the_leaves_still_decode_and_refine() {
+    let (old, new) = kept_came_stream_and_todays("came-eight-before-waiting-paths.mc");
+    assert_eq!(header_of(&old).syntax, 8);
+    assert!(header_of(&new).syntax >= 9);
+    assert!(new.len() < old.len(), "{} against {}", new.len(), old.len());
+    let [old_faces, new_faces] = settle_far_from_eight(&[&old, &new])[..] else {
+        unreachable!("one count a stream")
+    };
+    assert_eq!(old_faces, new_faces);
+}
+
 /// `came` streams of syntax 5, whose deviation codes step by 2^(−1/2) below the parent's,
 /// still decode exactly and refine: `came-eight-before-anchored-deviations.mc` is the golden
 /// stream of that build, kept. Today's codes the nodes above depth 11 in quarter steps on a

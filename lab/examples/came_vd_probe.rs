@@ -34,9 +34,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let tolerance: f64 = args.get(4).map_or(Ok(1.0), |s| s.parse())?;
     let mut full = ViewMesh::from_stream(&bytes)?;
     full.settle(&View::everything(), Budget::UNLIMITED, 256);
-    let leaf: HashMap<u64, DVec3> = full
+    // The full mesh's triangles by birth, with their corners' positions.
+    let counterparts: HashMap<(u64, u32), [DVec3; 3]> = full
         .present_triangles()
-        .flat_map(|(l, at)| (0..3).map(move |k| (l[k].packed(), at[k])))
+        .map(|t| ((t.birth.0.packed(), t.birth.1), t.at))
         .collect();
     let full_mesh = full.mesh();
     let reference = FullMesh::new(&full_mesh);
@@ -50,8 +51,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let ms = started.elapsed().as_secs_f64() * 1e3;
         let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
         let (mut folded, mut shown) = (0, 0);
-        for (leaves, at) in front.present_triangles() {
-            let counterpart = leaves.map(|l| leaf[&l.packed()]);
+        for t in front.present_triangles() {
+            let at = t.at;
+            let counterpart = counterparts[&(t.birth.0.packed(), t.birth.1)];
             let full_normal = normal(counterpart);
             // A zero-area triangle of the full mesh turns no way.
             if full_normal != DVec3::ZERO

@@ -64,7 +64,7 @@ pub const EMC_AHEAD: Naming = Naming {
 pub const CAME: Naming = Naming {
     name: "came",
     id: 6,
-    syntax: 8,
+    syntax: 9,
     reads_from: 1,
 };
 

@@ -202,8 +202,9 @@ fn surface_in_view(triangles: &[(DVec3, f64)], view: &View) -> f64 {
     }
 }
 
-/// A vertex of the full mesh: its leaf path, position and number in the full mesh.
-type Leaf = (meshcodec::hierarchy::came::NodeId, DVec3, u32);
+/// The full mesh's triangles by birth ([`meshcodec::codecs::came::refine::PresentTriangle`]'s,
+/// the path packed), with their corners' positions.
+type Counterparts = std::collections::HashMap<(u64, u32), [DVec3; 3]>;
 
 /// Fold-overs of a front.
 #[derive(Clone, Copy, Default)]
@@ -217,16 +218,14 @@ struct FoldOvers {
 }
 
 /// Present faces of `front` whose normal makes 90° or more with their full-resolution
-/// counterpart's (`at`: each vertex's position by leaf path), seen from `view`.
-fn fold_overs(
-    front: &ViewMesh,
-    at: &std::collections::HashMap<u64, DVec3>,
-    view: &View,
-) -> FoldOvers {
+/// counterpart's (`full`), seen from `view`.
+fn fold_overs(front: &ViewMesh, full: &Counterparts, view: &View) -> FoldOvers {
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
     let mut out = FoldOvers::default();
-    for (leaves, adapted) in front.present_triangles() {
-        let full = leaves.map(|l| at.get(&l.packed()).copied().unwrap_or(DVec3::ZERO));
+    for t in front.present_triangles() {
+        let adapted = t.at;
+        let key = (t.birth.0.packed(), t.birth.1);
+        let full = full.get(&key).copied().unwrap_or([DVec3::ZERO; 3]);
         let n = normal(full);
         if normal(adapted).dot(n) <= 0.0 && n != DVec3::ZERO {
             let facing = (full[0] - view.eye()).dot(n) < 0.0;
@@ -274,37 +273,11 @@ pub fn run(results: &Path, log: &mut dyn FnMut(String)) -> Result<PathBuf> {
         stream.len(),
         started.elapsed().as_secs_f64()
     ));
-    // The reference: every vertex's leaf path and position, from the whole stream.
-    let (header, tree) = codecs::came::decode_tree(&stream)?;
-    let vertex_at: std::collections::HashMap<[u32; 3], u32> = canonical
-        .cells
-        .iter()
-        .enumerate()
-        .map(|(i, &c)| (c, i as u32))
-        .collect();
-    let leaves: Vec<Leaf> = tree
-        .nodes
-        .iter()
-        .filter(|n| n.leaf)
-        .map(|n| {
-            let vertex = vertex_at
-                .get(&n.position.map(|x| x as u32))
-                .copied()
-                .ok_or_else(|| Error::mesh("a leaf of the stream is no vertex of the mesh"))?;
-            Ok((
-                n.id,
-                codecs::came::decoded::to_world(&header.grid, n.position),
-                vertex,
-            ))
-        })
-        .collect::<Result<_>>()?;
-    drop(vertex_at);
     // `came` is lossless: its full decode is the canonical mesh.
     let full = canonical.to_mesh();
-    drop(tree);
     let path = stream_path();
     std::fs::write(&path, &stream)?;
-    let outcome = fly(results, &path, &full, &leaves, stream.len() as u64, log);
+    let outcome = fly(results, &path, &full, stream.len() as u64, log);
     let _ = std::fs::remove_file(&path);
     let mut report = outcome?;
     report.mesh = name.to_string();
@@ -392,15 +365,20 @@ fn fly(
     results: &Path,
     path: &Path,
     full: &TriMesh,
-    leaves: &[Leaf],
     stream_bytes: u64,
     log: &mut dyn FnMut(String),
 ) -> Result<Flythrough> {
     let cameras = cameras(full)?;
     let guarded = fly_alone(path, &cameras, true)?;
     let free = fly_alone(path, &cameras, false)?;
-    let at: std::collections::HashMap<u64, DVec3> =
-        leaves.iter().map(|&(id, p, _)| (id.packed(), p)).collect();
+    // The reference for fold-overs: every triangle of the stream refined everywhere.
+    let mut whole = ViewMesh::open_file(path)?;
+    whole.settle(&View::everything(), Budget::UNLIMITED, 256);
+    let at: Counterparts = whole
+        .present_triangles()
+        .map(|t| ((t.birth.0.packed(), t.birth.1), t.at))
+        .collect();
+    drop(whole);
     let triangles = centroids_and_areas(full);
     let reference = FullMesh::new(full);
     let mut front = ViewMesh::open_file(path)?;

@@ -69,6 +69,18 @@ pub struct Triangle {
 // The normal lives in what was the record's padding: decoding takes no more memory for it.
 const _: () = assert!(std::mem::size_of::<Triangle>() == 32);
 
+/// A corner whose path waits at a node for the unit that splits it (`came` syntax 9).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WaitingCorner {
+    /// The triangle (in decoding order) and which of its corners.
+    pub triangle: u32,
+    pub corner: u8,
+    /// Which corner of its birth split it is (n1, n2, n3: the contexts its steps take).
+    pub kind: u8,
+    /// Where its steps point (a step codes whether the child nearer this point holds it).
+    pub target: [f64; 3],
+}
+
 /// The sizes of a [`DecodedTree`] at one moment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Mark {
@@ -98,6 +110,14 @@ pub struct DecodedTree {
     /// Once the hierarchy is checked complete: every triangle's corners as nodes, so that the
     /// full mesh needs no lookup of its own.
     leaf_corners: Option<Vec<[u32; 3]>>,
+    /// `came` syntax 9: corner paths coded as far as their unit knows, waiting at the node
+    /// where they stop for the unit that splits it to carry them on; by node.
+    pub waiting: HashMap<u32, Vec<WaitingCorner>, foldhash::fast::FixedState>,
+    /// What the unit being decoded did to corners coded before it, to undo it if the unit is
+    /// refused: the corners it carried on (triangle, corner, the path before) in order, and
+    /// the waiting lists it took.
+    carried: Vec<(u32, u8, NodeId)>,
+    taken: Vec<(u32, Vec<WaitingCorner>)>,
     max_nodes: usize,
     max_triangles: usize,
 }
@@ -117,6 +137,9 @@ impl DecodedTree {
             dependency_nodes: Vec::new(),
             deviation_steps: Vec::with_capacity(expected),
             leaf_corners: None,
+            waiting: HashMap::default(),
+            carried: Vec::new(),
+            taken: Vec::new(),
             max_nodes: (2 * vertices).saturating_sub(1) as usize,
             max_triangles: triangles as usize,
         }
@@ -135,6 +158,17 @@ impl DecodedTree {
     /// Forgets everything decoded since `mark` (a unit that failed half-way).
     pub fn roll_back(&mut self, mark: Mark) {
         self.leaf_corners = None;
+        // The corners the unit carried on, back to where they waited, latest first.
+        for (t, k, before) in std::mem::take(&mut self.carried).into_iter().rev() {
+            if let Some(t) = self.triangles.get_mut(t as usize) {
+                t.corners[k as usize] = before;
+            }
+        }
+        for (node, list) in std::mem::take(&mut self.taken) {
+            self.waiting.insert(node, list);
+        }
+        // Corners wait only at nodes their unit created.
+        self.waiting.retain(|&node, _| (node as usize) < mark.nodes);
         for i in mark.nodes.min(self.nodes.len())..self.nodes.len() {
             let id = self.nodes[i].id;
             self.lookup.remove(&id.packed());
@@ -238,6 +272,43 @@ impl DecodedTree {
     pub fn close_dependencies(&mut self, s: NodeId, first: usize) {
         let range = first as u32..self.dependency_nodes.len() as u32;
         self.dependencies.push((s, range));
+    }
+
+    /// Corner `corner` of triangle `triangle`, whose path stops at node `node` (a node its
+    /// unit created and does not split), waits there for the unit that splits it.
+    pub fn wait(&mut self, node: u32, waiting: WaitingCorner) {
+        self.waiting.entry(node).or_default().push(waiting);
+    }
+
+    /// The corners waiting at node `node`, taken by the unit that splits it (in the order they
+    /// began to wait).
+    pub fn take_waiting(&mut self, node: u32) -> Vec<WaitingCorner> {
+        match self.waiting.remove(&node) {
+            Some(list) => {
+                self.taken.push((node, list.clone()));
+                list
+            }
+            None => Vec::new(),
+        }
+    }
+
+    /// Corner `corner` of triangle `triangle` carried on to `path`.
+    pub fn carry(&mut self, triangle: u32, corner: u8, path: NodeId) {
+        let t = &mut self.triangles[triangle as usize];
+        self.carried
+            .push((triangle, corner, t.corners[corner as usize]));
+        t.corners[corner as usize] = path;
+    }
+
+    /// The corners the unit being decoded carried on: (triangle, corner) in order.
+    pub fn carried(&self) -> impl Iterator<Item = (u32, u8)> + '_ {
+        self.carried.iter().map(|&(t, k, _)| (t, k))
+    }
+
+    /// The unit decoded last is kept: what would undo it is forgotten.
+    pub fn accept(&mut self) {
+        self.carried.clear();
+        self.taken.clear();
     }
 
     /// The splits split `i` (in decoding order) depends on.
@@ -627,6 +698,7 @@ impl<'a, U: UnitDecoder> CameDecoder<'a, U> {
             });
         match decoded {
             Ok((checked, children)) => {
+                self.tree.accept();
                 self.child_roots[i] = Some(children);
                 self.unit_triangles[i] = Some(mark.triangles..self.tree.triangles.len());
                 Ok(checked)

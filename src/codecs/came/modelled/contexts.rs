@@ -21,6 +21,18 @@ pub(super) enum Kind {
     Dependency = 3,
 }
 
+impl Kind {
+    /// The kind of a triangle's path by which corner of its birth split it is (0: n1, 1: n2,
+    /// else n3).
+    pub(super) fn of_corner(corner: u8) -> Kind {
+        match corner {
+            0 => Kind::N1,
+            1 => Kind::N2,
+            _ => Kind::N3,
+        }
+    }
+}
+
 /// Every adaptive context of one unit.
 #[derive(Clone)]
 pub(super) struct Contexts {

@@ -1,6 +1,8 @@
 //! `came`'s unit decoder: a unit's two passes read back into the decoded tree.
 
-use super::super::decoded::{Bounds, DecodedTree, FaceNormal, Triangle, UnitDecoder};
+use super::super::decoded::{
+    Bounds, DecodedTree, FaceNormal, Triangle, UnitDecoder, WaitingCorner,
+};
 use super::super::knowledge::Status;
 use super::super::{cut_at, Params};
 use super::contexts::*;
@@ -159,19 +161,27 @@ impl UnitReader<'_> {
 
     /// A leaf's path from `start` (decoded node `known`), and its proxy: the first node on it
     /// that is not an inner node whose split the unit knows (`hierarchy::came::face_normals`).
+    /// With `defer` (syntax 9) the path stops at the first node this unit created and does not
+    /// split, returned third: the unit that splits that node carries it on.
     fn leaf_path(
         &mut self,
         start: NodeId,
         known: u32,
         target: [f64; 3],
         kind: Kind,
-    ) -> Result<(NodeId, u32)> {
+        defer: bool,
+    ) -> Result<(NodeId, u32, Option<u32>)> {
         let mut x = start;
         let (mut status, mut node) = (self.tree.status_of(known, self.unit), Some(known));
         let mut proxy = None;
         loop {
             if status != Status::Inner && proxy.is_none() {
                 proxy = node;
+            }
+            if let (true, Status::Open, Some(i)) = (defer, status, node) {
+                if self.tree.nodes[i as usize].created_unit == self.unit {
+                    return Ok((x, proxy.unwrap_or(known), Some(i)));
+                }
             }
             let depth = x.len() as usize;
             let ends_here = match status {
@@ -180,7 +190,7 @@ impl UnitReader<'_> {
                 Status::Inner | Status::Open => false,
             };
             if ends_here {
-                return Ok((x, proxy.unwrap_or(known)));
+                return Ok((x, proxy.unwrap_or(known), None));
             }
             let bit = if status == Status::Inner {
                 let (_, positions) = self.children_positions(node.expect("decoded"));
@@ -193,6 +203,21 @@ impl UnitReader<'_> {
             (status, node) = self.descend(status, node, bit);
             x = self.child(x, bit)?;
         }
+    }
+
+    /// Syntax 9: carries on the corner paths waiting at `s`, which this unit splits, each as
+    /// far as this unit knows ([`UnitReader::leaf_path`]), in the order they began to wait.
+    fn carry_on(&mut self, s: u32) -> Result<()> {
+        let start = self.tree.nodes[s as usize].id;
+        for waiting in self.tree.take_waiting(s) {
+            let kind = Kind::of_corner(waiting.kind);
+            let (path, _, stop) = self.leaf_path(start, s, waiting.target, kind, true)?;
+            self.tree.carry(waiting.triangle, waiting.corner, path);
+            if let Some(node) = stop {
+                self.tree.wait(node, waiting);
+            }
+        }
+        Ok(())
     }
 
     /// What the stream says of a triangle's normal (syntax 4), after its orientation bit: on
@@ -515,6 +540,14 @@ impl ModelledUnits {
         }
         // Pass 2.
         let max_triangles = header.triangles;
+        // Syntax 9 codes corner paths only as far as their unit knows: first the paths that
+        // wait at this unit's splits, carried on.
+        let defer = header.syntax >= 9;
+        if defer {
+            for &s in &queue {
+                r.carry_on(s)?;
+            }
+        }
         for &s in &queue {
             let node = &r.tree.nodes[s as usize];
             let sid = node.id;
@@ -531,20 +564,36 @@ impl ModelledUnits {
             let mut thirds = Vec::with_capacity(count as usize);
             for _ in 0..count {
                 let [t, u] = children;
-                let (n1, p1) = r.leaf_path(r.child(sid, false)?, t, positions[1], Kind::N1)?;
-                let (n2, p2) = r.leaf_path(r.child(sid, true)?, u, positions[0], Kind::N2)?;
+                let targets = [positions[1], positions[0], ps];
+                let n1 = r.leaf_path(r.child(sid, false)?, t, targets[0], Kind::N1, defer)?;
+                let n2 = r.leaf_path(r.child(sid, true)?, u, targets[1], Kind::N2, defer)?;
                 let up = r.uint(|c| &mut c.up, 52, "n3.up")? + 1;
                 let (start, start_node) = r.other_child(s, up)?;
-                let (n3, p3) = r.leaf_path(start, start_node, ps, Kind::N3)?;
-                thirds.push((n3, start.len()));
+                let n3 = r.leaf_path(start, start_node, ps, Kind::N3, defer)?;
+                thirds.push((n3.0, start.len(), n3.2.is_none()));
                 let flipped = r.bit(|c| &mut c.orientation[previous])?;
                 previous = 1 + flipped as usize;
-                let (corners, proxies) = if flipped {
-                    ([n2, n1, n3], [p2, p1, p3])
-                } else {
-                    ([n1, n2, n3], [p1, p2, p3])
-                };
+                // Which corner each path is (n1, n2, n3 in the triangle's order).
+                let slots = if flipped { [1, 0, 2] } else { [0, 1, 2] };
+                let mut corners = [NodeId::ROOT; 3];
+                let mut proxies = [0; 3];
+                for (kind, path) in [n1, n2, n3].into_iter().enumerate() {
+                    corners[slots[kind]] = path.0;
+                    proxies[slots[kind]] = path.1;
+                }
                 let normal = r.face_normal(proxies, params, header.grid.cell)?;
+                let triangle = r.tree.triangles.len() as u32;
+                for (kind, path) in [n1, n2, n3].into_iter().enumerate() {
+                    if let Some(node) = path.2 {
+                        let waiting = WaitingCorner {
+                            triangle,
+                            corner: slots[kind] as u8,
+                            kind: kind as u8,
+                            target: targets[kind],
+                        };
+                        r.tree.wait(node, waiting);
+                    }
+                }
                 r.tree.add_triangle(
                     Triangle {
                         corners,
@@ -562,16 +611,17 @@ impl ModelledUnits {
                     thirds.len() as u64,
                     "a dependency's triangle",
                 )?;
-                if let Some(&(leaf, below)) = thirds.get(which as usize) {
-                    // An inner node of the n3 path, from the junction's child down.
+                if let Some(&(path, below, complete)) = thirds.get(which as usize) {
+                    // An inner node of the n3 path, from the junction's child down: counted
+                    // up from the node above its leaf, or from where the path waits.
                     let rise = r.uint(|c| &mut c.dependency_rise, 52, "a dependency's rise")?;
-                    let len = (leaf.len() as u64)
+                    let len = (path.len() as u64 + !complete as u64)
                         .checked_sub(rise + 1)
                         .filter(|&l| l >= below as u64);
                     let Some(len) = len else {
                         return Err(Error::malformed(0, at, "a dependency above its path"));
                     };
-                    r.tree.dependency_nodes.push(leaf.ancestor(len as u8));
+                    r.tree.dependency_nodes.push(path.ancestor(len as u8));
                     continue;
                 }
                 let up = r.uint(|c| &mut c.dependency_up, 52, "a dependency's up")? + 1;

@@ -63,6 +63,17 @@ pub(super) struct Encoder<'a> {
     face_normal_codes: Vec<Vec<Option<Option<[i32; 2]>>>>,
     /// The largest angle between a coded normal and its triangle's, in degrees.
     face_normal_error: f64,
+    /// Per unit, in stream order: the corner paths it carries on (syntax 9), by the split of
+    /// its where they wait, in the order they began to wait.
+    carried: Vec<Vec<(u32, Vec<Waiting>)>>,
+}
+
+/// A corner path waiting at a node for the unit that splits it (syntax 9).
+#[derive(Clone, Copy)]
+struct Waiting {
+    leaf: u32,
+    target: [f64; 3],
+    kind: Kind,
 }
 
 impl<'a> Encoder<'a> {
@@ -135,8 +146,10 @@ impl<'a> Encoder<'a> {
             born: born_triangles(tree, mesh),
             face_normal_codes: Vec::new(),
             face_normal_error: 0.0,
+            carried: Vec::new(),
         };
         encoder.code_face_normals(mesh.grid.cell);
+        encoder.carried = encoder.waiting_paths();
         encoder
     }
 
@@ -205,6 +218,81 @@ impl<'a> Encoder<'a> {
 
     fn status(&self, x: u32, unit: NodeId) -> Status {
         self.part.knowledge.status(x, self.tree.is_leaf(x), unit)
+    }
+
+    /// Whether a corner path coded by `unit` stops at `x` to wait (syntax 9): a node the unit
+    /// created and whose split another unit codes.
+    fn waits_at(&self, x: u32, unit: NodeId) -> bool {
+        self.status(x, unit) == Status::Open && self.part.knowledge.created_unit[x as usize] == unit
+    }
+
+    /// Where the path from `start` to `leaf` that `unit` codes ends: the leaf, or the node it
+    /// waits at (`true`).
+    fn path_end(&self, start: u32, leaf: u32, unit: NodeId) -> (u32, bool) {
+        let lid = self.tree.ids[leaf as usize];
+        let mut x = start;
+        while x != leaf {
+            if self.waits_at(x, unit) {
+                return (x, true);
+            }
+            let [a, b] = self.tree.children_of(x).expect("paths pass inner nodes");
+            x = if lid.bit(self.tree.ids[x as usize].len()) {
+                b
+            } else {
+                a
+            };
+        }
+        (leaf, false)
+    }
+
+    /// The three corner paths of a triangle born at `s`: start, leaf, target, kind.
+    fn corner_paths(&self, s: u32, tri: &BornTriangle) -> [(u32, u32, [f64; 3], Kind); 3] {
+        let tree = self.tree;
+        let [t, u] = tree.children_of(s).expect("inner");
+        let [l1, l2, l3] = tri.leaves;
+        let sid = tree.ids[s as usize];
+        let up = sid.len() - tree.ids[l3 as usize].common_len(sid);
+        let p = |v: u32| self.positions[v as usize];
+        [
+            (t, l1, p(u), Kind::N1),
+            (u, l2, p(t), Kind::N2),
+            (self.other_child(s, up), l3, p(s), Kind::N3),
+        ]
+    }
+
+    /// Which corner paths each unit carries on (syntax 9): the units in stream order, as a
+    /// decoder meets them, each first carrying on the paths waiting at its splits, then coding
+    /// its own triangles' paths, every path as far as the unit knows.
+    fn waiting_paths(&self) -> Vec<Vec<(u32, Vec<Waiting>)>> {
+        let mut waiting: std::collections::HashMap<u32, Vec<Waiting>> = Default::default();
+        let mut carried = Vec::with_capacity(self.part.units.len());
+        for meta in &self.part.units {
+            let unit = self.tree.ids[meta.root as usize];
+            let mut here = Vec::new();
+            for &s in &meta.nodes {
+                if let Some(list) = waiting.remove(&s) {
+                    for w in &list {
+                        if let (end, true) = self.path_end(s, w.leaf, unit) {
+                            waiting.entry(end).or_default().push(*w);
+                        }
+                    }
+                    here.push((s, list));
+                }
+            }
+            for &s in &meta.nodes {
+                for tri in &self.born[s as usize - self.tree.leaves] {
+                    for (start, leaf, target, kind) in self.corner_paths(s, tri) {
+                        if let (end, true) = self.path_end(start, leaf, unit) {
+                            let w = Waiting { leaf, target, kind };
+                            waiting.entry(end).or_default().push(w);
+                        }
+                    }
+                }
+            }
+            carried.push(here);
+        }
+        debug_assert!(waiting.is_empty(), "every waiting path is carried on");
+        carried
     }
 
     /// Codes every unit: its bytes, ledger and bits per field. A first pass over all units with
@@ -316,7 +404,13 @@ impl<'a> Encoder<'a> {
                 put_cone(enc, ctx, parent, cone);
             }
         }
-        // Pass 2: triangles and dependencies.
+        // Pass 2: the corner paths waiting at the unit's splits, carried on; then triangles
+        // and dependencies.
+        for (s, list) in &self.carried[m] {
+            for w in list {
+                self.put_leaf_path(enc, ctx, *s, w.leaf, w.target, w.kind, unit);
+            }
+        }
         for &s in &meta.nodes {
             let [t, u] = tree.children_of(s).expect("inner");
             let sid = tree.ids[s as usize];
@@ -331,19 +425,14 @@ impl<'a> Encoder<'a> {
             let mut previous = 0;
             let normals = &self.face_normal_codes[s as usize - tree.leaves];
             for (tri, normal) in born.iter().zip(normals) {
-                let [l1, l2, l3] = tri.leaves;
-                let (pt, pu, ps) = (
-                    self.positions[t as usize],
-                    self.positions[u as usize],
-                    self.positions[s as usize],
-                );
-                self.put_leaf_path(enc, ctx, t, l1, pu, Kind::N1, unit);
-                self.put_leaf_path(enc, ctx, u, l2, pt, Kind::N2, unit);
-                let junction = tree.ids[l3 as usize].common_len(sid);
-                let up = sid.len() - junction;
+                let [n1, n2, n3] = self.corner_paths(s, tri);
+                for (start, leaf, target, kind) in [n1, n2] {
+                    self.put_leaf_path(enc, ctx, start, leaf, target, kind, unit);
+                }
+                let up = sid.len() - tree.ids[tri.leaves[2] as usize].common_len(sid);
                 enc.uint(&mut ctx.up, up as u64 - 1, C, "connectivity");
-                let start = self.other_child(s, up);
-                self.put_leaf_path(enc, ctx, start, l3, ps, Kind::N3, unit);
+                let (start, leaf, target, kind) = n3;
+                self.put_leaf_path(enc, ctx, start, leaf, target, kind, unit);
                 enc.bit(
                     &mut ctx.orientation[previous],
                     tri.flipped,
@@ -364,16 +453,24 @@ impl<'a> Encoder<'a> {
             for &y in deps {
                 // Almost always an ancestor of an n3 corner below its junction: which
                 // triangle's, and how far above the corner.
+                // The n3 path as the unit codes it: to its leaf, or to where it waits (then
+                // the node it waits at may be the one).
                 let yid = tree.ids[y as usize];
-                let on = born.iter().position(|t| {
-                    let leaf = tree.ids[t.leaves[2] as usize];
-                    yid.is_ancestor_of(leaf) && yid.len() > leaf.common_len(sid)
-                });
-                let which = on.unwrap_or(born.len());
+                let rise = |t: &BornTriangle| {
+                    let (start, leaf, _, _) = self.corner_paths(s, t)[2];
+                    let (end, waits) = self.path_end(start, leaf, unit);
+                    let end = tree.ids[end as usize];
+                    let below = yid.len() > tree.ids[leaf as usize].common_len(sid);
+                    (below && yid.is_ancestor_of(end) && (waits || yid != end))
+                        .then(|| end.len() - yid.len() - !waits as u8)
+                };
+                let on = born
+                    .iter()
+                    .enumerate()
+                    .find_map(|(k, t)| Some((k, rise(t)?)));
+                let which = on.map_or(born.len(), |(k, _)| k);
                 enc.uint(&mut ctx.dependency_on, which as u64, C, "dependencies");
-                if let Some(k) = on {
-                    let leaf = tree.ids[born[k].leaves[2] as usize];
-                    let rise = leaf.len() - yid.len() - 1;
+                if let Some((_, rise)) = on {
                     enc.uint(&mut ctx.dependency_rise, rise as u64, C, "dependencies");
                     continue;
                 }
@@ -419,6 +516,10 @@ impl<'a> Encoder<'a> {
         loop {
             let status = self.status(x, unit);
             let depth = tree.ids[x as usize].len();
+            if self.waits_at(x, unit) {
+                // The unit that splits x carries the path on (syntax 9).
+                return;
+            }
             match status {
                 Status::Leaf => return,
                 Status::Unknown => {

@@ -147,6 +147,9 @@ pub(super) struct UnitDelta {
     /// The units under this one and the nodes whose splits each holds first, open until they
     /// are loaded.
     pub opens: Vec<(usize, u32)>,
+    /// Corners of earlier units' triangles whose paths this unit carried on (`came` syntax 9):
+    /// the triangle (numbered as the loader's tree numbers them), the corner and its path now.
+    pub carried: Vec<(u32, u8, NodeId)>,
 }
 
 /// A unit fetched, or why it was refused.
@@ -218,6 +221,10 @@ fn delta(decoded: &DecodedUnit, header: &Header) -> Result<UnitDelta> {
             list.push(Dependency { id: d, node });
         }
         out.splits.push((s, list));
+    }
+    for (t, k) in tree.carried() {
+        out.carried
+            .push((t, k, tree.triangles[t as usize].corners[k as usize]));
     }
     // Every node a child unit splits first: its root, or (depth bands) the open nodes under
     // it, which this unit created.

@@ -39,7 +39,7 @@ mod front;
 mod loader;
 mod view;
 
-pub use front::{Adapted, Budget, Fetched, Pick, ViewMesh};
+pub use front::{Adapted, Budget, Fetched, Pick, PresentTriangle, ViewMesh};
 pub use loader::{
     deviation_margin, head_length, ByteSource, Fetch, Reads, SeekSource, DEVIATION_MARGIN,
 };

@@ -76,6 +76,12 @@ impl ViewMesh {
             self.faces.corners.push([NONE; 3]);
             self.guard.suspected.push(Suspicion::None);
         }
+        // Paths that waited at nodes this unit splits, carried on below them.
+        for (t, k, path) in delta.carried {
+            if let Some(corners) = self.faces.leaf_corners.get_mut(t as usize) {
+                corners[k as usize] = path;
+            }
+        }
         for (s, deps) in delta.splits {
             self.nodes.depends_on[s as usize] = deps;
         }

@@ -91,6 +91,7 @@ use super::loader::{ByteSource, Fetch, Loader, Reads, SeekSource};
 use super::view::View;
 use crate::error::{Error, Result};
 use glam::DVec3;
+pub use output::PresentTriangle;
 use parts::{Faces, Front, Guard, Loading, Nodes, Scratch};
 use std::ops::Range;
 use std::path::Path;

@@ -7,6 +7,21 @@ use crate::hierarchy::came::NodeId;
 use crate::mesh::TriMesh;
 use glam::DVec3;
 
+/// A triangle of the adapted mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PresentTriangle {
+    /// Which of the full mesh's triangles it stands for: the node whose split creates it and
+    /// its place among that split's triangles, the same in every front of the stream.
+    pub birth: (NodeId, u32),
+    /// Its corners' paths as far as the loaded meta-nodes give them: the full mesh's vertices'
+    /// leaf paths once the meta-nodes below are loaded (`came` from syntax 9 codes a path only
+    /// as far as its meta-node knows the hierarchy; the meta-node splitting the node it stops
+    /// at carries it on).
+    pub paths: [NodeId; 3],
+    /// Its corners' positions in the adapted mesh.
+    pub at: [DVec3; 3],
+}
+
 impl ViewMesh {
     /// Where the vertex with leaf path `leaf` stands in the adapted mesh: the position of the
     /// active node on its path (`None` if the path leaves the hierarchy above the front).
@@ -23,14 +38,20 @@ impl ViewMesh {
             .map(|&v| self.nodes.ids[v as usize])
     }
 
-    /// The present triangles: each one's corners' leaf paths (which name the full mesh's
-    /// triangle it stands for) and its corners' positions in the adapted mesh.
-    pub fn present_triangles(&self) -> impl Iterator<Item = ([NodeId; 3], [DVec3; 3])> + '_ {
-        (0..self.faces.corners.len())
-            .filter(|&t| self.faces.present(t))
-            .map(|t| {
-                let at = self.faces.corners[t].map(|v| self.nodes.bounds[v as usize].center);
-                (self.faces.leaf_corners[t], at)
+    /// The present triangles ([`PresentTriangle`]), by their birth nodes in loading order.
+    pub fn present_triangles(&self) -> impl Iterator<Item = PresentTriangle> + '_ {
+        (0..self.nodes.ids.len())
+            .filter(|&v| self.front.state[v] == State::Split)
+            .flat_map(move |v| {
+                self.nodes.born[v]
+                    .iter()
+                    .enumerate()
+                    .map(move |(ordinal, &t)| PresentTriangle {
+                        birth: (self.nodes.ids[v], ordinal as u32),
+                        paths: self.faces.leaf_corners[t as usize],
+                        at: self.faces.corners[t as usize]
+                            .map(|c| self.nodes.bounds[c as usize].center),
+                    })
             })
     }
 

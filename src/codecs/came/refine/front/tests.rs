@@ -532,31 +532,39 @@ fn the_adapted_mesh_is_the_full_mesh_projected_through_the_front_so_it_has_no_cr
     }
 }
 
+/// The full mesh's triangles by birth ([`PresentTriangle::birth`], packed), with their
+/// corners' positions.
+type Counterparts = HashMap<(u64, u32), [DVec3; 3]>;
+
 /// Present faces meeting `view`'s frustum whose normal makes 90° or more with their
-/// counterpart's (the full mesh's triangle, on the leaves' positions `full`), and the present faces that are not the full mesh's own.
-fn fold_overs_in_view(vm: &ViewMesh, full: &HashMap<u64, DVec3>, view: &View) -> (usize, usize) {
+/// counterpart's (the full mesh's triangle, `full`), and the present faces that are not the
+/// full mesh's own.
+fn fold_overs_in_view(vm: &ViewMesh, full: &Counterparts, view: &View) -> (usize, usize) {
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
     let (mut folded, mut coarse) = (0, 0);
-    for t in (0..vm.faces.corners.len()).filter(|&t| vm.faces.present(t)) {
-        let at = vm.faces.corners[t].map(|v| vm.nodes.bounds[v as usize].center);
-        let counterpart = vm.faces.leaf_corners[t].map(|l| full[&l.packed()]);
-        if at != counterpart {
-            coarse += 1;
-        }
-        if vm.in_view(view, vm.faces.corners[t]) && normal(at).dot(normal(counterpart)) <= 0.0 {
-            folded += 1;
+    for v in (0..vm.nodes.ids.len()).filter(|&v| vm.front.state[v] == State::Split) {
+        for (ordinal, &t) in vm.nodes.born[v].iter().enumerate() {
+            let t = t as usize;
+            let at = vm.faces.corners[t].map(|c| vm.nodes.bounds[c as usize].center);
+            let counterpart = full[&(vm.nodes.ids[v].packed(), ordinal as u32)];
+            if at != counterpart {
+                coarse += 1;
+            }
+            if vm.in_view(view, vm.faces.corners[t]) && normal(at).dot(normal(counterpart)) <= 0.0 {
+                folded += 1;
+            }
         }
     }
     (folded, coarse)
 }
 
-/// Every leaf's position (by packed path) in the test stream refined everywhere, found once.
-fn full_positions() -> &'static HashMap<u64, DVec3> {
-    static FULL: OnceLock<HashMap<u64, DVec3>> = OnceLock::new();
+/// The test stream's triangles refined everywhere, by birth, found once.
+fn full_positions() -> &'static Counterparts {
+    static FULL: OnceLock<Counterparts> = OnceLock::new();
     FULL.get_or_init(|| {
         let (full, _) = refine_everything(stream());
         full.present_triangles()
-            .flat_map(|(leaves, at)| (0..3).map(move |k| (leaves[k].packed(), at[k])))
+            .map(|t| ((t.birth.0.packed(), t.birth.1), t.at))
             .collect()
     })
 }
