@@ -170,7 +170,7 @@ def test_info_reads_the_header_and_index():
     stream = meshcodec.encode(mesh.vertices, mesh.faces, codec="came", quant_bits=14)
     about = meshcodec.info(stream)
     assert about["codec"] == "came" and about["quant_bits"] == 14
-    assert about["format_version"] == meshcodec.FORMAT_VERSION and about["syntax"] == 8
+    assert about["format_version"] == meshcodec.FORMAT_VERSION and about["syntax"] == 9
     assert about["appearance"] is None
     assert about["bytes"] == about["stream_bytes"] == len(stream)
     assert not about["layered"] and not about["truncated"]

@@ -17,6 +17,12 @@
 //!
 //! Syntax 8 cuts that tree's bands over regions of four levels instead of six ([`SHAPE`]): the
 //! deeper tree's far fronts then read fewer and smaller units, and its streams are smaller too.
+//!
+//! Syntax 9 codes a triangle's corner paths only as far as its unit knows the hierarchy: a path
+//! stops at the first node the unit created and does not split, and waits there for the unit
+//! that splits that node (always one under this unit), which carries it on as steps through
+//! splits it knows. A view that reads only coarse units no longer reads the paths' steps below
+//! them, and those steps, coded where the shape is known, need no leaf flags.
 
 mod contexts;
 mod decoder;
@@ -105,7 +111,7 @@ pub fn encode_with_unit_fields(mesh: &CanonicalMesh) -> Result<(Encoded, UnitFie
         naming: DESCRIPTOR.naming,
         per_node_bounds: true,
         build: BuildOptions::QUADRIC_ORDER,
-        shape: SHAPE,
+        shape: shape_for(mesh),
         component_bits: 0,
         radius_bits: RADIUS_BITS,
         cone_bits: cones::AXIS_BITS,
@@ -138,6 +144,31 @@ pub const SHAPE: Shape = Shape::Bands {
     whole: 256,
 };
 
+/// How `came` cuts the hierarchy of a mesh of [`LARGE_MESH_VERTICES`] or more (syntax 9):
+/// bands of one level over regions of three, a unit holding the rest of its subtree when that
+/// is at most 64 splits, so that a view of part of a large mesh reads small units. Units cost
+/// about 21 bytes each in contexts starting afresh, index entries and flushes, which a small
+/// mesh's stream feels (bunny.ply would take 30.51 → 32.81 bits a triangle in syntax 8) and a
+/// large mesh's views repay (BENCHMARKS.md, "`came` syntax 9").
+pub const SHAPE_LARGE: Shape = Shape::Bands {
+    region: 3,
+    band: 1,
+    whole: 64,
+};
+
+/// The meshes whose `came` streams are cut by [`SHAPE_LARGE`]: those of this many vertices or
+/// more.
+pub const LARGE_MESH_VERTICES: usize = 1 << 18;
+
+/// How `came` cuts `mesh`'s hierarchy (syntax 9).
+pub fn shape_for(mesh: &CanonicalMesh) -> Shape {
+    if mesh.vertex_count() >= LARGE_MESH_VERTICES {
+        SHAPE_LARGE
+    } else {
+        SHAPE
+    }
+}
+
 /// The bands of syntaxes 5 to 7: two levels over regions of six (chosen on the balanced tree
 /// of syntaxes 5 and 6: BENCHMARKS.md, "`came` syntax 5: units by depth band").
 const SHAPE_BEFORE_8: Shape = Shape::Bands {
@@ -146,12 +177,13 @@ const SHAPE_BEFORE_8: Shape = Shape::Bands {
     whole: 256,
 };
 
-/// How a stream of `syntax` cuts its bands (syntax 5 on).
-fn shape_of(syntax: u8) -> Shape {
-    if syntax >= 8 {
-        SHAPE
-    } else {
-        SHAPE_BEFORE_8
+/// The ways a stream of `syntax` may cut its bands (syntax 5 on; none before).
+fn shapes_of(syntax: u8) -> &'static [Shape] {
+    match syntax {
+        ..=4 => &[],
+        5..=7 => &[SHAPE_BEFORE_8],
+        8 => &[SHAPE],
+        _ => &[SHAPE, SHAPE_LARGE],
     }
 }
 
@@ -189,14 +221,26 @@ pub fn params(header: &Header) -> Result<Params> {
             ),
         ));
     }
-    if let (5.., Shape::Bands { region, band, .. }) = (header.syntax, shape_of(header.syntax)) {
-        if params.region_levels != region || params.meta_levels != band {
-            return Err(Error::malformed(
-                0,
-                0,
-                format!("came streams cut bands of {band} levels over regions of {region}"),
-            ));
-        }
+    // The bands the syntax cuts (syntax 9: a large mesh's otherwise, `shape_for`).
+    let shapes = shapes_of(header.syntax);
+    let cuts = |shape: &Shape| match *shape {
+        Shape::Bands { region, band, .. } => (region, band),
+        Shape::Levels { levels, .. } => (0, levels),
+    };
+    let cut = (params.region_levels, params.meta_levels);
+    if !shapes.is_empty() && !shapes.iter().any(|shape| cuts(shape) == cut) {
+        let listed: Vec<String> = shapes
+            .iter()
+            .map(|shape| {
+                let (region, band) = cuts(shape);
+                format!("bands of {band} levels over regions of {region}")
+            })
+            .collect();
+        return Err(Error::malformed(
+            0,
+            0,
+            format!("came streams cut {}", listed.join(" or ")),
+        ));
     }
     if with_face_normals
         && (params.face_normal_steps != face_normals::STEPS

@@ -171,3 +171,39 @@ fn a_unit_whose_region_holds_a_node_no_unit_above_it_split_is_refused() {
     );
     assert_eq!(tree.nodes.len(), nodes);
 }
+
+/// A unit refused once decoded (here by the check a client runs on what it added) leaves the
+/// tree as it was (syntax 9): the corner paths it carried on wait again where they waited, at
+/// the paths before, and those it began wait nowhere; decoded again, it is kept, and the
+/// stream decodes whole with no path left waiting.
+#[test]
+fn a_refused_unit_puts_back_the_corner_paths_it_carried_on() {
+    let (_, bytes) = stream(&generate::icosphere(5));
+    let reader = StreamReader::open(&bytes).unwrap();
+    let mut d = decoder(&bytes);
+    let corners = |d: &CameDecoder<'_, ModelledUnits>| -> Vec<[NodeId; 3]> {
+        d.tree().triangles.iter().map(|t| t.corners).collect()
+    };
+    let mut carried = 0;
+    for i in 0..reader.index().units.len() {
+        let unit = reader.unit(i).unwrap();
+        let before = (corners(&d), d.tree().waiting.clone());
+        let refused = d.decode_unit_checked(i, unit.bytes, |added| {
+            carried += added.tree.carried().count();
+            Err::<(), _>(crate::Error::Unsupported("refused by its check".into()))
+        });
+        assert!(refused.is_err());
+        assert!(
+            (corners(&d), d.tree().waiting.clone()) == before,
+            "unit {i}"
+        );
+        d.decode_unit_bytes(i, unit.bytes).unwrap();
+    }
+    assert!(carried > 100, "{carried} paths carried on");
+    assert!(d.tree().waiting.is_empty());
+    for t in &d.tree().triangles {
+        for c in t.corners {
+            assert!(d.tree().nodes[d.tree().get(c).unwrap() as usize].leaf);
+        }
+    }
+}
