@@ -70,16 +70,20 @@ pub struct Triangle {
 const _: () = assert!(std::mem::size_of::<Triangle>() == 32);
 
 /// A corner whose path waits at a node for the unit that splits it (`came` syntax 9).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WaitingCorner {
     /// The triangle (in decoding order) and which of its corners.
     pub triangle: u32,
     pub corner: u8,
     /// Which corner of its birth split it is (n1, n2, n3: the contexts its steps take).
     pub kind: u8,
-    /// Where its steps point (a step codes whether the child nearer this point holds it).
-    pub target: [f64; 3],
+    /// The node whose position its steps point to (a step codes whether the child nearer it
+    /// holds the path).
+    pub target: u32,
 }
+
+// Held for every corner that waits: small, so that decoding stays within its memory bound.
+const _: () = assert!(std::mem::size_of::<WaitingCorner>() == 12);
 
 /// The sizes of a [`DecodedTree`] at one moment.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -280,16 +284,22 @@ impl DecodedTree {
         self.waiting.entry(node).or_default().push(waiting);
     }
 
-    /// The corners waiting at node `node`, taken by the unit that splits it (in the order they
-    /// began to wait).
-    pub fn take_waiting(&mut self, node: u32) -> Vec<WaitingCorner> {
+    /// Takes the corners waiting at node `node` for the unit that splits it: how many, each
+    /// then read by [`DecodedTree::taken`] (in the order they began to wait).
+    pub fn take_waiting(&mut self, node: u32) -> usize {
         match self.waiting.remove(&node) {
             Some(list) => {
-                self.taken.push((node, list.clone()));
-                list
+                let count = list.len();
+                self.taken.push((node, list));
+                count
             }
-            None => Vec::new(),
+            None => 0,
         }
+    }
+
+    /// The `i`-th corner [`DecodedTree::take_waiting`] took last.
+    pub fn taken(&self, i: usize) -> WaitingCorner {
+        self.taken.last().expect("corners taken").1[i]
     }
 
     /// Corner `corner` of triangle `triangle` carried on to `path`.
@@ -309,6 +319,10 @@ impl DecodedTree {
     pub fn accept(&mut self) {
         self.carried.clear();
         self.taken.clear();
+        if self.waiting.is_empty() {
+            // Every path is complete: the table's room goes too.
+            self.waiting = HashMap::default();
+        }
     }
 
     /// The splits split `i` (in decoding order) depends on.

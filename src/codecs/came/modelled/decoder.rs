@@ -209,9 +209,11 @@ impl UnitReader<'_> {
     /// far as this unit knows ([`UnitReader::leaf_path`]), in the order they began to wait.
     fn carry_on(&mut self, s: u32) -> Result<()> {
         let start = self.tree.nodes[s as usize].id;
-        for waiting in self.tree.take_waiting(s) {
+        for i in 0..self.tree.take_waiting(s) {
+            let waiting = self.tree.taken(i);
             let kind = Kind::of_corner(waiting.kind);
-            let (path, _, stop) = self.leaf_path(start, s, waiting.target, kind, true)?;
+            let target = self.tree.nodes[waiting.target as usize].position;
+            let (path, _, stop) = self.leaf_path(start, s, target, kind, true)?;
             self.tree.carry(waiting.triangle, waiting.corner, path);
             if let Some(node) = stop {
                 self.tree.wait(node, waiting);
@@ -564,9 +566,10 @@ impl ModelledUnits {
             let mut thirds = Vec::with_capacity(count as usize);
             for _ in 0..count {
                 let [t, u] = children;
-                let targets = [positions[1], positions[0], ps];
-                let n1 = r.leaf_path(r.child(sid, false)?, t, targets[0], Kind::N1, defer)?;
-                let n2 = r.leaf_path(r.child(sid, true)?, u, targets[1], Kind::N2, defer)?;
+                // Where each path's steps point: v_u, v_t, v_s.
+                let targets = [u, t, s];
+                let n1 = r.leaf_path(r.child(sid, false)?, t, positions[1], Kind::N1, defer)?;
+                let n2 = r.leaf_path(r.child(sid, true)?, u, positions[0], Kind::N2, defer)?;
                 let up = r.uint(|c| &mut c.up, 52, "n3.up")? + 1;
                 let (start, start_node) = r.other_child(s, up)?;
                 let n3 = r.leaf_path(start, start_node, ps, Kind::N3, defer)?;

@@ -233,7 +233,8 @@ pub fn params(header: &Header) -> Result<Params> {
             .iter()
             .map(|shape| {
                 let (region, band) = cuts(shape);
-                format!("bands of {band} levels over regions of {region}")
+                let levels = if band == 1 { "level" } else { "levels" };
+                format!("bands of {band} {levels} over regions of {region}")
             })
             .collect();
         return Err(Error::malformed(

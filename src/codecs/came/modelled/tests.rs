@@ -207,3 +207,36 @@ fn a_refused_unit_puts_back_the_corner_paths_it_carried_on() {
         }
     }
 }
+
+/// Syntax 9 reads both cuts `came` writes (bands of two levels over regions of four, and of one
+/// over regions of three for large meshes); syntax 8 only the first; any other is refused.
+#[test]
+fn syntax_9_reads_the_large_meshes_bands_and_no_others() {
+    let (_, bytes) = stream(&generate::icosphere(2));
+    let mut header = StreamReader::open(&bytes).unwrap().header().clone();
+    assert_eq!(header.syntax, 9);
+    assert_eq!((header.params[8], header.params[0]), (4, 2));
+    (header.params[8], header.params[0]) = (3, 1);
+    let large = params(&header).unwrap();
+    assert_eq!(
+        large.shape(),
+        Shape::Bands {
+            region: 3,
+            band: 1,
+            whole: 0
+        }
+    );
+    header.syntax = 8;
+    let refused = params(&header).unwrap_err().to_string();
+    assert!(
+        refused.contains("bands of 2 levels over regions of 4"),
+        "{refused}"
+    );
+    header.syntax = 9;
+    (header.params[8], header.params[0]) = (5, 1);
+    let refused = params(&header).unwrap_err().to_string();
+    assert!(
+        refused.contains("regions of 4 or bands of 1 level over regions of 3"),
+        "{refused}"
+    );
+}
