@@ -161,6 +161,28 @@ for codec in raw emc emc-ahead emc-paper pm pm-reordered came came-paper; do
     tail -c +8 "$stream" > "$dir/$name.body"
   done
 done
+# A torus fine enough for several meta-nodes (1,200 vertices), so that `came`'s corner paths
+# wait at the nodes where their meta-node stops for the one that splits them (syntax 9).
+fine=$(mktemp --suffix=.obj)
+python3 - "$fine" <<'EOF'
+import math, sys
+U, V = 60, 20
+with open(sys.argv[1], 'w') as f:
+    for i in range(U):
+        for j in range(V):
+            a = 2 * math.pi * i / U; b = 2 * math.pi * j / V
+            r = 1 + 0.4 * math.cos(b) + 0.05 * math.sin(5 * a)
+            f.write('v %.6f %.6f %.6f\n' % (r * math.cos(a), r * math.sin(a), 0.4 * math.sin(b)))
+    for i in range(U):
+        for j in range(V):
+            q = [i * V + j, ((i + 1) % U) * V + j, ((i + 1) % U) * V + (j + 1) % V, i * V + (j + 1) % V]
+            f.write('f %d %d %d\nf %d %d %d\n' % (q[0] + 1, q[1] + 1, q[2] + 1, q[0] + 1, q[2] + 1, q[3] + 1))
+EOF
+for codec in came came-paper; do
+  target/release/meshcodec encode --codec "$codec" --quant 10 "$fine" "$stream" >/dev/null 2>&1
+  tail -c +8 "$stream" > "$seeds/decode_${codec//-/_}/torus-fine.body"
+done
+rm -f "$fine"
 # emc streams with slabs, every pass of 4 visits or more sliced into 3 slabs (as `emc` writes
 # meshes of 65,536 vertices or more, in small).
 cargo build --release --example emc_slabs
