@@ -32,8 +32,9 @@ pub fn graph_edges(triangles: u64) -> u64 {
 /// Most bytes a decoder allocates at once beyond the stream it reads, as a multiple of the
 /// decoded mesh's own size (24 bytes a position, 12 a triangle): the coder's state and contexts,
 /// the decoder's graph or face adjacency, and the mesh it hands out. Checked by tests/limits.rs on a 3,301-vertex mesh,
-/// where the decoders measure 2.1 (raw), 4.5 (pm), 4.2 (emc-paper), 5.5 (emc), 8.9 (came-paper)
-/// and 8.9 (came, which keeps its whole hierarchy for view-dependent refinement: two nodes a
-/// vertex with their positions, spheres and paths, and every triangle's corner paths; its
-/// priors add about 10 kB whatever the mesh).
+/// where the decoders measure 2.1 (raw), 4.5 (pm), 4.2 (emc-paper), 5.5 (emc), 9.0 (came-paper)
+/// and 8.8 (came, which keeps its whole hierarchy for view-dependent refinement: two nodes a
+/// vertex with their positions, spheres and paths, every triangle's corner paths and, while
+/// units are missing, the corners waiting for them (12 bytes each); its priors add about 10 kB
+/// whatever the mesh).
 pub const DECODE_MEMORY_MULTIPLE: usize = 9;
