@@ -47,29 +47,38 @@ enum Rule {
     },
 }
 
+/// Per inner node, the index of the unit that codes its split: its parent's when that unit
+/// holds its subtree whole, else `unit_for`'s (which lists whether each unit it makes is whole).
+fn assign_units(
+    tree: &meshcodec::codecs::came::decoded::DecodedTree,
+    mut unit_for: impl FnMut(usize, &mut Vec<bool>) -> u32,
+) -> (Vec<u32>, usize) {
+    let n = tree.nodes.len();
+    let mut unit_of = vec![u32::MAX; n];
+    let mut whole_unit: Vec<bool> = Vec::new();
+    // Parents come before their children in the decoded order.
+    for v in 0..n {
+        if tree.nodes[v].children.is_none() {
+            continue;
+        }
+        let parent = tree.nodes[v].parent as usize;
+        unit_of[v] = match unit_of.get(parent) {
+            Some(&unit) if whole_unit[unit as usize] => unit,
+            _ => unit_for(v, &mut whole_unit),
+        };
+    }
+    (unit_of, whole_unit.len())
+}
+
 /// [`Rule::ErrorBands`]: per inner node, the index of the unit that codes its split.
 fn error_band_partition(
     tree: &meshcodec::codecs::came::decoded::DecodedTree,
     inner_below: &[usize],
     (s, k, b, whole): (u16, u16, u16, usize),
 ) -> (Vec<u32>, usize) {
-    let n = tree.nodes.len();
     let level = |v: usize| tree.deviation_steps[v] / s;
-    let mut unit_of = vec![u32::MAX; n];
-    let mut whole_unit: Vec<bool> = Vec::new();
     let mut unit_at: std::collections::HashMap<(u32, u16), u32> = Default::default();
-    for v in 0..n {
-        let node = &tree.nodes[v];
-        if node.children.is_none() {
-            continue;
-        }
-        if node.parent != u32::MAX {
-            let pu = unit_of[node.parent as usize];
-            if whole_unit[pu as usize] {
-                unit_of[v] = pu;
-                continue;
-            }
-        }
+    assign_units(tree, |v, whole_unit| {
         let l = level(v);
         // The band's first level, and the deepest ancestor k levels coarser than it.
         let first = if l < k + b {
@@ -78,12 +87,16 @@ fn error_band_partition(
             k + b + (l - k - b) / b * b
         };
         // The coarsest band is the root's unit; the others are keyed by their region's root.
-        let mut r = if first > 0 { node.parent } else { u32::MAX };
+        let mut r = if first > 0 {
+            tree.nodes[v].parent
+        } else {
+            u32::MAX
+        };
         while r != u32::MAX && level(r as usize) + k > first {
             r = tree.nodes[r as usize].parent;
         }
         let r = if r == u32::MAX { 0 } else { r };
-        let unit = *unit_at.entry((r, first)).or_insert_with(|| {
+        *unit_at.entry((r, first)).or_insert_with(|| {
             // The region's splits from the band's first level down: a whole unit when few.
             let mut frontier = vec![r];
             let mut total = 0;
@@ -102,10 +115,8 @@ fn error_band_partition(
             }
             whole_unit.push(first > 0 && total <= whole);
             whole_unit.len() as u32 - 1
-        });
-        unit_of[v] = unit;
-    }
-    (unit_of, whole_unit.len())
+        })
+    })
 }
 
 /// [`Rule::Bands`]: per inner node, the index of the unit that codes its split.
@@ -114,9 +125,6 @@ fn band_partition(
     inner_below: &[usize],
     (k, b, whole): (u8, u8, usize),
 ) -> (Vec<u32>, usize) {
-    let n = tree.nodes.len();
-    let mut unit_of = vec![u32::MAX; n];
-    let mut whole_unit: Vec<bool> = Vec::new();
     let mut unit_at: std::collections::HashMap<u32, u32> = Default::default();
     // Inner nodes under `r` at depth `a` or deeper.
     let below = |r: u32, a: u8| -> usize {
@@ -133,20 +141,8 @@ fn band_partition(
         }
         total
     };
-    // Parents come before their children in the decoded order.
-    for v in 0..n {
-        let node = &tree.nodes[v];
-        if node.children.is_none() {
-            continue;
-        }
-        if node.parent != u32::MAX {
-            let pu = unit_of[node.parent as usize];
-            if whole_unit[pu as usize] {
-                unit_of[v] = pu;
-                continue;
-            }
-        }
-        let d = node.id.len();
+    assign_units(tree, |v, whole_unit| {
+        let d = tree.nodes[v].id.len();
         let (root_depth, first) = if d < k + b {
             (0, 0)
         } else {
@@ -157,13 +153,11 @@ fn band_partition(
         while tree.nodes[r as usize].id.len() > root_depth {
             r = tree.nodes[r as usize].parent;
         }
-        let unit = *unit_at.entry(r).or_insert_with(|| {
+        *unit_at.entry(r).or_insert_with(|| {
             whole_unit.push(below(r, first) <= whole);
             whole_unit.len() as u32 - 1
-        });
-        unit_of[v] = unit;
-    }
-    (unit_of, whole_unit.len())
+        })
+    })
 }
 
 /// Per inner node: the index of the unit that codes its split.
