@@ -63,8 +63,8 @@ pub(super) struct Encoder<'a> {
     face_normal_codes: Vec<Vec<Option<Option<[i32; 2]>>>>,
     /// The largest angle between a coded normal and its triangle's, in degrees.
     face_normal_error: f64,
-    /// Per unit, in stream order: the corner paths it carries on (syntax 9), by the split of
-    /// its where they wait, in the order they began to wait.
+    /// Per unit, in stream order: the corner paths it carries on (syntax 9), by the unit's
+    /// split they wait at, in the order they began to wait.
     carried: Vec<Vec<(u32, Vec<Waiting>)>>,
 }
 
