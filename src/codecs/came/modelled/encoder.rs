@@ -424,15 +424,25 @@ impl<'a> Encoder<'a> {
             );
             let mut previous = 0;
             let normals = &self.face_normal_codes[s as usize - tree.leaves];
+            // Per triangle, its n3 path as the unit codes it (to its leaf, or to the node it
+            // waits at: then that node may be a dependency), and its junction's depth.
+            let mut thirds = Vec::with_capacity(born.len());
             for (tri, normal) in born.iter().zip(normals) {
                 let [n1, n2, n3] = self.corner_paths(s, tri);
                 for (start, leaf, target, kind) in [n1, n2] {
                     self.put_leaf_path(enc, ctx, start, leaf, target, kind, unit);
                 }
-                let up = sid.len() - tree.ids[tri.leaves[2] as usize].common_len(sid);
-                enc.uint(&mut ctx.up, up as u64 - 1, C, "connectivity");
+                let junction = tree.ids[tri.leaves[2] as usize].common_len(sid);
+                enc.uint(
+                    &mut ctx.up,
+                    (sid.len() - junction) as u64 - 1,
+                    C,
+                    "connectivity",
+                );
                 let (start, leaf, target, kind) = n3;
                 self.put_leaf_path(enc, ctx, start, leaf, target, kind, unit);
+                let (end, waits) = self.path_end(start, leaf, unit);
+                thirds.push((tree.ids[end as usize], junction, waits));
                 enc.bit(
                     &mut ctx.orientation[previous],
                     tri.flipped,
@@ -451,23 +461,16 @@ impl<'a> Encoder<'a> {
             let deps = &tree.dependencies[s as usize - tree.leaves];
             enc.uint(&mut ctx.dependencies, deps.len() as u64, C, "dependencies");
             for &y in deps {
-                // Almost always an ancestor of an n3 corner below its junction: which
-                // triangle's, and how far above the corner.
-                // The n3 path as the unit codes it: to its leaf, or to where it waits (then
-                // the node it waits at may be the one).
+                // Almost always a node of a triangle's n3 path below its junction: which
+                // triangle's, and how far above the path's leaf (or the node it waits at).
                 let yid = tree.ids[y as usize];
-                let rise = |t: &BornTriangle| {
-                    let (start, leaf, _, _) = self.corner_paths(s, t)[2];
-                    let (end, waits) = self.path_end(start, leaf, unit);
-                    let end = tree.ids[end as usize];
-                    let below = yid.len() > tree.ids[leaf as usize].common_len(sid);
-                    (below && yid.is_ancestor_of(end) && (waits || yid != end))
-                        .then(|| end.len() - yid.len() - !waits as u8)
-                };
-                let on = born
+                let on = thirds
                     .iter()
                     .enumerate()
-                    .find_map(|(k, t)| Some((k, rise(t)?)));
+                    .find_map(|(k, &(end, junction, waits))| {
+                        (yid.len() > junction && yid.is_ancestor_of(end) && (waits || yid != end))
+                            .then(|| (k, end.len() - yid.len() - !waits as u8))
+                    });
                 let which = on.map_or(born.len(), |(k, _)| k);
                 enc.uint(&mut ctx.dependency_on, which as u64, C, "dependencies");
                 if let Some((_, rise)) = on {

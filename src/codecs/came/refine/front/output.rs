@@ -40,18 +40,23 @@ impl ViewMesh {
 
     /// The present triangles ([`PresentTriangle`]), by their birth nodes in loading order.
     pub fn present_triangles(&self) -> impl Iterator<Item = PresentTriangle> + '_ {
-        (0..self.nodes.ids.len())
-            .filter(|&v| self.front.state[v] == State::Split)
+        self.present_by_birth()
+            .map(move |(v, ordinal, t)| PresentTriangle {
+                birth: (self.nodes.ids[v as usize], ordinal),
+                paths: self.faces.leaf_corners[t as usize],
+                at: self.faces.corners[t as usize].map(|c| self.nodes.bounds[c as usize].center),
+            })
+    }
+
+    /// The present triangles as (birth node, place among its triangles, triangle): those
+    /// born at the split nodes.
+    pub(super) fn present_by_birth(&self) -> impl Iterator<Item = (u32, u32, u32)> + '_ {
+        (0..self.nodes.ids.len() as u32)
+            .filter(|&v| self.front.state[v as usize] == State::Split)
             .flat_map(move |v| {
-                self.nodes.born[v]
-                    .iter()
-                    .enumerate()
-                    .map(move |(ordinal, &t)| PresentTriangle {
-                        birth: (self.nodes.ids[v], ordinal as u32),
-                        paths: self.faces.leaf_corners[t as usize],
-                        at: self.faces.corners[t as usize]
-                            .map(|c| self.nodes.bounds[c as usize].center),
-                    })
+                let born = self.nodes.born[v as usize].iter();
+                born.enumerate()
+                    .map(move |(ordinal, &t)| (v, ordinal as u32, t))
             })
     }
 

@@ -542,17 +542,15 @@ type Counterparts = HashMap<(u64, u32), [DVec3; 3]>;
 fn fold_overs_in_view(vm: &ViewMesh, full: &Counterparts, view: &View) -> (usize, usize) {
     let normal = |p: [DVec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
     let (mut folded, mut coarse) = (0, 0);
-    for v in (0..vm.nodes.ids.len()).filter(|&v| vm.front.state[v] == State::Split) {
-        for (ordinal, &t) in vm.nodes.born[v].iter().enumerate() {
-            let t = t as usize;
-            let at = vm.faces.corners[t].map(|c| vm.nodes.bounds[c as usize].center);
-            let counterpart = full[&(vm.nodes.ids[v].packed(), ordinal as u32)];
-            if at != counterpart {
-                coarse += 1;
-            }
-            if vm.in_view(view, vm.faces.corners[t]) && normal(at).dot(normal(counterpart)) <= 0.0 {
-                folded += 1;
-            }
+    for (v, ordinal, t) in vm.present_by_birth() {
+        let corners = vm.faces.corners[t as usize];
+        let at = corners.map(|c| vm.nodes.bounds[c as usize].center);
+        let counterpart = full[&(vm.nodes.ids[v as usize].packed(), ordinal)];
+        if at != counterpart {
+            coarse += 1;
+        }
+        if vm.in_view(view, corners) && normal(at).dot(normal(counterpart)) <= 0.0 {
+            folded += 1;
         }
     }
     (folded, coarse)
