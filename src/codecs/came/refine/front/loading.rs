@@ -21,14 +21,6 @@ impl ViewMesh {
             Ok(delta) => {
                 self.loading.units[loaded.unit] = UnitState::Loaded;
                 self.grow(delta);
-                // The orientation certificates read the deepest loaded nodes: a collapse
-                // refused before may be allowed now.
-                for p in std::mem::take(&mut self.guard.refused) {
-                    if !self.guard.in_retry[p as usize] {
-                        self.guard.in_retry[p as usize] = true;
-                        self.guard.retry.push(p);
-                    }
-                }
             }
             Err(e) => {
                 self.loading.units[loaded.unit] = UnitState::Refused;
@@ -97,8 +89,12 @@ impl ViewMesh {
     pub(super) fn take_arrivals(&mut self, block: bool) -> usize {
         let arrived = self.loading.loader.collect(self.loading.outstanding, block);
         let count = arrived.len();
+        let loaded_before = self.nodes.ids.len();
         for loaded in arrived {
             self.take_in(loaded);
+        }
+        if self.nodes.ids.len() > loaded_before {
+            self.retry_after_arrivals();
         }
         count
     }

@@ -101,6 +101,26 @@ impl ViewMesh {
         }
     }
 
+    /// After meta-nodes arrived: the collapses refused for a face whose certificate reads the
+    /// deepest loaded nodes are listed to be tried again (it may hold now). Those refused for
+    /// a face whose own coded normal decides it stay refused: no meta-node changes what that
+    /// face proves, and a move of the face lists them again ([`Self::retry_around`]).
+    pub(super) fn retry_after_arrivals(&mut self) {
+        let mut refused = std::mem::take(&mut self.guard.refused);
+        refused.retain(|&p| {
+            let culprit = self.guard.held_by[p as usize];
+            if culprit != NONE && self.faces.normals[culprit as usize].decides() {
+                return true;
+            }
+            if !self.guard.in_retry[p as usize] {
+                self.guard.in_retry[p as usize] = true;
+                self.guard.retry.push(p);
+            }
+            false
+        });
+        self.guard.refused = refused;
+    }
+
     /// Whether the face on active nodes `corners` shows in the view: it meets the frustum and
     /// spans the tolerance on the screen ([`View::shows_triangle`]).
     pub(super) fn in_view(&self, view: &View, corners: [u32; 3]) -> bool {
@@ -466,8 +486,9 @@ impl ViewMesh {
     /// After the passes: the collapses a face's orientation may have refused tried again, and
     /// the guard ([`Self::guard`]), until neither does anything. Tried again: those near a face
     /// that moved, appeared or went since they were last tried (`retry`: the parents of its
-    /// corners), and every refused one after a meta-node arrives (the certificates read the
-    /// deepest loaded nodes) or after whole passes (a view that may be new).
+    /// corners), after meta-nodes arrive those refused for a face whose certificate reads the
+    /// deepest loaded nodes ([`Self::retry_after_arrivals`]), and every refused one after whole
+    /// passes (a view that may be new).
     pub(super) fn settle_orientation(
         &mut self,
         view: &View,
