@@ -2,24 +2,15 @@
 //! nodes and triangles) miss the TLB on nearly every read with 4 kB pages; backed by 2 MB pages
 //! where the kernel allows it, far fewer do (BENCHMARKS.md, "The front's lists in huge pages").
 
-/// Reserves room for `count` records in `list` at once, rather than by doubling (which would
-/// move the pages already touched, small), and advises huge pages for it ([`advise`]), when
-/// that much is 2 MB or more; on Linux only, where a reservation costs address space, not
-/// memory, until it is touched. The reservation is at least 32 MB: glibc's allocator maps a
-/// block that large afresh, where below it (its threshold rises as large blocks are freed) it
-/// may hand back heap memory already touched, in small pages the advice does not change.
+/// Reserves room for `count` records in `list`, at once rather than by doubling (which would
+/// move the pages already touched, small), and advises huge pages for it ([`advise`]). Only on
+/// Linux, where a reservation costs address space, not memory, until it is touched.
 pub(crate) fn reserve<T>(list: &mut Vec<T>, count: usize) {
-    const FRESH: usize = 32 << 20;
-    let size = std::mem::size_of::<T>().max(1);
-    if cfg!(target_os = "linux") && count.saturating_mul(size) >= HUGE {
-        let count = count.max(FRESH / size);
+    if cfg!(target_os = "linux") {
         list.reserve_exact(count.saturating_sub(list.len()));
         advise(list);
     }
 }
-
-/// A huge page's size.
-const HUGE: usize = 2 << 20;
 
 /// Asks the kernel to back the 2 MB-aligned part of `list`'s buffer with huge pages (Linux's
 /// `MADV_HUGEPAGE`, honoured when transparent huge pages are `always` or `madvise`). Only a
@@ -29,6 +20,7 @@ const HUGE: usize = 2 << 20;
 fn advise<T>(list: &Vec<T>) {
     #[cfg(target_os = "linux")]
     {
+        const HUGE: usize = 2 << 20;
         let start = list.as_ptr() as usize;
         let bytes = list.capacity() * std::mem::size_of::<T>();
         let from = start.next_multiple_of(HUGE);
