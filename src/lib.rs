@@ -35,8 +35,8 @@
 //! ```
 
 // Unsafe code is allowed only where it is needed, each block with its SAFETY reason: the raw
-// views of `emc`'s slab lanes (`codecs::emc::clusters`, `codecs::emc::modelled::walk`), the
-// prefetch hint and the paging hint.
+// views of `emc`'s slab lanes (`codecs::emc::clusters`, `codecs::emc::modelled::walk`) and the
+// prefetch hint.
 #![deny(unsafe_code)]
 #![warn(clippy::undocumented_unsafe_blocks)]
 
@@ -45,7 +45,6 @@ pub mod coding;
 pub mod container;
 pub mod error;
 pub mod hierarchy;
-mod huge_pages;
 pub mod limits;
 pub mod mesh;
 mod prefetch;

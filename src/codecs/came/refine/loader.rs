@@ -369,9 +369,6 @@ pub(super) struct Opened {
     pub stream_bytes: u64,
     /// Bytes read for the header and the index's first entries.
     pub head_bytes: u64,
-    /// The full mesh's vertices and triangles, as the header counts them.
-    pub vertices: u64,
-    pub triangles: u64,
     pub root: Loaded,
 }
 
@@ -557,8 +554,6 @@ impl Loader {
             units,
             stream_bytes,
             head_bytes,
-            vertices: header.vertices,
-            triangles: header.triangles,
             root,
         };
         Ok((loader, opened))

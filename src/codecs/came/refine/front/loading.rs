@@ -85,38 +85,6 @@ impl ViewMesh {
         }
     }
 
-    /// Reserves the node and triangle lists for the whole hierarchy, in huge pages where the
-    /// system has them (`crate::huge_pages`: the passes and the guard read them in no order).
-    /// The hierarchy has 2V − 1 nodes over the header's V vertices, and its T triangles; at
-    /// most 8 of either a byte of the stream are reserved, so that a lying header reserves no
-    /// more than the stream justifies (past that, the lists grow as they would).
-    pub(super) fn reserve(&mut self, vertices: u64, triangles: u64, stream_bytes: u64) {
-        use crate::huge_pages::reserve;
-        let most = stream_bytes.saturating_mul(8);
-        let nodes = vertices.saturating_mul(2).min(most) as usize;
-        let triangles = triangles.min(most) as usize;
-        let (n, f, g) = (&mut self.nodes, &mut self.faces, &mut self.guard);
-        reserve(&mut n.ids, nodes);
-        reserve(&mut n.parent, nodes);
-        reserve(&mut n.children, nodes);
-        reserve(&mut n.opens, nodes);
-        reserve(&mut n.bounds, nodes);
-        reserve(&mut n.born, nodes);
-        reserve(&mut n.depends_on, nodes);
-        reserve(&mut self.front.state, nodes);
-        reserve(&mut self.front.active_slot, nodes);
-        reserve(&mut self.front.split_dependants, nodes);
-        reserve(&mut f.faces_at, nodes);
-        reserve(&mut g.held_by, nodes);
-        reserve(&mut g.refused_listed, nodes);
-        reserve(&mut g.in_retry, nodes);
-        reserve(&mut self.scratch.planned, nodes);
-        reserve(&mut f.leaf_corners, triangles);
-        reserve(&mut f.normals, triangles);
-        reserve(&mut f.corners, triangles);
-        reserve(&mut g.suspected, triangles);
-    }
-
     /// Takes in the meta-nodes that have arrived (all those asked for when `block`).
     pub(super) fn take_arrivals(&mut self, block: bool) -> usize {
         let arrived = self.loading.loader.collect(self.loading.outstanding, block);

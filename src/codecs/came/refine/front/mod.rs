@@ -280,7 +280,6 @@ impl ViewMesh {
             },
             scale: 1.0,
         };
-        vm.reserve(opened.vertices, opened.triangles, opened.stream_bytes);
         let root = opened.root;
         if let Err(e) = &root.outcome {
             return Err(Error::malformed(1, 0, format!("the root meta-node: {e}")));
