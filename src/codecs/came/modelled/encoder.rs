@@ -440,8 +440,7 @@ impl<'a> Encoder<'a> {
                     "connectivity",
                 );
                 let (start, leaf, target, kind) = n3;
-                self.put_leaf_path(enc, ctx, start, leaf, target, kind, unit);
-                let (end, waits) = self.path_end(start, leaf, unit);
+                let (end, waits) = self.put_leaf_path(enc, ctx, start, leaf, target, kind, unit);
                 thirds.push((tree.ids[end as usize], junction, waits));
                 enc.bit(
                     &mut ctx.orientation[previous],
@@ -501,6 +500,9 @@ impl<'a> Encoder<'a> {
         }
     }
 
+    /// Codes the corner path from `start` to `leaf` as far as `unit` knows the hierarchy, and
+    /// returns where it ends: the leaf, or the node it waits at (`true`), as [`Self::path_end`]
+    /// finds without coding it.
     #[allow(clippy::too_many_arguments)]
     fn put_leaf_path(
         &self,
@@ -511,7 +513,7 @@ impl<'a> Encoder<'a> {
         target: [f64; 3],
         kind: Kind,
         unit: NodeId,
-    ) {
+    ) -> (u32, bool) {
         let tree = self.tree;
         let lid = tree.ids[leaf as usize];
         let mut x = start;
@@ -521,10 +523,10 @@ impl<'a> Encoder<'a> {
             let depth = tree.ids[x as usize].len();
             if self.waits_at(x, unit) {
                 // The unit that splits x carries the path on (syntax 9).
-                return;
+                return (x, true);
             }
             match status {
-                Status::Leaf => return,
+                Status::Leaf => return (x, false),
                 Status::Unknown => {
                     let is_leaf = tree.is_leaf(x);
                     enc.bit(
@@ -534,7 +536,7 @@ impl<'a> Encoder<'a> {
                         "connectivity",
                     );
                     if is_leaf {
-                        return;
+                        return (x, false);
                     }
                 }
                 _ => {}
