@@ -1,7 +1,8 @@
 //! The fly-through's path (`meshcodec_lab::came::flythrough::cameras`) over a `came` stream, with one
 //! front alone (`meshcodec_lab::came::flythrough::fly_alone`, as the fly-through experiment times
 //! it): adaptation time per frame with the orientation guard and without, meta-node waits apart.
-//! Run: cargo run --release --example came_fly_adapt -- STREAM
+//! Run: cargo run --release --example came_fly_adapt -- STREAM [on|off]
+//! (`on` or `off` flies once, with the guard or without, for a profiler; both by default.)
 //! (when STREAM does not exist, the fly-through's stream — bunny-closed-35k subdivided twice,
 //! `came` at 12 bits — is encoded and written there first: about three minutes.)
 use meshcodec::codecs::came::refine::{Budget, View, ViewMesh};
@@ -20,7 +21,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     full.settle(&View::everything(), Budget::UNLIMITED, 256);
     let cameras = cameras(&full.mesh())?;
     drop(full);
-    for guard in [true, false] {
+    let guards = match std::env::args().nth(2).as_deref() {
+        None => vec![true, false],
+        Some("on") => vec![true],
+        Some("off") => vec![false],
+        Some(other) => return Err(format!("expected on or off, not {other}").into()),
+    };
+    for guard in guards {
         let frames = fly_alone(path, &cameras, guard)?;
         let mut sorted: Vec<f64> = frames.iter().map(|f| f.adapt_ms).collect();
         sorted.sort_by(f64::total_cmp);
