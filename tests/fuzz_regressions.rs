@@ -81,6 +81,7 @@ regressions! {
     gltf_indices_of_a_float_type_are_refused: "read_gltf" / "indices-of-float-component-type";
     positions_beyond_f32_are_refused_by_the_gltf_writer: "read_ply" / "positions-beyond-f32-written-as-gltf";
     colours_beyond_f32_are_refused_by_the_gltf_writer: "read_obj" / "colours-beyond-f32-written-as-gltf";
+    obj_writer_colours_every_vertex_when_some_are_in_no_face: "read_ply" / "colours-with-vertices-no-face-uses-written-as-obj";
     came_guard_skips_a_corner_not_above_its_leaf: "adapt_came" / "guard-corner-not-above-its-leaf";
     came_node_decoded_beyond_the_grid_is_refused: "decode_came" / "node-position-beyond-the-grid";
 }

@@ -295,6 +295,14 @@ pub fn write_attributed(m: &AttributedMesh, out: &mut impl std::io::Write) -> Re
     if let Some(library) = a.materials.as_ref().and_then(|m| m.library.as_ref()) {
         let _ = writeln!(text, "mtllib {library}");
     }
+    // A vertex no face uses has no wedge, so no colour; OBJ's colours are all or none (a
+    // reader refuses a file that gives some vertices one and others none), so it gets white,
+    // which no face can show.
+    if a.colours.is_some() {
+        for c in &mut vertex_colour {
+            c.get_or_insert([1.0; 4]);
+        }
+    }
     for (p, c) in mesh.positions.iter().zip(&vertex_colour) {
         match c {
             Some(c) => {
