@@ -33,11 +33,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         sorted.sort_by(f64::total_cmp);
         let at = |q: f64| sorted[((sorted.len() - 1) as f64 * q).round() as usize];
         let waiting: f64 = frames.iter().map(|f| f.wait_ms).sum();
+        let adapting: f64 = frames.iter().map(|f| f.adapt_ms).sum();
         println!(
-            "guard {guard}: adaptation median {:.1} ms, 95th percentile {:.1} ms, first frame {:.1} ms; {:.0} ms waiting for meta-nodes",
+            "guard {guard}: adaptation median {:.1} ms, 95th percentile {:.1} ms, first frame {:.1} ms, {:.0} ms over the path; {:.0} ms waiting for meta-nodes",
             at(0.5),
             at(0.95),
             frames[0].adapt_ms,
+            adapting,
             waiting
         );
     }
