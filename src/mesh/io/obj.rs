@@ -266,7 +266,7 @@ fn check_face_indices(bytes: &[u8]) -> Result<()> {
 /// a vertex (with its colour when colours are per vertex), one `vt` and `vn` a wedge, `usemtl`
 /// where the material changes, `f v/vt/vn`. Numbers in Rust's shortest round-trip form, so they
 /// read back as the same doubles. OBJ holds colours per vertex only: a mesh whose colours
-/// differ between the wedges of a vertex is refused.
+/// differ between the wedges of a vertex is refused, and a vertex no face uses is written white.
 pub fn write_attributed(m: &AttributedMesh, out: &mut impl std::io::Write) -> Result<()> {
     use std::fmt::Write as _;
     let (mesh, a) = (&m.mesh, &m.attributes);
