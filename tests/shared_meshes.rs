@@ -90,7 +90,7 @@ fn every_shared_mesh_round_trips_losslessly() {
         .flat_map(|mesh| registry.iter().map(move |codec| (mesh, codec)))
         .collect();
     // Per job: the failures, and the runs pm cut to a manifold.
-    let outcomes: Vec<(Vec<String>, Vec<String>)> = jobs
+    let (failures, cut): (Vec<Vec<String>>, Vec<Vec<String>>) = jobs
         .into_par_iter()
         .map(|((file, mesh), codec)| {
             let (mut failures, mut cut) = (Vec::new(), Vec::new());
@@ -144,9 +144,8 @@ fn every_shared_mesh_round_trips_losslessly() {
             }
             (failures, cut)
         })
-        .collect();
-    let failures: Vec<String> = outcomes.iter().flat_map(|o| o.0.clone()).collect();
-    let cut: Vec<String> = outcomes.iter().flat_map(|o| o.1.clone()).collect();
+        .unzip();
+    let (failures, cut) = (failures.concat(), cut.concat());
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     eprintln!("cut to a manifold by pm: {}", cut.join(", "));
     // The meshes MANIFEST.md says are not manifolds are among them.
