@@ -247,15 +247,24 @@ impl ViewMesh {
         cos_beta * cos_gamma - sin_beta * sin_gamma > 1e-9
     }
 
-    /// Whether ecol of split node `s` leaves every face it moves that is in view certain of
-    /// its orientation (the faces born at `s`, on both children, go).
+    /// Whether ecol of split node `s` may be made, for the faces it moves.
     ///
-    /// A refused node is listed (`refused`), and the face that refused it is checked first the
-    /// next time (a node the guard split is refused again and again while its view lasts: one
-    /// face checked, not its dozen). `retry`: check a listed node again.
+    /// In the passes (`retry` false) it may, unless the guard refused it in this view: the
+    /// faces it moves are listed (`collapse` suspects them), and the guard after the passes
+    /// splits again where one in view is left not certain, and lists that split as refused.
+    /// Checking those faces before the collapse as well read each of them twice in a frame
+    /// (a fifth of the fly-through's median frame: BENCHMARKS.md).
+    ///
+    /// Tried again (`retry`: a refused collapse, after the guard, when a face it would move
+    /// has moved, or in a new view), it is made only if it leaves every face it moves that is
+    /// in view certain of its orientation (the faces born at `s`, on both children, go):
+    /// made and split again, it would be tried again and again. A refused node is listed
+    /// (`refused`), and the face that refused it is checked first the next time (a node the
+    /// guard split is refused again and again while its view lasts: one face checked, not its
+    /// dozen).
     ///
     /// While the front holds more faces than a face budget allows, the budget comes first: the
-    /// collapse is made, and the faces it leaves not certain stay listed.
+    /// passes' collapse is made, and the faces it leaves not certain stay listed.
     pub(super) fn collapse_keeps_orientation(
         &mut self,
         s: u32,
@@ -267,12 +276,11 @@ impl ViewMesh {
         if !view.keeps_orientation() {
             return true;
         }
-        // (Not when trying again after the guard, which would undo its splits over and over.)
-        if !retry && budget.faces.is_some_and(|target| self.faces.count > target) {
-            return true;
-        }
-        if self.guard.refused_listed[su] && !retry {
-            return false;
+        // The passes: the guard settles what they leave (a retry is checked, or it would undo
+        // the guard's splits over and over).
+        if !retry {
+            return budget.faces.is_some_and(|target| self.faces.count > target)
+                || !self.guard.refused_listed[su];
         }
         let [t, u] = self.nodes.children[su];
         // Face `f` once `s` is collapsed: in view and not certain?
