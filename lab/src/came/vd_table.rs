@@ -205,6 +205,8 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
         .collect();
     let within = ratios.iter().filter(|&&r| r <= FACE_TARGET).count();
     let adapt: Vec<f64> = frames.iter().map(|f| f.front.adapt_ms).collect();
+    // The same front without the guard, timed in the same run: how fast the machine was.
+    let adapt_unguarded: Vec<f64> = frames.iter().map(|f| f.adapt_ms_unguarded).collect();
     let max_error = frames.iter().map(|f| f.max_error_px).fold(0.0, f64::max);
     let least_mean = frames
         .iter()
@@ -282,6 +284,12 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
     row(&mut md, "adaptation ms (fetch waits apart)", &adapt, 1);
     row(
         &mut md,
+        "adaptation ms without the guard (same run)",
+        &adapt_unguarded,
+        1,
+    );
+    row(
+        &mut md,
         "fetch wait ms",
         &frames.iter().map(|f| f.front.wait_ms).collect::<Vec<_>>(),
         1,
@@ -349,7 +357,7 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
          | per-frame mean error at least τ/4 | least frame mean {least_mean:.3} px{simplifier_mean} | {} |\n\
          | far view of dragon-50k reads at most 5% of its stream | {} | {} |\n\
          | the million-triangle mesh whole at 1.5 diagonals reads at most 10% | {} | {} |\n\
-         | fly-through adaptation: median at most 4 ms, 95th percentile at most 16 ms | {:.1} ms, {:.1} ms | {} |",
+         | fly-through adaptation: median at most 4 ms, 95th percentile at most 16 ms | {:.1} ms, {:.1} ms (without the guard, same run: {:.1} ms, {:.1} ms) | {} |",
         ratios.len(),
         ratios.iter().copied().fold(0.0, f64::max),
         met(worst_ratio <= FACE_TARGET && within == ratios.len() && !ratios.is_empty()),
@@ -362,6 +370,8 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
         met(large_middle.is_some_and(|v| v.share_of_stream <= 0.10)),
         quantile(&adapt, 0.5),
         quantile(&adapt, 0.95),
+        quantile(&adapt_unguarded, 0.5),
+        quantile(&adapt_unguarded, 0.95),
         met(quantile(&adapt, 0.5) <= 4.0 && quantile(&adapt, 0.95) <= 16.0)
     );
     // Renders.

@@ -66,13 +66,14 @@
 //! they decide it, exactly once the leaves are in. Only a face that is not certain from its
 //! counterpart itself (it folds over) or whose meta-nodes cannot come (refused) has a corner
 //! split (with its dependencies) — the coarsest whose split alone would make it certain, else
-//! the coarsest that can be split — in turn until it is, at worst down to the leaves. Splitting for want of data chased each counterpart down the
-//! hierarchy, face after face, and cost the million-triangle mesh's far view 13× the unguarded
-//! front's faces (1.05× now, for 17 points more of its stream read: BENCHMARKS.md). The
-//! passes collapse without checking the faces a collapse moves: a face in view it leaves not
-//! certain is listed and split as above after the passes (the split is mostly the collapse
-//! undone), and the guard's splits and the collapses they undo are tried again only with their
-//! faces checked first, a collapse that would leave a face in view not certain not being made. Faces out of view that
+//! the coarsest that can be split — in turn until it is, at worst down to the leaves.
+//! Splitting for want of data chased each counterpart down the hierarchy, face after face, and
+//! cost the million-triangle mesh's far view 13× the unguarded front's faces (1.05× now, for 17
+//! points more of its stream read: BENCHMARKS.md). The passes collapse without checking the
+//! faces a collapse moves: those it leaves in view and not certain are split as above after the
+//! passes, like any other listed face. A node the guard split collapses again only when a retry
+//! finds every face in view it would move certain (retries come after the guard, when a face
+//! the collapse would move moves, and in each new view). Faces out of view that
 //! are not certain stay listed, to be made certain when a view sees them (certainty out of
 //! view would refine the whole surface: 7× the faces close up, in the fly-through). A face
 //! waiting for a meta-node is also kept listed (the front is not settled meanwhile), and so
