@@ -253,7 +253,7 @@ impl ViewMesh {
     /// faces it moves are listed (`collapse` suspects them), and the guard after the passes
     /// splits again where one in view is left not certain, and lists that split as refused.
     /// Checking those faces before the collapse as well read each of them twice in a frame
-    /// (a fifth of the fly-through's median frame: BENCHMARKS.md).
+    /// (the fly-through's median frame 16% longer: BENCHMARKS.md).
     ///
     /// Tried again (`retry`: a refused collapse, after the guard, when a face it would move
     /// has moved, or in a new view), it is made only if it leaves every face it moves that is
