@@ -3,7 +3,7 @@
 
 use super::super::loader::{Loaded, UnitDelta, NONE};
 use super::orientation::CodedNormal;
-use super::parts::Bounds;
+use super::parts::{Bounds, Links};
 use super::{Ready, State, Suspicion, UnitState, ViewMesh};
 use smallvec::SmallVec;
 
@@ -31,15 +31,21 @@ impl ViewMesh {
 
     pub(super) fn grow(&mut self, delta: UnitDelta) {
         for n in delta.nodes {
-            let v = self.nodes.ids.len() as u32;
+            let v = self.nodes.links.len() as u32;
             if n.parent != NONE {
                 let p = n.parent as usize;
-                self.nodes.children[p][n.id.bit(n.id.len() - 1) as usize] = v;
+                self.nodes.links[p].children[n.id.bit(n.id.len() - 1) as usize] = v;
                 self.nodes.opens[p] = NONE;
             }
-            self.nodes.ids.push(n.id);
-            self.nodes.parent.push(n.parent);
-            self.nodes.children.push([NONE; 2]);
+            self.nodes.links.push(Links {
+                faces_at: SmallVec::new(),
+                id: n.id,
+                children: [NONE; 2],
+                parent: n.parent,
+                active_slot: NONE,
+                split_dependants: 0,
+                state: State::Below,
+            });
             self.nodes.opens.push(NONE);
             self.nodes.bounds.push(Bounds {
                 center: n.center,
@@ -47,20 +53,16 @@ impl ViewMesh {
                 deviation: n.deviation,
                 cone: n.cone,
             });
-            self.front.state.push(State::Below);
             self.nodes.born.push(SmallVec::new());
             self.nodes.depends_on.push(SmallVec::new());
-            self.front.split_dependants.push(0);
             self.guard.held_by.push(NONE);
             self.guard.refused_listed.push(false);
             self.guard.in_retry.push(false);
-            self.faces.faces_at.push(SmallVec::new());
-            self.front.active_slot.push(NONE);
             self.scratch.planned.push(false);
         }
         self.front
             .active_bits
-            .resize(self.nodes.ids.len().div_ceil(64), 0);
+            .resize(self.nodes.links.len().div_ceil(64), 0);
         for (birth, corners, normal) in delta.triangles {
             self.nodes.born[birth as usize].push(self.faces.leaf_corners.len() as u32);
             self.faces.leaf_corners.push(corners);
@@ -89,11 +91,11 @@ impl ViewMesh {
     pub(super) fn take_arrivals(&mut self, block: bool) -> usize {
         let arrived = self.loading.loader.collect(self.loading.outstanding, block);
         let count = arrived.len();
-        let loaded_before = self.nodes.ids.len();
+        let loaded_before = self.nodes.links.len();
         for loaded in arrived {
             self.take_in(loaded);
         }
-        if self.nodes.ids.len() > loaded_before {
+        if self.nodes.links.len() > loaded_before {
             self.retry_after_arrivals();
         }
         count
@@ -102,7 +104,7 @@ impl ViewMesh {
     /// Whether active node `v` can be split now; asks for its meta-node if that is missing.
     pub(super) fn ready(&mut self, v: u32) -> Ready {
         let vu = v as usize;
-        if self.nodes.children[vu][0] != NONE {
+        if self.nodes.links[vu].children[0] != NONE {
             return Ready::Now;
         }
         let unit = self.nodes.opens[vu];

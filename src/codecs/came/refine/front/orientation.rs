@@ -90,7 +90,7 @@ impl ViewMesh {
     /// the guard refused (the passes try every other collapse themselves).
     pub(super) fn retry_around(&mut self, f: u32) {
         for c in self.faces.corners[f as usize] {
-            let p = self.nodes.parent[c as usize];
+            let p = self.nodes.links[c as usize].parent;
             if p != NONE
                 && self.guard.refused_listed[p as usize]
                 && !self.guard.in_retry[p as usize]
@@ -175,7 +175,7 @@ impl ViewMesh {
     ) -> Option<u32> {
         let mut v = corners
             .into_iter()
-            .find(|&c| self.nodes.ids[c as usize].is_ancestor_of(leaf))
+            .find(|&c| self.nodes.links[c as usize].id.is_ancestor_of(leaf))
             .unwrap_or(0);
         while let Some(c) = self.child_toward(v, leaf) {
             v = c;
@@ -282,7 +282,7 @@ impl ViewMesh {
             return budget.faces.is_some_and(|target| self.faces.count > target)
                 || !self.guard.refused_listed[su];
         }
-        let [t, u] = self.nodes.children[su];
+        let [t, u] = self.nodes.links[su].children;
         // Face `f` once `s` is collapsed: in view and not certain?
         let spoilt = |f: u32| {
             let corners = self.faces.corners[f as usize];
@@ -301,7 +301,8 @@ impl ViewMesh {
             Some(held)
         } else {
             [t, u].iter().find_map(|&c| {
-                self.faces.faces_at[c as usize]
+                self.nodes.links[c as usize]
+                    .faces_at
                     .iter()
                     .copied()
                     .find(|&f| spoilt(f))
@@ -444,7 +445,7 @@ impl ViewMesh {
                     }
                 }
                 for &c in &activated {
-                    if self.front.state[c as usize] == State::Active && self.wants(view, c) {
+                    if self.nodes.links[c as usize].state == State::Active && self.wants(view, c) {
                         self.refine_down(c, view, budget, done, below);
                     }
                 }

@@ -35,14 +35,14 @@ impl ViewMesh {
         self.front
             .active
             .iter()
-            .map(|&v| self.nodes.ids[v as usize])
+            .map(|&v| self.nodes.links[v as usize].id)
     }
 
     /// The present triangles ([`PresentTriangle`]), by their birth nodes in loading order.
     pub fn present_triangles(&self) -> impl Iterator<Item = PresentTriangle> + '_ {
         self.present_by_birth()
             .map(move |(v, ordinal, t)| PresentTriangle {
-                birth: (self.nodes.ids[v as usize], ordinal),
+                birth: (self.nodes.links[v as usize].id, ordinal),
                 paths: self.faces.leaf_corners[t as usize],
                 at: self.faces.corners[t as usize].map(|c| self.nodes.bounds[c as usize].center),
             })
@@ -51,8 +51,8 @@ impl ViewMesh {
     /// The present triangles as (birth node, place among its triangles, triangle): those
     /// born at the split nodes.
     pub(super) fn present_by_birth(&self) -> impl Iterator<Item = (u32, u32, u32)> + '_ {
-        (0..self.nodes.ids.len() as u32)
-            .filter(|&v| self.front.state[v as usize] == State::Split)
+        (0..self.nodes.links.len() as u32)
+            .filter(|&v| self.nodes.links[v as usize].state == State::Split)
             .flat_map(move |v| {
                 let born = self.nodes.born[v as usize].iter();
                 born.enumerate()
@@ -62,7 +62,7 @@ impl ViewMesh {
 
     /// The adapted mesh: the active nodes' positions, the present triangles.
     pub fn mesh(&self) -> TriMesh {
-        let mut index = vec![NONE; self.nodes.ids.len()];
+        let mut index = vec![NONE; self.nodes.links.len()];
         let mut positions = Vec::with_capacity(self.front.active.len());
         for &v in &self.front.active {
             index[v as usize] = positions.len() as u32;
@@ -98,19 +98,23 @@ impl ViewMesh {
 
     /// Checks every invariant of the module docs; the first broken one, described.
     pub fn check_invariants(&self) -> std::result::Result<(), String> {
-        let n = self.nodes.ids.len();
+        let n = self.nodes.links.len();
         self.nodes.check()?;
-        self.front.check(n)?;
+        self.front.check(&self.nodes.links)?;
         self.faces.check()?;
         self.guard.check()?;
-        if self.front.state[0] == State::Below {
+        if self.nodes.links[0].state == State::Below {
             return Err("the root is below the front".into());
         }
         for v in 0..n {
-            let st = self.front.state[v];
-            let inner = self.nodes.children[v][0] != NONE;
-            for c in self.nodes.children[v].into_iter().filter(|&c| c != NONE) {
-                let cs = self.front.state[c as usize];
+            let st = self.nodes.links[v].state;
+            let inner = self.nodes.links[v].children[0] != NONE;
+            for c in self.nodes.links[v]
+                .children
+                .into_iter()
+                .filter(|&c| c != NONE)
+            {
+                let cs = self.nodes.links[c as usize].state;
                 let fine = match st {
                     State::Split => cs != State::Below,
                     _ => cs == State::Below,
@@ -123,16 +127,15 @@ impl ViewMesh {
                 return Err(format!("leaf {v} is split"));
             }
             let bit = self.front.active_bits[v / 64] >> (v % 64) & 1 == 1;
-            if (st == State::Active) != (self.front.active_slot[v] != NONE)
+            if (st == State::Active) != (self.nodes.links[v].active_slot != NONE)
                 || (st == State::Active) != bit
             {
                 return Err(format!("node {v} is {st:?} but listed otherwise"));
             }
             if st == State::Split {
-                if let Some(d) = self.nodes.depends_on[v]
-                    .iter()
-                    .find(|d| d.node == NONE || self.front.state[d.node as usize] != State::Split)
-                {
+                if let Some(d) = self.nodes.depends_on[v].iter().find(|d| {
+                    d.node == NONE || self.nodes.links[d.node as usize].state != State::Split
+                }) {
                     return Err(format!(
                         "split node {v} depends on {:?}, which is not split",
                         d.id
@@ -141,12 +144,16 @@ impl ViewMesh {
             }
         }
         let mut dependants = vec![0u32; n];
-        for v in (0..n).filter(|&v| self.front.state[v] == State::Split) {
+        for v in (0..n).filter(|&v| self.nodes.links[v].state == State::Split) {
             for d in &self.nodes.depends_on[v] {
                 dependants[d.node as usize] += 1;
             }
         }
-        if dependants != self.front.split_dependants {
+        if dependants
+            .iter()
+            .zip(&self.nodes.links)
+            .any(|(&d, l)| d != l.split_dependants)
+        {
             return Err("the counts of split dependants are off".into());
         }
         let mut listed = vec![0usize; n];
@@ -154,11 +161,11 @@ impl ViewMesh {
         for v in 0..n {
             for &t in &self.nodes.born[v] {
                 let tu = t as usize;
-                if self.faces.present(tu) != (self.front.state[v] == State::Split) {
+                if self.faces.present(tu) != (self.nodes.links[v].state == State::Split) {
                     return Err(format!(
                         "triangle {t} present {} at a {:?} birth node",
                         self.faces.present(tu),
-                        self.front.state[v]
+                        self.nodes.links[v].state
                     ));
                 }
                 if !self.faces.present(tu) {
@@ -169,8 +176,8 @@ impl ViewMesh {
                 for (k, (&corner, &leaf)) in c.iter().zip(&self.faces.leaf_corners[tu]).enumerate()
                 {
                     let cu = corner as usize;
-                    if self.front.state[cu] != State::Active
-                        || !self.nodes.ids[cu].is_ancestor_of(leaf)
+                    if self.nodes.links[cu].state != State::Active
+                        || !self.nodes.links[cu].id.is_ancestor_of(leaf)
                     {
                         return Err(format!(
                             "triangle {t}'s corner {k} is not its leaf's active node"
@@ -199,7 +206,7 @@ impl ViewMesh {
             ));
         }
         for &v in &self.front.active {
-            let list = &self.faces.faces_at[v as usize];
+            let list = &self.nodes.links[v as usize].faces_at;
             if list.len() != listed[v as usize]
                 || list
                     .iter()

@@ -13,14 +13,14 @@ use glam::DVec3;
 use smallvec::SmallVec;
 
 /// The decoded tree's records, one entry a node in the loader's decoding order, every list as
-/// long as `ids`: what a meta-node brought. Only `children` and `opens` change after, when the
-/// meta-node that splits a node is taken in.
+/// long as `links`: what a meta-node brought, and each node's place on the front (in its
+/// links, beside its place in the tree, as a split or collapse reads both). Of what a
+/// meta-node brought, only `children` and `opens` change after, when the meta-node that
+/// splits a node is taken in.
 #[derive(Default)]
 pub(super) struct Nodes {
-    pub(super) ids: Vec<NodeId>,
-    pub(super) parent: Vec<u32>,
-    /// Children, `[NONE; 2]` for leaves and nodes whose split is not loaded.
-    pub(super) children: Vec<[u32; 2]>,
+    /// What a split or collapse reads and writes of a node, in one cache line.
+    pub(super) links: Vec<Links>,
     /// The meta-node that splits the node, while it is not loaded (else `NONE`).
     pub(super) opens: Vec<u32>,
     /// What the view test reads of each node (one cache line a node: the test of every
@@ -31,6 +31,28 @@ pub(super) struct Nodes {
     /// Nodes whose splits the node's split needs.
     pub(super) depends_on: Vec<SmallVec<[Dependency; 2]>>,
 }
+
+/// A node's path, parent, children, state, place on the front and faces: what a split or
+/// collapse reads and writes of it, in one cache line (seven lists before: the fly-through's
+/// median frame 5% longer, BENCHMARKS.md).
+#[derive(Clone, Debug)]
+#[repr(C, align(64))]
+pub(super) struct Links {
+    /// Present triangles with a corner at the node (active nodes only).
+    pub(super) faces_at: SmallVec<[u32; 6]>,
+    pub(super) id: NodeId,
+    /// Children, `[NONE; 2]` for leaves and nodes whose split is not loaded.
+    pub(super) children: [u32; 2],
+    pub(super) parent: u32,
+    /// The node's place among the front's active nodes (`NONE` if it is not active).
+    pub(super) active_slot: u32,
+    /// Split nodes depending on the node.
+    pub(super) split_dependants: u32,
+    pub(super) state: State,
+}
+
+// One cache line.
+const _: () = assert!(std::mem::size_of::<Links>() == 64);
 
 /// A node's position, error sphere, deviation and normal cone: what the view test reads.
 #[derive(Clone, Copy, Debug)]
@@ -46,23 +68,20 @@ pub(super) struct Bounds {
     pub(super) cone: NormalCone,
 }
 
-/// Which nodes are on the front: each node's state, the active ones listed (each with its
-/// place in the list, and a bit each), and how many split nodes depend on each split node.
+/// Which nodes are on the front: the active ones listed, and a bit each (each node's state,
+/// place in the list and split dependants are in its [`Links`]).
 #[derive(Default)]
 pub(super) struct Front {
-    pub(super) state: Vec<State>,
-    /// The active nodes, and each node's place among them.
+    /// The active nodes (each one's place among them is in its links).
     pub(super) active: Vec<u32>,
-    pub(super) active_slot: Vec<u32>,
     /// The active nodes again, a bit a node (bit v % 64 of word v / 64): a pass lists them
     /// in node order from it.
     pub(super) active_bits: Vec<u64>,
-    /// Split nodes depending on the node.
-    pub(super) split_dependants: Vec<u32>,
 }
 
 /// The triangles: each one's corners (as leaves, and as the active nodes on their paths),
-/// whether it is present, how many are, and each active node's present triangles.
+/// whether it is present, and how many are (each active node's present triangles are in its
+/// [`Links`]).
 #[derive(Default)]
 pub(super) struct Faces {
     // Per triangle.
@@ -74,8 +93,6 @@ pub(super) struct Faces {
     pub(super) corners: Vec<[u32; 3]>,
     /// Present triangles.
     pub(super) count: usize,
-    /// Present triangles with a corner at the node (per node; active nodes only).
-    pub(super) faces_at: Vec<SmallVec<[u32; 6]>>,
 }
 
 /// The orientation guard's lists: faces whose orientation is to be made certain, and the
@@ -147,10 +164,8 @@ pub(super) type Checked = std::result::Result<(), String>;
 impl Nodes {
     /// Every list one entry a node; a child's parent is the node it hangs from.
     pub(super) fn check(&self) -> Checked {
-        let n = self.ids.len();
+        let n = self.links.len();
         let lengths = [
-            self.parent.len(),
-            self.children.len(),
             self.opens.len(),
             self.bounds.len(),
             self.born.len(),
@@ -159,9 +174,9 @@ impl Nodes {
         if lengths.iter().any(|&len| len != n) {
             return Err(format!("node lists of lengths {lengths:?} for {n} nodes"));
         }
-        for (v, children) in self.children.iter().enumerate() {
-            for &c in children.iter().filter(|&&c| c != NONE) {
-                if self.parent.get(c as usize) != Some(&(v as u32)) {
+        for (v, links) in self.links.iter().enumerate() {
+            for &c in links.children.iter().filter(|&&c| c != NONE) {
+                if self.links.get(c as usize).map(|l| l.parent) != Some(v as u32) {
                     return Err(format!("node {c} is a child of {v} but not its parent's"));
                 }
             }
@@ -171,21 +186,18 @@ impl Nodes {
 }
 
 impl Front {
-    /// A state a node of `n`; the active list, each active node's place in it and its bit agree.
-    pub(super) fn check(&self, n: usize) -> Checked {
-        if self.state.len() != n || self.active_slot.len() != n || self.split_dependants.len() != n
-        {
-            return Err(format!("front lists of other lengths than its {n} nodes"));
-        }
+    /// The active list, each active node's place in it (in `links`) and its bit agree.
+    pub(super) fn check(&self, links: &[Links]) -> Checked {
+        let n = links.len();
         if self.active_bits.len() < n.div_ceil(64) {
             return Err("the active bitmap is short".into());
         }
         for (slot, &v) in self.active.iter().enumerate() {
-            if self.active_slot.get(v as usize) != Some(&(slot as u32)) {
+            if links.get(v as usize).map(|l| l.active_slot) != Some(slot as u32) {
                 return Err(format!("active node {v} is not at its place {slot}"));
             }
         }
-        let listed = self.active_slot.iter().filter(|&&s| s != NONE).count();
+        let listed = links.iter().filter(|l| l.active_slot != NONE).count();
         let bits: u32 = self.active_bits.iter().map(|w| w.count_ones()).sum();
         if listed != self.active.len() || bits as usize != self.active.len() {
             return Err("the active list, places and bits disagree".into());

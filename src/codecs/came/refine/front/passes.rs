@@ -35,7 +35,7 @@ impl ViewMesh {
             self.loading.waited_now.clear();
             let waiting = std::mem::take(&mut self.loading.waiting_nodes);
             for &v in &waiting {
-                if self.front.state[v as usize] == State::Active && self.wants(view, v) {
+                if self.nodes.links[v as usize].state == State::Active && self.wants(view, v) {
                     self.refine_down(v, view, budget, done, &mut below);
                 }
             }
@@ -77,19 +77,18 @@ impl ViewMesh {
                 // processor to foresee).
                 if let Some(&ahead) = pass.get(i + 8) {
                     prefetch(self.nodes.bounds.as_ptr().wrapping_add(ahead as usize));
-                    prefetch(self.nodes.parent.as_ptr().wrapping_add(ahead as usize));
+                    prefetch(self.nodes.links.as_ptr().wrapping_add(ahead as usize));
                 }
                 if let Some(&ahead) = pass.get(i + 4) {
-                    let p = self.nodes.parent[ahead as usize] as usize;
+                    let p = self.nodes.links[ahead as usize].parent as usize;
                     prefetch(self.nodes.bounds.as_ptr().wrapping_add(p));
-                    prefetch(self.nodes.children.as_ptr().wrapping_add(p));
-                    prefetch(self.front.split_dependants.as_ptr().wrapping_add(p));
+                    prefetch(self.nodes.links.as_ptr().wrapping_add(p));
                 }
                 if done.splits + done.collapses >= budget.operations {
                     self.scratch.cursor = v;
                     return true;
                 }
-                if self.front.state[v as usize] != State::Active {
+                if self.nodes.links[v as usize].state != State::Active {
                     continue;
                 }
                 if self.wants(view, v) && self.ready(v) != Ready::Never {
@@ -99,7 +98,7 @@ impl ViewMesh {
                 // Up the tree while the parent may and should go; then the same from each
                 // node those collapses freed of its last split dependant (so that a chain of
                 // dependencies unwinds in one pass, not one pass a link).
-                let p = self.nodes.parent[v as usize];
+                let p = self.nodes.links[v as usize].parent;
                 if p == tried && done.splits + done.collapses == tried_at {
                     continue;
                 }
@@ -148,7 +147,7 @@ impl ViewMesh {
             {
                 self.collapse(p);
                 done.collapses += 1;
-                p = self.nodes.parent[p as usize];
+                p = self.nodes.links[p as usize].parent;
             }
             match self.scratch.freed.pop() {
                 Some(d) if done.splits + done.collapses < budget.operations => p = d,
@@ -171,7 +170,7 @@ impl ViewMesh {
         below.clear();
         below.push(v);
         while let Some(x) = below.pop() {
-            if self.front.state[x as usize] != State::Active
+            if self.nodes.links[x as usize].state != State::Active
                 || done.splits + done.collapses >= budget.operations
                 || !self.wants(view, x)
             {

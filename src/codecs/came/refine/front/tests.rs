@@ -250,15 +250,15 @@ fn back_faces_stay_coarse_unless_the_view_is_two_sided() {
         let b = &one.nodes.bounds[v as usize];
         view.faces_away(b.center, b.radius, &b.cone)
     };
-    let split_in_two: std::collections::HashSet<NodeId> = (0..two.nodes.ids.len())
-        .filter(|&v| two.front.state[v] == State::Split)
-        .map(|v| two.nodes.ids[v])
+    let split_in_two: std::collections::HashSet<NodeId> = (0..two.nodes.links.len())
+        .filter(|&v| two.nodes.links[v].state == State::Split)
+        .map(|v| two.nodes.links[v].id)
         .collect();
     let culled = one
         .front
         .active
         .iter()
-        .filter(|&&v| split_in_two.contains(&one.nodes.ids[v as usize]) && faces_away(v))
+        .filter(|&&v| split_in_two.contains(&one.nodes.links[v as usize].id) && faces_away(v))
         .count();
     assert!(culled > 0);
 }
@@ -545,7 +545,7 @@ fn fold_overs_in_view(vm: &ViewMesh, full: &Counterparts, view: &View) -> (usize
     for (v, ordinal, t) in vm.present_by_birth() {
         let corners = vm.faces.corners[t as usize];
         let at = corners.map(|c| vm.nodes.bounds[c as usize].center);
-        let counterpart = full[&(vm.nodes.ids[v as usize].packed(), ordinal)];
+        let counterpart = full[&(vm.nodes.links[v as usize].id.packed(), ordinal)];
         if at != counterpart {
             coarse += 1;
         }

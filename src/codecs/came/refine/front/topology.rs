@@ -8,20 +8,20 @@ use smallvec::SmallVec;
 
 impl ViewMesh {
     pub(super) fn activate(&mut self, v: u32) {
-        self.front.state[v as usize] = State::Active;
-        self.front.active_slot[v as usize] = self.front.active.len() as u32;
+        self.nodes.links[v as usize].state = State::Active;
+        self.nodes.links[v as usize].active_slot = self.front.active.len() as u32;
         self.front.active.push(v);
         self.front.active_bits[v as usize / 64] |= 1 << (v % 64);
     }
 
     pub(super) fn deactivate(&mut self, v: u32, to: State) {
-        self.front.state[v as usize] = to;
-        let slot = self.front.active_slot[v as usize] as usize;
+        self.nodes.links[v as usize].state = to;
+        let slot = self.nodes.links[v as usize].active_slot as usize;
         self.front.active.swap_remove(slot);
         if let Some(&moved) = self.front.active.get(slot) {
-            self.front.active_slot[moved as usize] = slot as u32;
+            self.nodes.links[moved as usize].active_slot = slot as u32;
         }
-        self.front.active_slot[v as usize] = NONE;
+        self.nodes.links[v as usize].active_slot = NONE;
         self.front.active_bits[v as usize / 64] &= !(1 << (v % 64));
     }
 
@@ -29,12 +29,12 @@ impl ViewMesh {
     /// corrupt stream's corner).
     pub(super) fn active_on(&self, leaf: NodeId) -> Option<u32> {
         let mut v = 0u32;
-        while self.front.state[v as usize] == State::Split {
-            let len = self.nodes.ids[v as usize].len();
+        while self.nodes.links[v as usize].state == State::Split {
+            let len = self.nodes.links[v as usize].id.len();
             if len >= leaf.len() {
                 return None;
             }
-            v = self.nodes.children[v as usize][leaf.bit(len) as usize];
+            v = self.nodes.links[v as usize].children[leaf.bit(len) as usize];
         }
         Some(v)
     }
@@ -50,17 +50,17 @@ impl ViewMesh {
         while let Some(c) = self.child_toward(v, id) {
             v = c;
         }
-        (v, self.nodes.ids[v as usize] == id)
+        (v, self.nodes.links[v as usize].id == id)
     }
 
     /// The loaded child of `v` on the path to `id`: none when `v` is as deep as `id` (or,
     /// in a corrupt stream, deeper) or that child is not loaded.
     pub(super) fn child_toward(&self, v: u32, id: NodeId) -> Option<u32> {
-        let depth = self.nodes.ids[v as usize].len();
+        let depth = self.nodes.links[v as usize].id.len();
         if depth >= id.len() {
             return None;
         }
-        Some(self.nodes.children[v as usize][id.bit(depth) as usize]).filter(|&c| c != NONE)
+        Some(self.nodes.links[v as usize].children[id.bit(depth) as usize]).filter(|&c| c != NONE)
     }
 
     /// A node to split before `v` may be: its first dependency not split (or planned to be),
@@ -90,10 +90,10 @@ impl ViewMesh {
     /// (where a triangle born at `s` finds its third corner: a neighbour of `v_s`, Hoppe's
     /// v_l or v_r), without a walk from the root.
     pub(super) fn neighbour_on(&self, s: u32, leaf: NodeId) -> Option<u32> {
-        self.faces.faces_at[s as usize].iter().find_map(|&f| {
+        self.nodes.links[s as usize].faces_at.iter().find_map(|&f| {
             self.faces.corners[f as usize]
                 .into_iter()
-                .find(|&n| n != s && self.nodes.ids[n as usize].is_ancestor_of(leaf))
+                .find(|&n| n != s && self.nodes.links[n as usize].id.is_ancestor_of(leaf))
         })
     }
 
@@ -102,10 +102,10 @@ impl ViewMesh {
     /// a corrupt stream).
     pub(super) fn split(&mut self, s: u32) -> bool {
         let su = s as usize;
-        let depth = self.nodes.ids[su].len();
-        let own = self.nodes.ids[su];
+        let depth = self.nodes.links[su].id.len();
+        let own = self.nodes.links[su].id;
         let deep = |c: NodeId| c.len() > depth;
-        for &f in &self.faces.faces_at[su] {
+        for &f in &self.nodes.links[su].faces_at {
             for k in 0..3 {
                 if self.faces.corners[f as usize][k] == s
                     && !deep(self.faces.leaf_corners[f as usize][k])
@@ -124,7 +124,7 @@ impl ViewMesh {
                     if !deep(c) {
                         return false;
                     }
-                    self.nodes.children[su][c.bit(depth) as usize]
+                    self.nodes.links[su].children[c.bit(depth) as usize]
                 } else {
                     match self.neighbour_on(s, c).or_else(|| self.active_on(c)) {
                         Some(v) => v,
@@ -134,18 +134,18 @@ impl ViewMesh {
             }
             born.push(corners);
         }
-        let [t, u] = self.nodes.children[su];
+        let [t, u] = self.nodes.links[su].children;
         self.deactivate(s, State::Split);
         self.activate(t);
         self.activate(u);
-        for f in std::mem::take(&mut self.faces.faces_at[su]) {
+        for f in std::mem::take(&mut self.nodes.links[su].faces_at) {
             let fu = f as usize;
             for k in 0..3 {
                 if self.faces.corners[fu][k] == s {
-                    let child =
-                        self.nodes.children[su][self.faces.leaf_corners[fu][k].bit(depth) as usize];
+                    let child = self.nodes.links[su].children
+                        [self.faces.leaf_corners[fu][k].bit(depth) as usize];
                     self.faces.corners[fu][k] = child;
-                    self.faces.faces_at[child as usize].push(f);
+                    self.nodes.links[child as usize].faces_at.push(f);
                 }
             }
             self.suspect(f);
@@ -153,31 +153,32 @@ impl ViewMesh {
         for (i, corners) in born.into_iter().enumerate() {
             let f = self.nodes.born[su][i];
             for &c in &corners {
-                self.faces.faces_at[c as usize].push(f);
+                self.nodes.links[c as usize].faces_at.push(f);
             }
             self.faces.corners[f as usize] = corners;
             self.suspect(f);
         }
         self.faces.count += self.nodes.born[su].len();
         for &d in &self.nodes.depends_on[su] {
-            self.front.split_dependants[d.node as usize] += 1;
+            self.nodes.links[d.node as usize].split_dependants += 1;
         }
         true
     }
 
     /// Whether node `v` is a leaf of the hierarchy (not a node whose split is still to load).
     pub(super) fn is_leaf(&self, v: u32) -> bool {
-        self.nodes.children[v as usize][0] == NONE && self.nodes.opens[v as usize] == NONE
+        self.nodes.links[v as usize].children[0] == NONE && self.nodes.opens[v as usize] == NONE
     }
 
     /// Whether ecol of split node `s` is legal: both children active, no split dependant.
     pub(super) fn can_collapse(&self, s: u32) -> bool {
         let su = s as usize;
-        self.front.state[su] == State::Split
-            && self.front.split_dependants[su] == 0
-            && self.nodes.children[su]
+        self.nodes.links[su].state == State::Split
+            && self.nodes.links[su].split_dependants == 0
+            && self.nodes.links[su]
+                .children
                 .iter()
-                .all(|&c| self.front.state[c as usize] == State::Active)
+                .all(|&c| self.nodes.links[c as usize].state == State::Active)
     }
 
     /// ecol of `s` ([`Self::can_collapse`]).
@@ -187,7 +188,7 @@ impl ViewMesh {
             let f = self.nodes.born[su][i];
             self.retry_around(f);
             for c in self.faces.corners[f as usize] {
-                let list = &mut self.faces.faces_at[c as usize];
+                let list = &mut self.nodes.links[c as usize].faces_at;
                 if let Some(at) = list.iter().position(|&g| g == f) {
                     list.swap_remove(at);
                 }
@@ -195,21 +196,21 @@ impl ViewMesh {
             self.faces.corners[f as usize] = [NONE; 3];
         }
         self.faces.count -= self.nodes.born[su].len();
-        for c in self.nodes.children[su] {
-            for f in std::mem::take(&mut self.faces.faces_at[c as usize]) {
+        for c in self.nodes.links[su].children {
+            for f in std::mem::take(&mut self.nodes.links[c as usize].faces_at) {
                 for corner in &mut self.faces.corners[f as usize] {
                     if *corner == c {
                         *corner = s;
                     }
                 }
-                self.faces.faces_at[su].push(f);
+                self.nodes.links[su].faces_at.push(f);
                 self.suspect(f);
             }
             self.deactivate(c, State::Below);
         }
         self.activate(s);
         for &d in &self.nodes.depends_on[su] {
-            let count = &mut self.front.split_dependants[d.node as usize];
+            let count = &mut self.nodes.links[d.node as usize].split_dependants;
             *count -= 1;
             if *count == 0 {
                 self.scratch.freed.push(d.node);
@@ -220,9 +221,11 @@ impl ViewMesh {
     /// The node's state once the splits planned so far are made.
     pub(super) fn planned_state(&self, v: u32) -> State {
         let vu = v as usize;
-        match self.front.state[vu] {
+        match self.nodes.links[vu].state {
             _ if self.scratch.planned[vu] => State::Split,
-            State::Below if self.scratch.planned[self.nodes.parent[vu] as usize] => State::Active,
+            State::Below if self.scratch.planned[self.nodes.links[vu].parent as usize] => {
+                State::Active
+            }
             state => state,
         }
     }
@@ -248,7 +251,7 @@ impl ViewMesh {
             let Some(&v) = stack.last() else {
                 break Ready::Now;
             };
-            if stack.len() > self.nodes.ids.len() {
+            if stack.len() > self.nodes.links.len() {
                 // The dependencies form a cycle: a corrupt stream.
                 break Ready::Never;
             }
@@ -256,7 +259,7 @@ impl ViewMesh {
                 State::Split => {
                     stack.pop();
                 }
-                State::Below => stack.push(self.nodes.parent[v as usize]),
+                State::Below => stack.push(self.nodes.links[v as usize].parent),
                 State::Active => match self.ready(v) {
                     Ready::Now => match self.unmet_dependency(v) {
                         Some(d) => stack.push(d),
@@ -285,7 +288,7 @@ impl ViewMesh {
                     outcome = Ready::Never;
                     break;
                 }
-                activated.extend(self.nodes.children[v as usize]);
+                activated.extend(self.nodes.links[v as usize].children);
                 made += 1;
             }
         }
