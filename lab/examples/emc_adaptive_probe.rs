@@ -47,11 +47,10 @@
 #[allow(dead_code)]
 mod emc_octree;
 
-use emc_octree::{build, least, Built, Tree};
+use emc_octree::{build, least, priority, Built, Candidate, Tree};
 use glam::DVec3;
 use meshcodec::hierarchy::simplify::quadric::Quadric;
 use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SEED};
-use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap};
 use std::path::Path;
 
@@ -326,14 +325,6 @@ enum Op {
     Extend(Cluster),
 }
 
-fn priority(gain: f64, bits: f64) -> f64 {
-    if bits <= 0.0 {
-        f64::INFINITY
-    } else {
-        gain / bits
-    }
-}
-
 fn best(model: &Model, c: &Cluster) -> Option<(Op, f64, f64)> {
     let split = model
         .split(c)
@@ -345,26 +336,6 @@ fn best(model: &Model, c: &Cluster) -> Option<(Op, f64, f64)> {
         .into_iter()
         .flatten()
         .max_by(|a, b| priority(a.2, a.1).total_cmp(&priority(b.2, b.1)))
-}
-
-#[derive(PartialEq)]
-struct Candidate {
-    priority: f64,
-    id: usize,
-    version: u32,
-}
-impl Eq for Candidate {}
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Candidate {
-    fn cmp(&self, o: &Self) -> Ordering {
-        self.priority
-            .total_cmp(&o.priority)
-            .then(o.id.cmp(&self.id))
-    }
 }
 
 /// The schedule a greedy order must send: in each layer, for every cluster that can still act,

@@ -36,10 +36,9 @@
 
 mod emc_octree;
 
-use emc_octree::{build, least, Built, Tree};
+use emc_octree::{build, least, priority, Built, Candidate, Tree};
 use meshcodec::codecs::LevelMesh;
 use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SEED};
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 impl Tree {
@@ -216,37 +215,6 @@ impl<'a> State<'a> {
             })
             .collect();
         self.tree.project(&self.owner, positions)
-    }
-}
-
-#[derive(PartialEq)]
-struct Candidate {
-    priority: f64,
-    id: usize,
-    version: u32,
-}
-impl Eq for Candidate {}
-impl PartialOrd for Candidate {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Candidate {
-    fn cmp(&self, o: &Self) -> Ordering {
-        self.priority
-            .total_cmp(&o.priority)
-            .then(o.id.cmp(&self.id))
-    }
-}
-
-/// Gain per bit; a decision the model prices at nothing (the path meeting a branch, whose
-/// flag the split's bits pay) is taken at once, whatever it does to the error: the split
-/// needs it.
-fn priority(gain: f64, bits: f64) -> f64 {
-    if bits <= 0.0 {
-        f64::INFINITY
-    } else {
-        gain / bits
     }
 }
 

@@ -13,6 +13,7 @@ use meshcodec::mesh::io::{read_mesh, resolve};
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::{CanonicalMesh, TriMesh};
 use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SEED};
+use std::cmp::Ordering;
 use std::collections::HashSet;
 
 /// A quadric's least value (every vertex's quadric here holds a point term, so it has one).
@@ -95,6 +96,39 @@ impl Tree {
             let centre = ((c as u64 >> (l - k)) * span) as f64 + (span as f64 - 1.0) / 2.0;
             g.origin[a] + (centre + 0.5) * g.cell[a]
         }))
+    }
+}
+
+/// A cluster's best decision in a greedy order's heap, under the cluster's `version` when it
+/// was pushed (a later version makes it stale); the most gain per bit first, then the lowest id.
+#[derive(PartialEq)]
+pub struct Candidate {
+    pub priority: f64,
+    pub id: usize,
+    pub version: u32,
+}
+impl Eq for Candidate {}
+impl PartialOrd for Candidate {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Candidate {
+    fn cmp(&self, o: &Self) -> Ordering {
+        self.priority
+            .total_cmp(&o.priority)
+            .then(o.id.cmp(&self.id))
+    }
+}
+
+/// Gain per bit; a decision the model prices at nothing (the path meeting a branch, whose
+/// flag the split's bits pay) is taken at once, whatever it does to the error: the split
+/// needs it.
+pub fn priority(gain: f64, bits: f64) -> f64 {
+    if bits <= 0.0 {
+        f64::INFINITY
+    } else {
+        gain / bits
     }
 }
 
