@@ -38,8 +38,9 @@ pub struct Tree {
     pub half_bits: Vec<f64>,
     /// Bits before the first decision (header, index, flushes).
     pub fixed_bits: f64,
-    /// Whether a split is valued by the quadrics' least values (where the clusters' vertices
-    /// could best stand) rather than at the representatives the decisions so far place.
+    /// `emc_order_probe`'s choice: whether a split is valued by the quadrics' least values
+    /// (where the clusters' vertices could best stand) rather than at the representatives the
+    /// decisions so far place.
     pub splits_at_best: bool,
 }
 
