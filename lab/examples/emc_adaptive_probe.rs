@@ -35,8 +35,8 @@
 //!   positions, or (the bound) at the representatives' own positions, the last step's cell
 //!   centres; RMS both ways relative to the diagonal, as `experiment` measures. Every order is
 //!   measured at the bits of the level order's levels, and reported as a ratio to it. The last
-//!   column scales `emc-ahead`'s measured RMS over `pm`'s at the same bits (`pm` read from
-//!   `results/pm/MESH-q12.csv`, interpolated on log–log axes as paper-tables/emc-vs-anchors.md
+//!   column scales `emc-ahead`'s measured RMS over `pm`'s at the same bits (both read from
+//!   results/ at 12 bits, `pm` interpolated on log–log axes, as paper-tables/emc-vs-anchors.md
 //!   does) by those ratios: what the order would make of `emc-ahead`.
 //!
 //! BENCHMARKS.md ("An adaptive depth, probed") has the figures.
@@ -51,6 +51,7 @@ use emc_octree::{build, least, priority, Built, Candidate, Tree};
 use glam::DVec3;
 use meshcodec::hierarchy::simplify::quadric::Quadric;
 use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SEED};
+use meshcodec_lab::tables::{load_at, log_log_interpolate, rms_curve};
 use std::collections::{BinaryHeap, HashMap};
 use std::path::Path;
 
@@ -639,38 +640,6 @@ struct Columns {
     untold: Vec<(usize, f64)>,
 }
 
-/// (bits, RMS) of every level of a result CSV written by `experiment`.
-fn curve(path: &Path) -> Result<Vec<(f64, f64)>, Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| format!("{}: {e} (run the anchors experiment first)", path.display()))?;
-    let mut lines = text.lines();
-    let head: Vec<&str> = lines.next().ok_or("empty CSV")?.split(',').collect();
-    let column = |name: &str| {
-        head.iter()
-            .position(|h| *h == name)
-            .ok_or_else(|| format!("{}: no column {name}", path.display()))
-    };
-    let (bits, rms) = (column("bits")?, column("rms")?);
-    let mut points = Vec::new();
-    for line in lines {
-        let fields: Vec<&str> = line.split(',').collect();
-        points.push((fields[bits].parse()?, fields[rms].parse()?));
-    }
-    Ok(points)
-}
-
-/// `points`' y at `x` on log–log axes between the two points around it.
-fn interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
-    points.windows(2).find_map(|w| {
-        let ((x0, y0), (x1, y1)) = (w[0], w[1]);
-        if !(x0 <= x && x <= x1 && x0 > 0.0 && y0 > 0.0 && y1 > 0.0) || x0 == x1 {
-            return None;
-        }
-        let t = (x / x0).ln() / (x1 / x0).ln();
-        Some((y0.ln() + t * (y1 / y0).ln()).exp())
-    })
-}
-
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut meshes: Vec<String> = std::env::args().skip(1).collect();
     if meshes.is_empty() {
@@ -678,9 +647,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let results = Path::new(env!("CARGO_MANIFEST_DIR")).join("../results");
     for name in meshes {
-        let ahead = curve(&results.join(format!("emc-ahead/{name}.csv")))?;
-        let mut pm = curve(&results.join(format!("pm/{name}-q12.csv")))?;
-        pm.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let ahead: Vec<(f64, f64)> = load_at(&results, "emc-ahead", &name, 12)?
+            .levels
+            .iter()
+            .map(|l| (l.bits as f64, l.rms.unwrap_or(f64::NAN)))
+            .collect();
+        let pm = rms_curve(&load_at(&results, "pm", &name, 12)?);
         let Built { original, tree, .. } = build(&name)?;
         let reference = Reference::new(&original, SampleBudget::default(), DEFAULT_SEED);
         if tree.levels != ahead.len() {
@@ -722,7 +694,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // Every other order at the level order's bits: its gain alone.
             let bits: Vec<f64> = levels.iter().map(|l| l.0).collect();
             let (greedy_rows, schedule) = greedy(&model, &bits, &layers, false, &reference);
-            let (sent, _) = greedy(&model, &bits, &layers, true, &reference);
+            // (The exact bound's schedule is counted, not paid: the table has no use for it.)
+            let sent = if show == Show::Coded {
+                greedy(&model, &bits, &layers, true, &reference).0
+            } else {
+                Vec::new()
+            };
             let (flags, plain, under_contexts) = schedule.bits();
             println!(
                 "{name}, {rule:?}, {show:?}: the greedy order's schedule over {} layers: {flags} flags, {:.0} bits with no context ({:.2}% of the lossless stream), {:.0} under the contexts ({:.2}%)",
@@ -743,7 +720,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("| level | `emc-ahead` bits/vertex | the model's level order, bits/vertex | `emc-ahead` RMS | `pm` RMS at those bits | `emc-ahead` / `pm` | the model's level order, RMS: oracle, larger half, exact | greedy / level order at the same bits: oracle, larger half, exact | greedy with its schedule sent / level order: oracle, larger half | untold / level order: oracle, larger half, exact | `emc-ahead` / `pm` times the gain (larger half): greedy, sent, untold |");
         println!("|---:|---:|---:|---:|---:|---:|---|---|---|---|---|");
         for (l, &(bits, rms)) in ahead.iter().enumerate() {
-            let pm_rms = interpolate(&pm, bits);
+            let pm_rms = log_log_interpolate(&pm, bits);
             let level = |k: usize| columns[k].levels[l].1;
             let gain = |k: usize, rows: &[(usize, f64)]| rows[l].1 / level(k);
             let greedy = |k: usize| gain(k, &columns[k].greedy);

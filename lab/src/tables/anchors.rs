@@ -3,7 +3,6 @@
 
 use super::*;
 use crate::plot;
-use crate::results::RunResult;
 use meshcodec::error::{Error, Result};
 use std::path::{Path, PathBuf};
 
@@ -126,19 +125,12 @@ pub(crate) fn intermediate_levels(results: &Path, md: &mut String) -> Result<()>
     let _ = writeln!(md, "## Intermediate levels: RMS error at the same bits\n");
     let _ = writeln!(md, "Each level of `emc` and of `emc-ahead` (every vertex's position coded two levels ahead of the octree's splits: docs/FORMAT.md §7.1) at 12 bits beside `pm`'s and the valence-driven coder's RMS error at the same cumulative bits, interpolated on log–log axes between their own levels (blank where they have no level on one side). RMS is relative to the bounding box's diagonal, both ways between the level and the original (docs/CONTRACT.md §5). `emc` shows each vertex where its neighbours predict it inside its cell (`codecs::emc::modelled::placement`; BENCHMARKS.md compares it with the cell centres). The target of the last column: the level's RMS no higher than the lower of the others'.\n");
     let valence = valence_anchor()?;
-    let rms_points = |r: &RunResult| -> Vec<(f64, f64)> {
-        r.levels
-            .iter()
-            .filter_map(|l| Some((l.bits as f64, l.rms?)))
-            .filter(|&(_, rms)| rms > 0.0)
-            .collect()
-    };
     for (mesh, codec) in MESHES
         .iter()
         .flat_map(|&mesh| [(mesh, "emc"), (mesh, "emc-ahead")])
     {
         let emc = load_at(results, codec, mesh, 12)?;
-        let pm = rms_points(&load_at(results, "pm", mesh, 12)?);
+        let pm = rms_curve(&load_at(results, "pm", mesh, 12)?);
         let others: Vec<(&str, Vec<(f64, f64)>)> = if mesh == "bunny" {
             vec![("pm", pm), ("valence coder", valence.rms.clone())]
         } else {
@@ -182,7 +174,7 @@ pub(crate) fn intermediate_levels(results: &Path, md: &mut String) -> Result<()>
 
 /// `points`' y at `x`, interpolated on log–log axes between the two points around it (sorted by
 /// x); `None` outside their range.
-pub(crate) fn log_log_interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
+pub fn log_log_interpolate(points: &[(f64, f64)], x: f64) -> Option<f64> {
     let mut sorted = points.to_vec();
     sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
     sorted.windows(2).find_map(|w| {

@@ -23,7 +23,9 @@ use crate::came;
 pub use crate::emc::tables::{emc_fig4, emc_fig5, emc_table1, EMC_TABLE1_COMMAND};
 pub use crate::pm::tables::{hoppe_tables, HOPPE_COMMAND};
 pub(crate) use anchors::ANCHORS_COMMAND;
-pub use anchors::{emc_rate_distortion, emc_rms_rate_distortion, emc_vs_anchors};
+pub use anchors::{
+    emc_rate_distortion, emc_rms_rate_distortion, emc_vs_anchors, log_log_interpolate,
+};
 pub use attributes::{ATTRIBUTES_COMMAND, ATTRIBUTE_MESHES};
 pub use emc_renders::emc_levels_beside_pm;
 
@@ -139,7 +141,7 @@ pub(crate) fn refused(results: &Path, codec: &str, mesh: &str) -> Option<String>
 }
 
 /// The result of `codec` on `mesh` at `quant` bits (cubic grid), by the harness's file naming.
-pub(crate) fn load_at(results: &Path, codec: &str, mesh: &str, quant: u8) -> Result<RunResult> {
+pub fn load_at(results: &Path, codec: &str, mesh: &str, quant: u8) -> Result<RunResult> {
     // Other coders' results (Draco's) have no default quantization: their stems always name it.
     let defaults = meshcodec::codecs::by_name(codec)
         .map(|c| c.default_options())
@@ -159,6 +161,17 @@ pub(crate) fn load_at(results: &Path, codec: &str, mesh: &str, quant: u8) -> Res
             path.display()
         ))
     })
+}
+
+/// Every level of `result` with an RMS above 0, as (cumulative bits, RMS): a rate–distortion
+/// curve for [`log_log_interpolate`].
+pub fn rms_curve(result: &RunResult) -> Vec<(f64, f64)> {
+    result
+        .levels
+        .iter()
+        .filter_map(|l| Some((l.bits as f64, l.rms?)))
+        .filter(|&(_, rms)| rms > 0.0)
+        .collect()
 }
 
 /// Regenerates every paper table and figure whose results are present; returns what it wrote
