@@ -7,8 +7,8 @@ whose tolerance is t (a pixel's size at the nearest point in view) gets the fewe
 a rung whose measured Hausdorff distance is within t: the count a mesh that knows nothing of
 the view needs to show within one pixel everywhere in it.
 
-Each view's chosen mesh is also measured on the screen as the view's front is (`meshcodec
-screen-distance`: the same camera, both ways, in pixels).
+Each view's chosen mesh, and each fly-through frame's, is also measured on the screen as the
+view's front is (`meshcodec screen-distance`: the same camera, both ways, in pixels).
 
 Writes results/came/vd-meshoptimizer.json, and renders of the meshes chosen for the far and
 near views under results/came/vd/ (the project's rasterizer, `meshcodec render`).
@@ -154,6 +154,39 @@ def render(mesh_path, out, eye, target, size, fov):
     )
 
 
+def fly_frames(fly, rungs, vertices, triangles, mesh, tmp, log):
+    """For each fly-through frame, the rung within its tolerance and that mesh's error on the
+    frame's screen, measured as the frame's two-sided front is (none where no rung fits; 0 where
+    only the full mesh does)."""
+    size = f"{fly['width']}x{fly['height']}"
+    written = {}
+    out = []
+    for frame in fly["frames"]:
+        rung = within(rungs, frame["pixel_at_nearest"])
+        entry = {"frame": frame["frame"], "tolerance": frame["pixel_at_nearest"],
+                 "triangles": (rung or {}).get("triangles")}
+        if rung and rung.get("full_mesh"):
+            entry.update(screen_max_px=0.0, screen_mean_px=0.0)
+        elif rung:
+            target = rung["target_error"]
+            if target not in written:
+                written[target] = Path(tmp) / f"frame-rung-{len(written)}.ply"
+                write_ply(written[target], vertices, simplify(vertices, triangles, target))
+            error = json.loads(meshcodec(
+                "screen-distance", ROOT / mesh["full_mesh"], written[target], "--json",
+                "--eye", ",".join(map(repr, frame["eye"])),
+                "--target", ",".join(map(repr, frame["target"])),
+                "--size", size, "--fov", fly["fov_degrees"],
+            ))
+            entry.update(screen_max_px=error["max_px"], screen_mean_px=error["mean_px"])
+        out.append(entry)
+    measured = [f["screen_mean_px"] for f in out if f.get("screen_max_px")]
+    if measured:
+        log(f"  fly-through: meshoptimizer's mean on the screen {min(measured):.4f}-{max(measured):.4f} px "
+            f"in the {len(measured)} frames where it simplifies")
+    return out
+
+
 def main():
     log = lambda line: print(line, flush=True)
     if not BIN.is_file():
@@ -209,10 +242,7 @@ def main():
             entry = {"mesh": mesh["mesh"], "subdivisions": mesh["subdivisions"], "triangles": mesh["triangles"],
                      "rungs": rungs, "views": views}
             if frames:
-                entry["flythrough_frames"] = [
-                    {"frame": i, "tolerance": t, "triangles": (within(rungs, t) or {}).get("triangles")}
-                    for i, t in enumerate(frames)
-                ]
+                entry["flythrough_frames"] = fly_frames(fly, rungs, vertices, triangles, mesh, tmp, log)
             out["meshes"].append(entry)
     path = RESULTS / "vd-meshoptimizer.json"
     path.write_text(json.dumps(out, indent=2) + "\n")
