@@ -166,7 +166,7 @@ def fly_frames(fly, rungs, vertices, triangles, mesh, tmp, log):
         entry = {"frame": frame["frame"], "tolerance": frame["pixel_at_nearest"],
                  "triangles": (rung or {}).get("triangles")}
         if rung and rung.get("full_mesh"):
-            entry.update(screen_max_px=0.0, screen_mean_px=0.0)
+            entry.update(full_mesh=True, screen_max_px=0.0, screen_mean_px=0.0)
         elif rung:
             target = rung["target_error"]
             if target not in written:
@@ -180,7 +180,7 @@ def fly_frames(fly, rungs, vertices, triangles, mesh, tmp, log):
             ))
             entry.update(screen_max_px=error["max_px"], screen_mean_px=error["mean_px"])
         out.append(entry)
-    measured = [f["screen_mean_px"] for f in out if f.get("screen_max_px")]
+    measured = [f["screen_mean_px"] for f in out if "screen_mean_px" in f and not f.get("full_mesh")]
     if measured:
         log(f"  fly-through: meshoptimizer's mean on the screen {min(measured):.4f}-{max(measured):.4f} px "
             f"in the {len(measured)} frames where it simplifies")

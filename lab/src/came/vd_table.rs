@@ -45,8 +45,11 @@ struct MeshoptView {
 #[derive(Deserialize)]
 struct MeshoptFrame {
     triangles: Option<usize>,
-    /// That mesh's error on the frame's screen (0 where only the full mesh is within a pixel;
-    /// none in a file made before the frames were measured).
+    /// Only the full mesh is within a pixel here.
+    #[serde(default)]
+    full_mesh: bool,
+    /// That mesh's error on the frame's screen (0 for the full mesh; none in a file made before
+    /// the frames were measured).
     #[serde(default)]
     screen_max_px: Option<f64>,
     #[serde(default)]
@@ -354,41 +357,41 @@ pub fn table(results: &Path, out: &Path) -> Result<PathBuf> {
         .find(|m| m.subdivisions > 0)
         .and_then(|m| m.views.iter().find(|v| v.view == "middle"));
     let met = |ok: bool| if ok { "met" } else { "**not met**" };
-    let simplifier_mean = if simplifier_means.is_empty() {
-        String::new()
-    } else {
-        format!(
-            " (meshoptimizer's meshes within a pixel, in the views where they simplify: {:.3}–{:.3} px",
-            simplifier_means.iter().copied().fold(f64::INFINITY, f64::min),
+    // meshoptimizer's means beside ours: in the views, and frame by frame along the path,
+    // whether a mesh within a pixel that knows nothing of the view reaches the target.
+    let mut simplifier_evidence = Vec::new();
+    if !simplifier_means.is_empty() {
+        simplifier_evidence.push(format!(
+            "in the views where they simplify: {:.3}–{:.3} px",
+            simplifier_means
+                .iter()
+                .copied()
+                .fold(f64::INFINITY, f64::min),
             simplifier_means.iter().copied().fold(0.0, f64::max)
-        )
-    };
-    // meshoptimizer's mean in the same frame, beside ours: whether a mesh within a pixel that
-    // knows nothing of the view reaches the target where ours does not.
+        ));
+    }
     let paired: Vec<(f64, f64)> = frames
         .iter()
         .zip(theirs)
         .filter_map(|(f, t)| t.screen_mean_px.map(|m| (f.mean_error_px, m)))
         .collect();
-    let simplifier_frames = if paired.is_empty() {
-        String::new()
-    } else {
-        let full = theirs
-            .iter()
-            .filter(|t| t.screen_max_px == Some(0.0))
-            .count();
-        format!(
-            "; along the fly-through: {:.3} px at most, 0 in the {full} frames where only the \
-             full mesh is within a pixel, and below ours in {} of {} frames",
+    if !paired.is_empty() {
+        simplifier_evidence.push(format!(
+            "along the fly-through: {:.3} px at most, 0 in the {} frames where only the full \
+             mesh is within a pixel, and below ours in {} of {} frames",
             paired.iter().map(|p| p.1).fold(0.0, f64::max),
+            theirs.iter().filter(|t| t.full_mesh).count(),
             paired.iter().filter(|p| p.1 < p.0).count(),
             paired.len()
+        ));
+    }
+    let simplifier_mean = if simplifier_evidence.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " (meshoptimizer's meshes within a pixel, {})",
+            simplifier_evidence.join("; ")
         )
-    };
-    let simplifier_mean = match (simplifier_mean.is_empty(), simplifier_frames.is_empty()) {
-        (true, true) => String::new(),
-        (false, _) => format!("{simplifier_mean}{simplifier_frames})"),
-        (true, false) => format!(" (meshoptimizer's meshes within a pixel{simplifier_frames})"),
     };
     let views_guard = vd
         .meshes
