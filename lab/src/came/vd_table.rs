@@ -18,7 +18,7 @@ const FACE_TARGET: f64 = 1.5;
 /// Faces with the orientation guard against without it, the most the target allows.
 const GUARD_TARGET: f64 = 1.25;
 
-/// A rung of meshoptimizer's ladder chosen for a view.
+/// A rung of meshoptimizer's ladder chosen for a view or a fly-through frame.
 #[derive(Deserialize, Clone, Default)]
 struct Chosen {
     #[serde(default)]
@@ -27,8 +27,8 @@ struct Chosen {
     hausdorff: Option<f64>,
     #[serde(default)]
     full_mesh: bool,
-    /// Its error on the screen, measured as the view's front is (none in a file made before
-    /// `meshcodec screen-distance`).
+    /// Its error on the screen, measured as the view's or the frame's front is (0 for the full
+    /// mesh; none in a file made before `meshcodec screen-distance` measured it).
     #[serde(default)]
     screen_max_px: Option<f64>,
     #[serde(default)]
@@ -43,26 +43,12 @@ struct MeshoptView {
 }
 
 #[derive(Deserialize)]
-struct MeshoptFrame {
-    triangles: Option<usize>,
-    /// Only the full mesh is within a pixel here.
-    #[serde(default)]
-    full_mesh: bool,
-    /// That mesh's error on the frame's screen (0 for the full mesh; none in a file made before
-    /// the frames were measured).
-    #[serde(default)]
-    screen_max_px: Option<f64>,
-    #[serde(default)]
-    screen_mean_px: Option<f64>,
-}
-
-#[derive(Deserialize)]
 struct MeshoptMesh {
     mesh: String,
     subdivisions: u32,
     views: Vec<MeshoptView>,
     #[serde(default)]
-    flythrough_frames: Vec<MeshoptFrame>,
+    flythrough_frames: Vec<Chosen>,
 }
 
 #[derive(Deserialize)]
