@@ -747,6 +747,7 @@ fn codec_list(py: Python<'_>) -> PyResult<Bound<'_, PyList>> {
                 Capability::SelectiveRefinement => "selective_refinement",
                 Capability::Attributes => "attributes",
                 Capability::AppearanceInLevels => "appearance_in_levels",
+                Capability::AppearanceWithLevels => "appearance_with_levels",
             })
             .collect();
         d.set_item("capabilities", capabilities)?;

@@ -86,6 +86,11 @@ pub enum Capability {
     /// Also carries appearance inside its levels, so that every level has it
     /// ([`Codec::encode_with_appearance`]; `pm`).
     AppearanceInLevels,
+    /// Carries appearance in a part after each level, so that every level shows it
+    /// (docs/FORMAT.md §10, [`appearance::levels`]): its levels keep their vertices' ids and add
+    /// new ones (`emc`, `emc-ahead`). [`encode_attributed`] codes appearance that way for these
+    /// codecs.
+    AppearanceWithLevels,
 }
 
 /// How a codec that refines appearance level by level gives a collapsed wedge its values
@@ -235,6 +240,12 @@ pub trait LevelDecoder: Send {
     fn extend(&mut self, _more: &[u8]) -> Result<bool> {
         Ok(false)
     }
+    /// Per vertex of the current level, the vertex of the full mesh it stands for, named by
+    /// that vertex's id at the full level's... (see [`appearance::levels`]); `None` when every
+    /// vertex stands for the one that keeps its id.
+    fn representatives(&self) -> Option<Vec<u32>> {
+        None
+    }
 }
 
 /// A decoder that can stop after any pass of a level.
@@ -378,6 +389,56 @@ pub fn encode_attributed_with(
                 )))
             });
     }
+    if codec
+        .capabilities()
+        .contains(&Capability::AppearanceWithLevels)
+    {
+        return encode_with_level_parts(codec, canonical, appearance);
+    }
+    encode_with_appearance_unit(codec, canonical, appearance)
+}
+
+/// `canonical` encoded by `codec` (one with [`Capability::AppearanceWithLevels`]) with
+/// `appearance` in a part after each level (docs/FORMAT.md §10).
+fn encode_with_level_parts(
+    codec: &dyn Codec,
+    canonical: &CanonicalMesh,
+    appearance: &CanonicalAttributes,
+) -> Result<Encoded> {
+    let mut encoded = codec.encode(canonical)?;
+    let vertices: Vec<usize> = encoded.levels.iter().map(|l| l.vertices).collect();
+    let plan = appearance::levels::PartsPlan::for_levels(&vertices, canonical.vertex_count());
+    let parts = appearance::levels::encode(&encoded.bytes, canonical, appearance, plan)?;
+    let bytes: usize = parts.parts.iter().map(Vec::len).sum();
+    encoded.stats.add_named("appearance_bytes", bytes as f64);
+    encoded
+        .stats
+        .add_named("appearance_settled_level", parts.settled_at as f64);
+    encoded
+        .stats
+        .add_named("appearance_birth_levels", plan.birth_levels as f64);
+    for (field, bits) in parts.fields {
+        encoded
+            .stats
+            .add_named(&format!("appearance_bits_{field}"), bits);
+    }
+    let mut writer = crate::container::StreamWriter::reopen(
+        std::mem::take(&mut encoded.bytes),
+        &encoded.levels,
+    )?;
+    writer.set_level_parts(appearance::spec_of(appearance), parts.parts)?;
+    (encoded.bytes, encoded.levels) = writer.finish();
+    Ok(encoded)
+}
+
+/// `canonical` encoded by `codec` with `appearance` in one appearance unit after the last
+/// level (docs/FORMAT.md §9), whatever the codec's own way: the unit every codec but
+/// `came-paper` can carry, for comparing with the codec's way.
+pub fn encode_with_appearance_unit(
+    codec: &dyn Codec,
+    canonical: &CanonicalMesh,
+    appearance: &CanonicalAttributes,
+) -> Result<Encoded> {
     let mut encoded = codec.encode(canonical)?;
     let (full, _) = decode(&encoded.bytes, Stop::All)?;
     let (unit, fields) = appearance::encode(&full.mesh, canonical, appearance)?;
@@ -456,6 +517,24 @@ fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
             format!("{} streams do not carry appearance that way", codec.name()),
         ));
     }
+    if reader.header().has_level_parts() {
+        if !codec
+            .capabilities()
+            .contains(&Capability::AppearanceWithLevels)
+        {
+            return Err(Error::malformed(
+                0,
+                5,
+                format!("{} streams do not carry appearance after each level", codec.name()),
+            ));
+        }
+        let spec = reader.header().appearance.clone().unwrap_or_default();
+        let parts = reader.clone();
+        let inner = codec.decoder(reader)?;
+        return Ok(Box::new(appearance::levels::WithLevelParts::new(
+            inner, parts, spec,
+        )));
+    }
     let inner = codec.decoder(reader)?;
     Ok(match appearance {
         Some(spec) => Box::new(appearance::decoder::WithAppearance::new(inner, spec, unit)),
@@ -481,6 +560,10 @@ pub(crate) fn level_ends_of(reader: &StreamReader) -> Result<Vec<u64>> {
     let mut ends = for_header(reader.header())?.level_ends(reader)?;
     if let (Some(unit), Some(last)) = (reader.index().appearance, ends.last_mut()) {
         *last = reader.payload_start() as u64 + unit.end();
+    }
+    // A level is decoded with its appearance part.
+    for (end, part) in ends.iter_mut().zip(&reader.index().level_parts) {
+        *end = reader.payload_start() as u64 + part.end();
     }
     Ok(ends)
 }

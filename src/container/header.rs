@@ -49,6 +49,9 @@ pub struct AppearanceSpec {
     /// Whether the levels' new normals are predicted from the geometry of their vertex's faces
     /// (docs/FORMAT.md §6.3; with normals coded in the levels only).
     pub geometric_normals: bool,
+    /// Whether every level is followed by a unit of its own appearance (docs/FORMAT.md §10:
+    /// `emc`, `emc-ahead`), rather than the last by the appearance unit.
+    pub level_parts: bool,
 }
 
 impl AppearanceSpec {
@@ -83,6 +86,7 @@ pub(super) const FLAG_MATERIALS: u8 = 8;
 pub(super) const FLAG_IN_LEVELS: u8 = 16;
 pub(super) const FLAG_DERIVED_NORMALS: u8 = 32;
 pub(super) const FLAG_GEOMETRIC_NORMALS: u8 = 64;
+pub(super) const FLAG_LEVEL_PARTS: u8 = 128;
 
 impl AppearanceSpec {
     pub(super) fn write(&self, out: &mut Vec<u8>) {
@@ -98,6 +102,11 @@ impl AppearanceSpec {
             }
             | if self.geometric_normals {
                 FLAG_GEOMETRIC_NORMALS
+            } else {
+                0
+            }
+            | if self.level_parts {
+                FLAG_LEVEL_PARTS
             } else {
                 0
             };
@@ -139,8 +148,9 @@ impl AppearanceSpec {
         let bad_mode = normal_modes != 0
             && (normal_modes == FLAG_DERIVED_NORMALS | FLAG_GEOMETRIC_NORMALS
                 || flags & (FLAG_NORMALS | FLAG_IN_LEVELS) != FLAG_NORMALS | FLAG_IN_LEVELS);
-        let known = attributes | FLAG_IN_LEVELS | FLAG_DERIVED_NORMALS | FLAG_GEOMETRIC_NORMALS;
-        if flags & attributes == 0 || flags & !known != 0 || bad_mode {
+        // The values travel in the splits (16) or in units after the levels (128), not both.
+        let two_places = flags & (FLAG_IN_LEVELS | FLAG_LEVEL_PARTS) == FLAG_IN_LEVELS | FLAG_LEVEL_PARTS;
+        if flags & attributes == 0 || bad_mode || two_places {
             return Err(Error::malformed(
                 0,
                 at,
@@ -152,6 +162,7 @@ impl AppearanceSpec {
             in_levels: flags & FLAG_IN_LEVELS != 0,
             derived_normals: flags & FLAG_DERIVED_NORMALS != 0,
             geometric_normals: flags & FLAG_GEOMETRIC_NORMALS != 0,
+            level_parts: flags & FLAG_LEVEL_PARTS != 0,
             ..AppearanceSpec::default()
         };
         if flags & FLAG_NORMALS != 0 {
@@ -216,7 +227,14 @@ impl Header {
     /// True when the index's last unit is the appearance unit (docs/FORMAT.md §1.1): the
     /// stream carries appearance outside its levels.
     pub fn has_appearance_unit(&self) -> bool {
-        self.appearance.as_ref().is_some_and(|a| !a.in_levels)
+        self.appearance
+            .as_ref()
+            .is_some_and(|a| !a.in_levels && !a.level_parts)
+    }
+
+    /// True when every level is followed by a unit of its appearance (docs/FORMAT.md §10).
+    pub fn has_level_parts(&self) -> bool {
+        self.appearance.as_ref().is_some_and(|a| a.level_parts)
     }
 
     /// Appends the header's bytes to `out`.

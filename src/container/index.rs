@@ -34,6 +34,9 @@ pub struct Index {
     pub payload_bytes: u64,
     /// The appearance unit, last in the stream, when the header declares appearance.
     pub appearance: Option<UnitEntry>,
+    /// The unit of each level's appearance, which follows the level, when the header declares
+    /// level parts (docs/FORMAT.md §10); empty otherwise.
+    pub level_parts: Vec<UnitEntry>,
 }
 
 impl Index {
@@ -67,17 +70,25 @@ impl Index {
             units,
             payload_bytes: offset,
             appearance: None,
+            level_parts: Vec::new(),
         }
     }
 
-    /// True when the units are levels: back to back in order, each depending on the one before.
+    /// True when the units are levels: in order, each depending on the one before (and back to
+    /// back, but for the level parts between them).
     pub fn is_layered(&self) -> bool {
         let mut offset = 0;
         self.units.iter().enumerate().all(|(i, unit)| {
             let in_place = unit.offset == offset && unit.parent == i.checked_sub(1);
-            offset += unit.length;
+            offset = unit.end() + self.level_parts.get(i).map_or(0, |p| p.length);
             in_place
         })
+    }
+
+    /// One past the last byte, from the payload's start, of level `i` and its level part.
+    pub fn level_end(&self, i: usize) -> Option<u64> {
+        let unit = self.units.get(i)?;
+        Some(self.level_parts.get(i).map_or(unit.end(), UnitEntry::end))
     }
 
     /// Refuses an index whose units are not levels (`at`: the payload's offset, for the error).
@@ -105,7 +116,7 @@ impl Index {
     /// Appends the index's bytes to `out`. The units lie back to back in order and form a
     /// tree in breadth-first order (FORMAT.md §2): the writers' own layout, checked here.
     pub fn write(&self, out: &mut Vec<u8>) {
-        let units: Vec<UnitEntry> = self.units.iter().chain(&self.appearance).copied().collect();
+        let units: Vec<UnitEntry> = self.stream_order();
         let mut children = vec![0u64; units.len()];
         let mut offset = 0;
         for unit in &units {
@@ -138,6 +149,55 @@ impl Index {
         varint::put(out, entries.len() as u64);
         varint::put(out, self.payload_bytes);
         out.extend_from_slice(&entries);
+    }
+
+    /// The units as the stream lists them: each level followed by its level part (the part's
+    /// parent is its level, the next level's the level before), then the appearance unit.
+    fn stream_order(&self) -> Vec<UnitEntry> {
+        if self.level_parts.is_empty() {
+            return self.units.iter().chain(&self.appearance).copied().collect();
+        }
+        let mut units = Vec::with_capacity(2 * self.units.len());
+        for (i, (level, part)) in self.units.iter().zip(&self.level_parts).enumerate() {
+            units.push(UnitEntry {
+                parent: i.checked_sub(1).map(|p| 2 * p),
+                ..*level
+            });
+            units.push(UnitEntry {
+                parent: Some(2 * i),
+                ..*part
+            });
+        }
+        units
+    }
+
+    /// Takes the level parts out of an index whose units alternate level, level part
+    /// (docs/FORMAT.md §10): the levels keep their own numbering; `at` is for errors.
+    pub(super) fn split_level_parts(&mut self, at: usize) -> Result<()> {
+        let listed = std::mem::take(&mut self.units);
+        if listed.len() % 2 != 0 {
+            return Err(Error::malformed(
+                0,
+                at,
+                "index: levels and their appearance units do not alternate",
+            ));
+        }
+        for (i, pair) in listed.chunks(2).enumerate() {
+            let (level, part) = (pair[0], pair[1]);
+            if level.parent != i.checked_sub(1).map(|p| 2 * p) || part.parent != Some(2 * i) {
+                return Err(Error::malformed(
+                    0,
+                    at,
+                    format!("index: level {i} or its appearance unit depends on another unit"),
+                ));
+            }
+            self.units.push(UnitEntry {
+                parent: i.checked_sub(1),
+                ..level
+            });
+            self.level_parts.push(part);
+        }
+        Ok(())
     }
 
     /// Reads and checks an index from `bytes` at `pos`.
@@ -246,6 +306,7 @@ impl PartialIndex {
                 units: Vec::new(),
                 payload_bytes,
                 appearance: None,
+                level_parts: Vec::new(),
             },
             children: Vec::new(),
             payload_start: *pos + entry_bytes as usize,
@@ -257,6 +318,9 @@ impl PartialIndex {
     /// The units the index lists for the codec of `header`: all but the appearance unit,
     /// where the header declares one (it is the last).
     pub fn codec_units(&self, header: &Header) -> usize {
+        if header.has_level_parts() {
+            return self.listed / 2;
+        }
         self.listed - header.has_appearance_unit() as usize
     }
 

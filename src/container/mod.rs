@@ -94,5 +94,8 @@ pub fn read_header_and_index(bytes: &[u8]) -> Result<(Header, Index, usize)> {
         }
         index.appearance = Some(unit);
     }
+    if header.has_level_parts() {
+        index.split_level_parts(pos)?;
+    }
     Ok((header, index, pos))
 }

@@ -93,9 +93,28 @@ impl<'a> StreamReader<'a> {
         &self.bytes
     }
 
-    /// Unit `i`, when all its bytes are present.
+    /// Unit `i`, when all its bytes are present (and, in a stream whose levels have
+    /// appearance parts, its part's too: a level is decoded with its appearance).
     pub fn unit(&self, i: usize) -> Option<LevelPayload<'_>> {
         let entry = self.index.units.get(i)?;
+        let start = self.payload_start + entry.offset as usize;
+        let end = self.payload_start + entry.end() as usize;
+        if let Some(part) = self.index.level_parts.get(i) {
+            if self.bytes.len() < self.payload_start + part.end() as usize {
+                return None;
+            }
+        }
+        self.bytes.get(start..end).map(|bytes| LevelPayload {
+            index: i,
+            start,
+            bytes,
+        })
+    }
+
+    /// The appearance part of level `i` (docs/FORMAT.md §10), when the stream has level parts
+    /// and its bytes are present.
+    pub fn level_part(&self, i: usize) -> Option<LevelPayload<'_>> {
+        let entry = self.index.level_parts.get(i)?;
         let start = self.payload_start + entry.offset as usize;
         let end = self.payload_start + entry.end() as usize;
         self.bytes.get(start..end).map(|bytes| LevelPayload {
@@ -237,6 +256,11 @@ impl<R: std::io::Read> ReadLevels<R> {
             match read_header_and_index(&bytes) {
                 Ok((header, index, offset)) => {
                     index.require_layered(offset)?;
+                    if header.has_level_parts() {
+                        return Err(Error::Unsupported(
+                            "levels read from an input stream carry no appearance parts".into(),
+                        ));
+                    }
                     return Ok(ReadLevels {
                         offset,
                         reader,

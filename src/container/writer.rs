@@ -44,6 +44,8 @@ pub struct StreamWriter {
     marks: Vec<(u64, LevelCost)>,
     /// The appearance unit, after every other.
     appearance: Option<Vec<u8>>,
+    /// The appearance part of each level, after it (docs/FORMAT.md §10).
+    level_parts: Vec<Vec<u8>>,
 }
 
 impl StreamWriter {
@@ -55,6 +57,7 @@ impl StreamWriter {
             units: Vec::new(),
             marks: Vec::new(),
             appearance: None,
+            level_parts: Vec::new(),
         }
     }
 
@@ -107,6 +110,7 @@ impl StreamWriter {
             units: index.units.iter().map(|u| (u.length, u.parent)).collect(),
             marks,
             appearance: None,
+            level_parts: Vec::new(),
         })
     }
 
@@ -115,6 +119,24 @@ impl StreamWriter {
     pub fn set_appearance(&mut self, spec: AppearanceSpec, unit: Vec<u8>) {
         self.header.appearance = Some(spec);
         self.appearance = Some(unit);
+    }
+
+    /// The appearance part of every level (docs/FORMAT.md §10), described by `spec` in the
+    /// header: each follows its level, which a reader decodes with it. A stream of levels
+    /// only, one part a level.
+    pub fn set_level_parts(&mut self, spec: AppearanceSpec, parts: Vec<Vec<u8>>) -> Result<()> {
+        let layered = self.units.iter().enumerate().all(|(i, u)| u.1 == i.checked_sub(1));
+        if !layered || parts.len() != self.units.len() || self.marks.len() != self.units.len() {
+            return Err(Error::Unsupported(
+                "appearance parts need a stream of levels, one part a level".into(),
+            ));
+        }
+        self.header.appearance = Some(AppearanceSpec {
+            level_parts: true,
+            ..spec
+        });
+        self.level_parts = parts;
+        Ok(())
     }
 
     /// Appends one level's payload and what it cost: a unit whose parent is the level before.
@@ -140,6 +162,9 @@ impl StreamWriter {
 
     /// The stream and, for each level, where it ends and what the stream cost up to there.
     pub fn finish(self) -> (Vec<u8>, Vec<LevelRecord>) {
+        if !self.level_parts.is_empty() {
+            return self.finish_with_level_parts();
+        }
         let appearance_bytes = self.appearance.as_ref().map_or(0, Vec::len);
         let mut bytes =
             Vec::with_capacity(self.payload.len() + appearance_bytes + 64 + 12 * self.units.len());
@@ -180,6 +205,49 @@ impl StreamWriter {
         if let (Some(_), Some(last)) = (&self.appearance, records.last_mut()) {
             last.end_byte = bytes.len();
         }
+        (bytes, records)
+    }
+
+    /// [`Self::finish`] for a stream of levels each followed by its appearance part.
+    fn finish_with_level_parts(self) -> (Vec<u8>, Vec<LevelRecord>) {
+        let mut bytes = Vec::new();
+        self.header.write(&mut bytes);
+        let mut index = Index::back_to_back([]);
+        let mut payload = Vec::with_capacity(self.payload.len());
+        let mut level_start = 0;
+        for ((length, parent), part) in self.units.iter().zip(&self.level_parts) {
+            let level = &self.payload[level_start..level_start + *length as usize];
+            level_start += level.len();
+            for (unit, bytes) in [(&mut index.units, level), (&mut index.level_parts, part)] {
+                unit.push(UnitEntry {
+                    offset: payload.len() as u64,
+                    length: bytes.len() as u64,
+                    parent: *parent,
+                });
+                payload.extend_from_slice(bytes);
+            }
+        }
+        index.payload_bytes = payload.len() as u64;
+        index.write(&mut bytes);
+        let start = bytes.len();
+        bytes.extend_from_slice(&payload);
+        let (mut connectivity, mut geometry) = (0, 0);
+        let records = self
+            .marks
+            .iter()
+            .zip(&index.level_parts)
+            .map(|(&(_, cost), part)| {
+                connectivity += cost.connectivity_bits;
+                geometry += cost.geometry_bits;
+                LevelRecord {
+                    end_byte: start + part.end() as usize,
+                    connectivity_bits: connectivity,
+                    geometry_bits: geometry,
+                    vertices: cost.vertices,
+                    triangles: cost.triangles,
+                }
+            })
+            .collect();
         (bytes, records)
     }
 }

@@ -71,6 +71,19 @@ impl Symbols for Reader {
     }
 }
 
+/// A vertex's first wedge as its representative showed it (docs/FORMAT.md §10): its values,
+/// but for the `uv_low_bits` lowest bits of each uv axis, left to the full appearance.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FirstValue {
+    /// The values; the uv's low bits are zero.
+    pub code: CornerCode,
+    /// uv bits (per axis) still to code.
+    pub uv_low_bits: u8,
+}
+
+/// Context sets for the low uv bits a representative left out, by their count.
+const UV_LOW_SETS: usize = 8;
+
 /// What the encoder knows: every decoded face's corners' values and material.
 pub struct Truth<'a> {
     /// Quantized values of each corner, per face of the decoded mesh.
@@ -108,6 +121,8 @@ struct Contexts {
     material: UintContext,
     /// [basis][scale][axis]
     uv: [[[IntContext; 2]; UV_SCALES]; 4],
+    /// The low uv bits a representative left out: [their count][scale][axis].
+    uv_low: [[[IntContext; 2]; UV_SCALES]; UV_LOW_SETS],
     /// [first wedge at its vertex][axis]
     normal: [[IntContext; 2]; 2],
     /// [spread of the known corners' colours][channel]
@@ -115,11 +130,15 @@ struct Contexts {
 }
 
 /// Runs the unit's syntax over `mesh` (the decoded full level), coding `truth` when given.
+/// With `first`, the values of each vertex's first wedge are known already (`first[v]`, the
+/// level appearance of §10): a wedge that a vertex starts with takes them uncoded, but for the
+/// low bits of its uv that its representative left out, coded here.
 pub fn run(
     symbols: &mut impl Symbols,
     mesh: &TriMesh,
     spec: &AppearanceSpec,
     truth: Option<&Truth>,
+    first: Option<&[Option<FirstValue>]>,
 ) -> Result<Appearance> {
     let traversal = Traversal::new(mesh);
     let faces = &mesh.faces;
@@ -178,6 +197,7 @@ pub fn run(
         // Which wedge each corner takes.
         let mut edge_continued: [Option<bool>; 3] = [None; 3];
         let mut born = [false; 3];
+        let mut partial: [Option<FirstValue>; 3] = [None; 3];
         for k in 0..3 {
             let v = face[k] as usize;
             let truth_code = truth.map(|t| t.corners[fu][k]);
@@ -254,10 +274,14 @@ pub fn run(
             if chosen == NONE {
                 chosen = out.wedge_vertex.len() as u32;
                 out.wedge_vertex.push(v as u32);
-                out.codes.push(CornerCode::default());
+                let known_first = first.filter(|_| first_wedge[v] == NONE).and_then(|f| f[v]);
+                out.codes.push(known_first.map(|f| f.code).unwrap_or_default());
                 next_wedge.push(first_wedge[v]);
                 first_wedge[v] = chosen;
-                born[k] = true;
+                // A first wedge whose uv is whole is known; one with low bits left goes
+                // through the values below for those alone.
+                born[k] = known_first.is_none_or(|f| f.uv_low_bits > 0);
+                partial[k] = known_first.filter(|f| f.uv_low_bits > 0);
             }
             out.corners[fu][k] = chosen;
         }
@@ -273,7 +297,10 @@ pub fn run(
             let mut code = CornerCode::default();
             let others = [(k + 1) % 3, (k + 2) % 3];
             let known_code = |j: usize| known[j].then(|| out.codes[out.corners[fu][j] as usize]);
-            if let (Some(bits), Some(max)) = (spec.normal_bits, normal_max) {
+            if let Some(shown) = partial[k] {
+                code = shown.code;
+            }
+            if let (Some(bits), Some(max), None) = (spec.normal_bits, normal_max, partial[k]) {
                 let first_at_vertex = next_wedge[w] == NONE;
                 let p = |i: usize| mesh.positions[face[i] as usize];
                 let direction = if first_at_vertex {
@@ -411,12 +438,40 @@ pub fn run(
                 let value = truth_code.uv.unwrap_or_default();
                 let mut t = [0u32; 2];
                 for axis in 0..2 {
-                    let d = symbols.int(
-                        &mut c.uv[basis as usize][scale][axis],
-                        value[axis] as i64 - predicted[axis] as i64,
-                        ["uv_unfolded", "uv_triangle", "uv_corner", "uv_previous"][basis as usize],
-                    )?;
-                    t[axis] = in_range(predicted[axis] as i64 + d, cells, "uv")?;
+                    t[axis] = match partial[k] {
+                        // The representative's high bits hold: the prediction is taken
+                        // into their cell, and the low bits coded from there.
+                        Some(shown) => {
+                            let low = shown.uv_low_bits.min(31);
+                            let base = shown.code.uv.unwrap_or_default()[axis] >> low << low;
+                            let top = base as i64 + (1i64 << low) - 1;
+                            let guess = (predicted[axis] as i64).clamp(base as i64, top);
+                            let d = symbols.int(
+                                &mut c.uv_low[(low as usize - 1).min(UV_LOW_SETS - 1)][scale]
+                                    [axis],
+                                value[axis] as i64 - guess,
+                                "uv_low",
+                            )?;
+                            let x = guess + d;
+                            if x < base as i64 || x > top {
+                                return Err(Error::malformed(
+                                    0,
+                                    0,
+                                    "appearance: uv low bits outside the representative's cell",
+                                ));
+                            }
+                            in_range(x, cells, "uv")?
+                        }
+                        None => {
+                            let d = symbols.int(
+                                &mut c.uv[basis as usize][scale][axis],
+                                value[axis] as i64 - predicted[axis] as i64,
+                                ["uv_unfolded", "uv_triangle", "uv_corner", "uv_previous"]
+                                    [basis as usize],
+                            )?;
+                            in_range(predicted[axis] as i64 + d, cells, "uv")?
+                        }
+                    };
                 }
                 if let Some(choices) = scored {
                     let actual = at(t);
@@ -427,7 +482,7 @@ pub fn run(
                 code.uv = Some(t);
                 previous_uv = t;
             }
-            if spec.colours {
+            if spec.colours && partial[k].is_none() {
                 let known_colours: Vec<[u8; 4]> = others
                     .iter()
                     .filter_map(|&j| known_code(j).and_then(|c| c.colour))

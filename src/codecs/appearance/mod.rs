@@ -20,8 +20,10 @@
 //! | wedge delta | the residual of a new wedge's values after prediction |
 //! | material prediction from an adjacent face | the `material` bit: "same as the face across an edge" |
 
+pub mod births;
 pub mod coder;
 pub mod decoder;
+pub mod levels;
 pub mod predict;
 pub mod traversal;
 
@@ -60,6 +62,7 @@ pub fn spec_of(appearance: &CanonicalAttributes) -> AppearanceSpec {
         in_levels: false,
         derived_normals: false,
         geometric_normals: false,
+        level_parts: false,
     }
 }
 
@@ -104,7 +107,7 @@ pub fn encode(
         materials: materials.as_deref(),
     };
     let mut encoder = ArithEncoder::default();
-    coder::run(&mut encoder, decoded, &spec_of(appearance), Some(&truth))?;
+    coder::run(&mut encoder, decoded, &spec_of(appearance), Some(&truth), None)?;
     let fields = encoder.field_bits.clone();
     let (bytes, _) = encoder.finish();
     Ok((bytes, fields))
@@ -123,7 +126,7 @@ pub fn decode(
         Error::malformed(unit, start, "appearance unit is not whole 32-bit words")
     })?;
     let mut reader = coder::Reader { coder, unit, start };
-    let appearance = coder::run(&mut reader, mesh, spec, None).map_err(|e| match e {
+    let appearance = coder::run(&mut reader, mesh, spec, None, None).map_err(|e| match e {
         Error::Malformed { what, .. } => Error::malformed(unit, start, what),
         e => e,
     })?;

@@ -496,6 +496,7 @@ impl Loader {
             units: Vec::new(),
             payload_bytes: index.index.payload_bytes,
             appearance: None,
+            level_parts: Vec::new(),
         };
         let decoder =
             refining_codec(&header)?.detached(&header, &no_entries, payload_start as usize)?;

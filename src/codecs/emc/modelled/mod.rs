@@ -171,7 +171,11 @@ const DESCRIPTOR: Descriptor = Descriptor {
     naming: names::EMC,
     summary: "embedded mesh coding with context-modelled arithmetic coding: octree splits whose positions and edges are predicted from decoded neighbours",
     default_options: cubic(12),
-    capabilities: &[Capability::PassStops, Capability::Attributes],
+    capabilities: &[
+        Capability::PassStops,
+        Capability::Attributes,
+        Capability::AppearanceWithLevels,
+    ],
     lossless: true,
 };
 
@@ -180,7 +184,11 @@ const AHEAD_DESCRIPTOR: Descriptor = Descriptor {
     naming: names::EMC_AHEAD,
     summary: "emc with every vertex's position coded two levels ahead of the octree's splits: better intermediate levels for a larger lossless stream",
     default_options: cubic(12),
-    capabilities: &[Capability::PassStops, Capability::Attributes],
+    capabilities: &[
+        Capability::PassStops,
+        Capability::Attributes,
+        Capability::AppearanceWithLevels,
+    ],
     lossless: true,
 };
 
