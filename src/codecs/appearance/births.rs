@@ -25,6 +25,10 @@ pub struct RepValue {
     pub material: Option<u32>,
     /// Low bits of each uv axis left uncoded, for the full appearance.
     pub uv_low_bits: u8,
+    /// Whether the values are a sketch (docs/FORMAT.md §10.1): which of its neighbours'
+    /// charts each wedge lies in, its values those the chart predicts; the full appearance
+    /// codes them again.
+    pub sketched: bool,
 }
 
 /// A level as the births see it: where its vertices are shown and which of them share an edge.
@@ -59,10 +63,33 @@ pub struct Births {
     contexts: Box<Contexts>,
     uv_scores: [f64; UV_PREDICTIONS],
     previous: RepValue,
+    /// By representative: its other wedges (across seams), in the order the settling level
+    /// meets them.
+    pub seams: Vec<Seams>,
 }
+
+/// A representative's wedges after its first.
+pub type Seams = smallvec::SmallVec<[CornerCode; 1]>;
+
+/// Most wedges a representative may have past its first.
+const MAX_SEAM_WEDGES: u64 = 64;
+
+/// Context sets for a sketch's chart choice, by how many charts there are to choose from.
+const SKETCH_CHOICES: usize = 4;
 
 #[derive(Default)]
 struct Contexts {
+    /// A sketched wedge's chart: [charts to choose from, 1 to 4 or more].
+    sketch_chart: [UintContext; SKETCH_CHOICES],
+    /// A sketch's wedges past the first: [charts left, 0 to 3 or more].
+    sketch_seams: [UintContext; SKETCH_CHOICES],
+    /// Wedges past the first: [a neighbour lies off the first wedge's chart].
+    seam_count: [UintContext; 2],
+    /// A seam wedge's uv: [predicted from a neighbour off the charts so far][axis].
+    seam_uv: [[IntContext; 2]; 2],
+    /// A seam wedge's normal and colour about the first wedge's.
+    seam_normal: [IntContext; 2],
+    seam_colour: [IntContext; 4],
     /// [a neighbour is known]
     material_same: [BitContext; 2],
     material: UintContext,
@@ -83,6 +110,7 @@ impl Births {
             contexts: Box::default(),
             uv_scores: [0.0; UV_PREDICTIONS],
             previous: RepValue::default(),
+            seams: vec![Seams::new(); vertices],
         }
     }
 
@@ -96,7 +124,7 @@ impl Births {
         born: &[u32],
         token: impl Fn(u32) -> u32,
         spec: &AppearanceSpec,
-        truth: Option<&[RepValue]>,
+        truth: Option<(&[RepValue], &[Seams])>,
     ) -> Result<()> {
         let neighbours = Neighbours::build(level);
         let mut known = Vec::new();
@@ -112,10 +140,134 @@ impl Births {
             neighbours.known(level, v, |w| self.values[token(w) as usize], &mut known);
             let normal = faces_normal(level, neighbours.faces_of(v));
             let prediction = self.predict(level.positions[v as usize], normal, &known, spec);
-            let truth = truth.map(|values| values[t]).unwrap_or_default();
-            let value = self.code_one(symbols, &prediction, spec, truth)?;
+            let first = truth.map(|(values, _)| values[t]).unwrap_or_default();
+            let value = self.code_one(symbols, &prediction, spec, first)?;
+            let seams = truth.map(|(_, seams)| &seams[t][..]).unwrap_or_default();
+            let p = level.positions[v as usize];
+            self.seams[t] = self.code_seams(symbols, p, normal, &value, &known, spec, seams)?;
             self.values[t] = Some(value);
             self.previous = value;
+        }
+        Ok(())
+    }
+
+    /// Codes or reads a sketch of the representatives born in `level` (those of the vertices
+    /// `born`, in order): for each, which of the charts its neighbours' wedges lie in holds
+    /// its first wedge, how many more wedges it has and in which of the other charts. Each
+    /// wedge's uv is what its chart's fit predicts; its other values what the neighbours
+    /// predict. `truth`: the encoder's values, as for [`Self::code`].
+    pub fn sketch(
+        &mut self,
+        symbols: &mut impl Symbols,
+        level: &LevelView,
+        born: &[u32],
+        token: impl Fn(u32) -> u32,
+        spec: &AppearanceSpec,
+        truth: Option<(&[RepValue], &[Seams])>,
+    ) -> Result<()> {
+        let neighbours = Neighbours::build(level);
+        let mut known = Vec::new();
+        for &v in born {
+            let t = token(v) as usize;
+            if t >= self.values.len() || self.values[t].is_some() {
+                return Err(Error::malformed(
+                    0,
+                    0,
+                    "appearance: a representative is born twice",
+                ));
+            }
+            neighbours.known(level, v, |w| self.values[token(w) as usize], &mut known);
+            let p = level.positions[v as usize];
+            let normal = faces_normal(level, neighbours.faces_of(v));
+            let mut value = self.predict(p, normal, &known, spec).value(spec);
+            value.sketched = true;
+            let mut seams = Seams::new();
+            if let Some(grid) = spec.uv_grid {
+                let cells = 1u64 << grid.bits;
+                // Every wedge of the neighbours, nearest first, grouped by chart.
+                let at = |q: [u32; 2]| DVec2::new(q[0] as f64, q[1] as f64);
+                let mut wedges: Vec<(DVec3, DVec2)> = Vec::new();
+                for &w in neighbours.of(v) {
+                    let tw = token(w) as usize;
+                    if let Some(known) = self.values[tw] {
+                        let q = level.positions[w as usize];
+                        wedges.extend(known.code.uv.map(|t| (q, at(t))));
+                        wedges.extend(self.seams[tw].iter().filter_map(|c| c.uv.map(|t| (q, at(t)))));
+                    }
+                }
+                wedges.sort_by(|a, b| {
+                    (a.0 - p)
+                        .length_squared()
+                        .total_cmp(&(b.0 - p).length_squared())
+                });
+                let mut charts: Vec<[u32; 2]> = Vec::new();
+                while let Some(&(q0, t0)) = wedges.first() {
+                    let chart = in_chart(&wedges, q0, t0);
+                    let fitted = uv_by_fit(p, normal_or_z(normal), &chart).unwrap_or(t0);
+                    charts.push(clamp_cell(fitted, cells));
+                    wedges.retain(|w| !chart.contains(w));
+                }
+                if !charts.is_empty() {
+                    let first = truth.map(|(values, _)| values[t].code.uv.unwrap_or_default());
+                    let nearest = |target: [u32; 2], among: &[usize]| {
+                        among
+                            .iter()
+                            .position(|&i| {
+                                let d = |c: [u32; 2]| at(c).distance_squared(at(target));
+                                among.iter().all(|&j| d(charts[i]) <= d(charts[j]))
+                            })
+                            .unwrap_or(0)
+                    };
+                    let mut left: Vec<usize> = (0..charts.len()).collect();
+                    let c = &mut *self.contexts;
+                    let choices = |n: usize| n.clamp(1, SKETCH_CHOICES) - 1;
+                    let pick = symbols.uint(
+                        &mut c.sketch_chart[choices(left.len())],
+                        first.map_or(0, |f| nearest(f, &left)) as u64,
+                        "sketch",
+                    )? as usize;
+                    let chosen = *left.get(pick).ok_or_else(|| {
+                        Error::malformed(0, 0, "appearance: a sketch's chart past those there are")
+                    })?;
+                    value.code.uv = Some(charts[chosen]);
+                    left.remove(pick);
+                    let truth_seams = truth.map(|(_, seams)| &seams[t][..]).unwrap_or_default();
+                    let count = symbols.uint(
+                        &mut c.sketch_seams[left.len().min(SKETCH_CHOICES - 1)],
+                        truth_seams.len().min(left.len()) as u64,
+                        "sketch",
+                    )? as usize;
+                    if count > left.len() {
+                        return Err(Error::malformed(
+                            0,
+                            0,
+                            "appearance: a sketch with more wedges than charts",
+                        ));
+                    }
+                    for j in 0..count {
+                        let target = truth_seams.get(j).and_then(|c| c.uv).unwrap_or_default();
+                        let pick = symbols.uint(
+                            &mut c.sketch_chart[choices(left.len())],
+                            nearest(target, &left) as u64,
+                            "sketch",
+                        )? as usize;
+                        let chosen = *left.get(pick).ok_or_else(|| {
+                            Error::malformed(
+                                0,
+                                0,
+                                "appearance: a sketch's chart past those there are",
+                            )
+                        })?;
+                        left.remove(pick);
+                        seams.push(CornerCode {
+                            uv: Some(charts[chosen]),
+                            ..value.code
+                        });
+                    }
+                }
+            }
+            self.values[t] = Some(value);
+            self.seams[t] = seams;
         }
         Ok(())
     }
@@ -262,6 +414,119 @@ impl Births {
         }
     }
 
+    /// Codes or reads the wedges of a representative past its `first` (those across seams):
+    /// their count, then each one's values, its uv predicted from the chart of the nearest
+    /// neighbour in `known` off the charts of the wedges before it.
+    #[allow(clippy::too_many_arguments)]
+    fn code_seams(
+        &mut self,
+        symbols: &mut impl Symbols,
+        p: DVec3,
+        normal: DVec3,
+        first: &RepValue,
+        known: &[(DVec3, RepValue)],
+        spec: &AppearanceSpec,
+        truth: &[CornerCode],
+    ) -> Result<Seams> {
+        let at = |q: [u32; 2]| DVec2::new(q[0] as f64, q[1] as f64);
+        let with_uv: Vec<(DVec3, DVec2)> = known
+            .iter()
+            .filter_map(|(q, v)| v.code.uv.map(|t| (*q, at(t))))
+            .collect();
+        // The neighbours off the chart of every wedge so far, nearest first.
+        let off_charts = |wedges: &[CornerCode]| -> Vec<(DVec3, DVec2)> {
+            let mut charts: Vec<(DVec3, DVec2)> = Vec::new();
+            for w in wedges {
+                if let Some(t) = w.uv {
+                    let mut around = vec![(p, at(t))];
+                    around.extend(&with_uv);
+                    charts.extend(in_chart(&around, p, at(t)));
+                }
+            }
+            with_uv
+                .iter()
+                .filter(|(q, t)| !charts.iter().any(|(r, u)| r == q && u == t))
+                .copied()
+                .collect()
+        };
+        let mut wedges: Vec<CornerCode> = vec![first.code];
+        let outside = spec.uv_grid.is_some() && !off_charts(&wedges).is_empty();
+        let c = &mut *self.contexts;
+        let count = symbols.uint(
+            &mut c.seam_count[outside as usize],
+            truth.len() as u64,
+            "seam_wedges",
+        )?;
+        if count > MAX_SEAM_WEDGES {
+            return Err(Error::malformed(
+                0,
+                0,
+                "appearance: a representative with too many wedges",
+            ));
+        }
+        let mut seams = Seams::new();
+        for j in 0..count as usize {
+            let value = truth.get(j).copied().unwrap_or_default();
+            let mut code = first.code;
+            if let Some(bits) = spec.normal_bits {
+                let max = octahedral_max(bits);
+                let predicted = first.code.normal.unwrap_or_default();
+                let mut n = [0u32; 2];
+                for axis in 0..2 {
+                    let d = symbols.int(
+                        &mut c.seam_normal[axis],
+                        value.normal.unwrap_or_default()[axis] as i64 - predicted[axis] as i64,
+                        "normal",
+                    )?;
+                    n[axis] = in_range(predicted[axis] as i64 + d, max as u64 + 1, "normal")?;
+                }
+                code.normal = Some(n);
+            }
+            if let Some(grid) = spec.uv_grid {
+                let cells = 1u64 << grid.bits;
+                let off = off_charts(&wedges);
+                let predicted = match off.first() {
+                    Some(&(q0, t0)) => {
+                        let chart = in_chart(&off, q0, t0);
+                        let t = uv_by_fit(p, normal_or_z(normal), &chart).unwrap_or(t0);
+                        clamp_cell(t, cells)
+                    }
+                    None => first.code.uv.unwrap_or_default(),
+                };
+                let mut t = [0u32; 2];
+                for axis in 0..2 {
+                    let d = symbols.int(
+                        &mut c.seam_uv[off.is_empty() as usize][axis],
+                        value.uv.unwrap_or_default()[axis] as i64 - predicted[axis] as i64,
+                        "uv_seam",
+                    )?;
+                    t[axis] = in_range(predicted[axis] as i64 + d, cells, "uv")?;
+                }
+                code.uv = Some(t);
+            }
+            if spec.colours {
+                let predicted = first.code.colour.unwrap_or_default();
+                let mut rgba = [0u8; 4];
+                for channel in 0..4 {
+                    let d = symbols.int(
+                        &mut c.seam_colour[channel],
+                        value.colour.unwrap_or_default()[channel].wrapping_sub(predicted[channel])
+                            as i8 as i64,
+                        "colour",
+                    )?;
+                    if !(-128..=127).contains(&d) {
+                        return Err(Error::malformed(0, 0, "appearance: colour out of range"));
+                    }
+                    rgba[channel] = predicted[channel].wrapping_add(d as i8 as u8);
+                }
+                code.colour = Some(rgba);
+            }
+            wedges.push(code);
+            seams.push(code);
+        }
+        Ok(seams)
+    }
+
     /// Codes or reads one representative's values about `prediction`.
     fn code_one(
         &mut self,
@@ -394,6 +659,7 @@ impl Prediction {
             },
             material: spec.materials.as_ref().map(|_| self.material),
             uv_low_bits: 0,
+            sketched: false,
         }
     }
 }
@@ -401,7 +667,7 @@ impl Prediction {
 /// The neighbours in `with_uv` (nearest first, the nearest at `q0` with uv `t0`) whose uv
 /// lies where the neighbourhood's median stretch puts it from the nearest one's: those in its
 /// chart, the nearest included.
-fn in_chart(with_uv: &[(DVec3, DVec2)], q0: DVec3, t0: DVec2) -> Vec<(DVec3, DVec2)> {
+pub(super) fn in_chart(with_uv: &[(DVec3, DVec2)], q0: DVec3, t0: DVec2) -> Vec<(DVec3, DVec2)> {
     let mut stretch: Vec<f64> = with_uv[1..]
         .iter()
         .filter_map(|(q, t)| {
@@ -422,7 +688,7 @@ fn in_chart(with_uv: &[(DVec3, DVec2)], q0: DVec3, t0: DVec2) -> Vec<(DVec3, DVe
 }
 
 /// The area-weighted normal of `faces` of `level` (zero without faces).
-fn faces_normal(level: &LevelView, faces: &[u32]) -> DVec3 {
+pub(super) fn faces_normal(level: &LevelView, faces: &[u32]) -> DVec3 {
     faces
         .iter()
         .map(|&f| {
@@ -441,7 +707,7 @@ fn normal_or_z(n: DVec3) -> DVec3 {
 }
 
 /// Each vertex's neighbours (over faces and loose edges) and faces, as compressed rows.
-struct Neighbours {
+pub(super) struct Neighbours {
     start: Vec<u32>,
     list: Vec<u32>,
     face_start: Vec<u32>,
@@ -449,7 +715,7 @@ struct Neighbours {
 }
 
 impl Neighbours {
-    fn build(level: &LevelView) -> Neighbours {
+    pub(super) fn build(level: &LevelView) -> Neighbours {
         let n = level.positions.len();
         let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(level.faces.len() * 6);
         for f in level.faces {
@@ -497,13 +763,13 @@ impl Neighbours {
         }
     }
 
-    fn of(&self, v: u32) -> &[u32] {
+    pub(super) fn of(&self, v: u32) -> &[u32] {
         &self.list[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
     }
 
     /// `v`'s neighbours that `value` gives values, with their positions, nearest first (the
     /// neighbour most likely in the vertex's chart), into `out`.
-    fn known(
+    pub(super) fn known(
         &self,
         level: &LevelView,
         v: u32,
@@ -524,7 +790,7 @@ impl Neighbours {
         });
     }
 
-    fn faces_of(&self, v: u32) -> &[u32] {
+    pub(super) fn faces_of(&self, v: u32) -> &[u32] {
         &self.face_list
             [self.face_start[v as usize] as usize..self.face_start[v as usize + 1] as usize]
     }

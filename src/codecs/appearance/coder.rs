@@ -81,6 +81,10 @@ pub struct FirstValue {
     pub uv_low_bits: u8,
 }
 
+/// The wedges of a vertex known before the full appearance, in the order its corners meet
+/// them (docs/FORMAT.md §10).
+pub type Known = smallvec::SmallVec<[FirstValue; 1]>;
+
 /// Context sets for the low uv bits a representative left out, by their count.
 const UV_LOW_SETS: usize = 8;
 
@@ -138,7 +142,7 @@ pub fn run(
     mesh: &TriMesh,
     spec: &AppearanceSpec,
     truth: Option<&Truth>,
-    first: Option<&[Option<FirstValue>]>,
+    first: Option<&[Known]>,
 ) -> Result<Appearance> {
     let traversal = Traversal::new(mesh);
     let faces = &mesh.faces;
@@ -151,6 +155,8 @@ pub fn run(
     };
     // Wedges of each vertex as a list through `next_wedge`, newest first.
     let mut first_wedge = vec![NONE; mesh.positions.len()];
+    // Wedges made at each vertex so far: the n-th takes the n-th known one.
+    let mut wedges_at = vec![0u8; if first.is_some() { mesh.positions.len() } else { 0 }];
     let mut next_wedge: Vec<u32> = Vec::new();
     let mut previous_uv = [0u32; 2];
     let mut previous_colour = [0u8; 4];
@@ -274,7 +280,11 @@ pub fn run(
             if chosen == NONE {
                 chosen = out.wedge_vertex.len() as u32;
                 out.wedge_vertex.push(v as u32);
-                let known_first = first.filter(|_| first_wedge[v] == NONE).and_then(|f| f[v]);
+                let known_first = first.and_then(|f| {
+                    let n = wedges_at[v];
+                    wedges_at[v] = n.saturating_add(1);
+                    f[v].get(n as usize).copied()
+                });
                 out.codes.push(known_first.map(|f| f.code).unwrap_or_default());
                 next_wedge.push(first_wedge[v]);
                 first_wedge[v] = chosen;

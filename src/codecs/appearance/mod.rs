@@ -21,6 +21,7 @@
 //! | material prediction from an adjacent face | the `material` bit: "same as the face across an edge" |
 
 pub mod births;
+pub mod charts;
 pub mod coder;
 pub mod decoder;
 pub mod levels;
