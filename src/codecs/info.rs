@@ -92,6 +92,9 @@ pub struct AppearanceInfo {
     pub in_levels: bool,
     /// The appearance unit, when the values are in one.
     pub unit: Option<UnitInfo>,
+    /// The unit of each level's appearance, which follows it (docs/FORMAT.md §10: `emc`,
+    /// `emc-ahead`); empty when the values are elsewhere. `unit` is the level's number.
+    pub level_parts: Vec<UnitInfo>,
 }
 
 /// What only the codec of a stream knows how to read of its header ([`Codec::facts`]); what a
@@ -141,6 +144,12 @@ impl StreamInfo {
             unit: index
                 .appearance
                 .map(|entry| unit(index.len(), &entry, reader.appearance_unit().is_some())),
+            level_parts: index
+                .level_parts
+                .iter()
+                .enumerate()
+                .map(|(i, entry)| unit(i, entry, reader.level_part(i).is_some()))
+                .collect(),
         });
         let ends = level_ends_of(&reader)?;
         Ok(StreamInfo {
@@ -179,15 +188,15 @@ mod tests {
     #[test]
     fn streams_describe_themselves() {
         for name in [
-            "v7/raw-eight.mc",
-            "v7/emc-beethoven.mc",
-            "v7/emc-paper-eight.mc",
-            "v7/pm-bunny-res4.mc",
-            "v7/pm-reordered-eight.mc",
-            "v7/came-eight.mc",
-            "v7/came-paper-eight.mc",
-            "v7/emc-spot-appearance.mc",
-            "v7/pm-reordered-spot-appearance-fit.mc",
+            "v8/raw-eight.mc",
+            "v8/emc-beethoven.mc",
+            "v8/emc-paper-eight.mc",
+            "v8/pm-bunny-res4.mc",
+            "v8/pm-reordered-eight.mc",
+            "v8/came-eight.mc",
+            "v8/came-paper-eight.mc",
+            "v8/emc-spot-appearance.mc",
+            "v8/pm-reordered-spot-appearance-fit.mc",
         ] {
             let bytes = golden(name);
             let info = StreamInfo::of(&bytes).unwrap();
@@ -197,11 +206,14 @@ mod tests {
             assert_eq!(info.stream_bytes, info.bytes, "{name}");
             assert!(!info.truncated && info.units.iter().all(|u| u.present));
             let mut end = info.payload_start;
-            for unit in info
-                .units
-                .iter()
-                .chain(info.appearance.iter().flat_map(|a| &a.unit))
-            {
+            let parts = info.appearance.iter().flat_map(|a| &a.level_parts);
+            let mut in_stream_order: Vec<&UnitInfo> = Vec::new();
+            for (i, level) in info.units.iter().enumerate() {
+                in_stream_order.push(level);
+                in_stream_order.extend(parts.clone().nth(i));
+            }
+            in_stream_order.extend(info.appearance.iter().flat_map(|a| &a.unit));
+            for unit in in_stream_order {
                 assert_eq!(unit.first_byte, end, "{name}: unit {}", unit.unit);
                 assert_eq!(unit.end_byte - unit.first_byte, unit.bytes);
                 end = unit.end_byte;
@@ -227,7 +239,7 @@ mod tests {
     /// `info`; the WebAssembly package's in camelCase), flattened facts included.
     #[test]
     fn the_serde_form_has_the_documented_keys() {
-        let info = StreamInfo::of(&golden("v7/pm-bunny-res4.mc")).unwrap();
+        let info = StreamInfo::of(&golden("v8/pm-bunny-res4.mc")).unwrap();
         let value = serde_json::to_value(&info).unwrap();
         let keys: Vec<&str> = value
             .as_object()

@@ -659,12 +659,12 @@ mod tests {
     /// (docs/CONTRACT.md §7), in one line.
     #[test]
     fn streams_of_an_unknown_codec_or_syntax_are_unsupported_in_one_line() {
-        let mut bytes = golden("v7/raw-eight.mc");
+        let mut bytes = golden("v8/raw-eight.mc");
         bytes[5] = 200;
         let e = decode(&bytes, Stop::All).map(|_| ()).unwrap_err();
         assert!(matches!(e, Error::Unsupported(_)), "{e}");
         assert!(e.to_string().contains("unknown codec id 200"), "{e}");
-        let mut bytes = golden("v7/emc-eight.mc");
+        let mut bytes = golden("v8/emc-eight.mc");
         bytes[6] = 2;
         let e = decode(&bytes, Stop::All).map(|_| ()).unwrap_err();
         assert!(matches!(e, Error::Unsupported(_)), "{e}");

@@ -1,9 +1,9 @@
 //! Decoding a stream as its bytes arrive (a download, a socket, a browser's `fetch`): each
 //! chunk is taken as it comes, and the newest level it completes is handed over. A decoder
 //! that can take more bytes ([`LevelDecoder::extend`]: `raw`, `emc`, `emc-paper`) goes on from
-//! the level it stopped at, so the whole stream is decoded once; the others (`pm`, the CAME
-//! codecs, streams with an appearance unit) are opened again on the longer prefix for each
-//! level handed over.
+//! the level it stopped at, so the whole stream is decoded once (with the appearance parts of
+//! `emc` and `emc-ahead`); the others (`pm`, the CAME codecs, streams with an appearance unit)
+//! are opened again on the longer prefix for each level handed over.
 
 use super::{decode_with, level_ends, on_pool, open_owned, LevelDecoder, LevelMesh, Stop};
 use crate::container::Header;
@@ -110,12 +110,12 @@ mod tests {
     #[test]
     fn levels_fed_in_chunks_are_the_levels_of_the_prefix() {
         for (name, incremental) in [
-            ("v7/emc-eight.mc", true),
-            ("v7/emc-paper-beethoven.mc", true),
-            ("v7/raw-eight.mc", true),
-            ("v7/pm-eight.mc", false),
-            ("v7/came-eight.mc", false),
-            ("v7/emc-spot-appearance.mc", false),
+            ("v8/emc-eight.mc", true),
+            ("v8/emc-paper-beethoven.mc", true),
+            ("v8/raw-eight.mc", true),
+            ("v8/pm-eight.mc", false),
+            ("v8/came-eight.mc", false),
+            ("v8/emc-spot-appearance.mc", true),
         ] {
             let bytes = golden(name);
             for chunk in [1, 7, 100, 4096] {
@@ -151,15 +151,15 @@ mod tests {
     /// `decode` ends on it whole: in the same error, or the same mesh.
     #[test]
     fn bytes_past_the_end_are_an_error_and_corrupt_streams_end_as_decode_ends() {
-        let bytes = golden("v7/emc-eight.mc");
+        let bytes = golden("v8/emc-eight.mc");
         let mut progressive = Progressive::new();
         progressive.push(&bytes).unwrap();
         let e = progressive.push(&[0]).unwrap_err().to_string();
         assert!(e.contains("after the last unit"), "{e}");
         for (name, at) in [
-            ("v7/emc-eight.mc", 0.9),
-            ("v7/emc-beethoven.mc", 0.5),
-            ("v7/emc-beethoven.mc", 0.1),
+            ("v8/emc-eight.mc", 0.9),
+            ("v8/emc-beethoven.mc", 0.5),
+            ("v8/emc-beethoven.mc", 0.1),
         ] {
             let mut corrupt = golden(name);
             let k = (corrupt.len() as f64 * at) as usize;

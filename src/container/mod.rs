@@ -32,7 +32,7 @@ pub const MAGIC: [u8; 4] = *b"MshC";
 /// appearance (the appearance flags say which), and it is the only version this build reads:
 /// version 7 gives each unit's length and children count where version 6 gave its offset,
 /// length and parent (a version 6 stream re-encodes to the same payload).
-pub const FORMAT_VERSION: u8 = 7;
+pub const FORMAT_VERSION: u8 = 8;
 /// The fewest bytes an index entry takes (two one-byte varints).
 const MIN_ENTRY_BYTES: u64 = 2;
 /// The most bytes an index entry takes: a length below 2^62 (nine varint bytes) and a

@@ -86,7 +86,7 @@ test("a close view reads a part of the stream, not all of it", async () => {
 });
 
 test("the golden came and came-paper streams refine as natively", async () => {
-  for (const file of ["v7/came-beethoven.mc", "v7/came-paper-beethoven.mc", "v7/came-eight.mc"]) {
+  for (const file of ["v8/came-beethoven.mc", "v8/came-paper-beethoven.mc", "v8/came-eight.mc"]) {
     const path = join(root, "tests/golden", file);
     const bytes = new Uint8Array(readFileSync(path));
     const stream = await CameStream.open(bytesReader(bytes), { firstRequest: 64 });
@@ -102,7 +102,7 @@ test("the golden came and came-paper streams refine as natively", async () => {
 
 test("bad input ends in Errors with the library's message, never a trap", async () => {
   const bytes = new Uint8Array(readFileSync(bunny));
-  const emc = new Uint8Array(readFileSync(join(root, "tests/golden/v7/emc-eight.mc")));
+  const emc = new Uint8Array(readFileSync(join(root, "tests/golden/v8/emc-eight.mc")));
   await assert.rejects(CameStream.open(bytesReader(emc)), /emc streams hold no vertex hierarchy/);
   await assert.rejects(CameStream.open(bytesReader(bytes.subarray(0, 20))), /ends after 20 bytes|truncated/);
   const corrupt = bytes.slice();

@@ -159,7 +159,7 @@ test("the viewer draws the outline the project's rasterizer draws from the same 
 });
 
 test("a stream with appearance is drawn with its uvs through the checker, a vertex a wedge", async () => {
-  const { page, problems } = await openViewer("../../tests/golden/v7/emc-spot-appearance.mc");
+  const { page, problems } = await openViewer("../../tests/golden/v8/emc-spot-appearance.mc");
   const state = await page.evaluate(() => window.viewer.state);
   assert.equal(state.status, "done", state.error ?? "");
   assert.ok(state.appearance.includes("uvs"), `appearance: ${state.appearance}`);
