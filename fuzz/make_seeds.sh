@@ -193,6 +193,22 @@ for mesh in $seeds/read_obj/torus.obj $seeds/read_obj/torus-fin.obj; do
   target/release/examples/emc_slabs "$mesh" --write "$stream" 3 2 2
   tail -c +8 "$stream" > "$seeds/decode_emc_ahead/$name-slabs.body"
 done
+# Streams whose levels carry their appearance in parts (emc, emc-ahead; docs/FORMAT.md §10),
+# with the magic and version cut off: decode_level_parts's input. spot at 6 bits has levels that
+# code their representatives, sketch them and settle.
+mkdir -p $seeds/decode_level_parts
+for codec in emc emc-ahead; do
+  for mesh in $seeds/read_obj/torus.obj $seeds/read_gltf/torus.glb $seeds/read_ply/torus-colours.ply; do
+    name=$(basename "$mesh"); name=${name%.*}-${mesh##*.}
+    target/release/meshcodec encode --codec "$codec" --quant 10 --uv-bits 8 --normal-bits 6 "$mesh" "$stream" >/dev/null 2>&1
+    tail -c +6 "$stream" > "$seeds/decode_level_parts/$codec-$name.body"
+  done
+  if [ -f ../shared/meshes/spot.obj ]; then
+    target/release/meshcodec encode --codec "$codec" --quant 6 --uv-bits 6 ../shared/meshes/spot.obj "$stream" >/dev/null 2>&1
+    tail -c +6 "$stream" > "$seeds/decode_level_parts/$codec-spot-q6.body"
+  fi
+done
+
 # Streams with appearance (every codec that carries it, on the seeds with uvs, normals,
 # materials or colours), with the magic and version cut off: decode_appearance's input.
 mkdir -p $seeds/decode_appearance

@@ -21,7 +21,7 @@ fn replay(target: &str, bytes: &[u8]) {
         }
         "adapt_came" => exercise::adapt_came(bytes),
         "decode_appearance" => exercise::decode_with_appearance(bytes),
-        "decode_pm_wedges" => exercise::decode_with_appearance(bytes),
+        "decode_pm_wedges" | "decode_level_parts" => exercise::decode_with_appearance(bytes),
         "roundtrip" => {
             if let Ok(input) =
                 exercise::GeneratedMesh::arbitrary_take_rest(Unstructured::new(bytes))

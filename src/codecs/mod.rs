@@ -240,9 +240,10 @@ pub trait LevelDecoder: Send {
     fn extend(&mut self, _more: &[u8]) -> Result<bool> {
         Ok(false)
     }
-    /// Per vertex of the current level, the vertex of the full mesh it stands for, named by
-    /// that vertex's id at the full level's... (see [`appearance::levels`]); `None` when every
-    /// vertex stands for the one that keeps its id.
+    /// Per vertex of the current level, the **representative** it stands for: a name, unique,
+    /// of a vertex of the full mesh, which keeps it to the full level (docs/FORMAT.md §10,
+    /// [`appearance::levels`]); `None` when every vertex stands for the vertex of the full mesh
+    /// with its id.
     fn representatives(&self) -> Option<Vec<u32>> {
         None
     }

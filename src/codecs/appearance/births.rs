@@ -352,7 +352,7 @@ impl Births {
                         .iter()
                         .map(|(_, t)| (*t - t0).abs().max_element())
                         .fold(0.0f64, f64::max);
-                    let scale = (spread.max(1.0).log2().round() as usize).min(UV_SCALES - 1);
+                    let scale = rounded_log2(spread as u64).min(UV_SCALES - 1);
                     if chart.len() < 2 {
                         UvPrediction {
                             basis: 1,
@@ -794,6 +794,17 @@ impl Neighbours {
         &self.face_list
             [self.face_start[v as usize] as usize..self.face_start[v as usize + 1] as usize]
     }
+}
+
+/// log2(`s`) rounded to the nearest integer (0 for 0 and 1), in integers, so that every
+/// platform buckets alike.
+fn rounded_log2(s: u64) -> usize {
+    if s <= 1 {
+        return 0;
+    }
+    let k = 63 - s.leading_zeros();
+    // log2(s) ≥ k + ½ exactly when s² ≥ 2^(2k + 1).
+    k as usize + ((s as u128) * (s as u128) >= 1u128 << (2 * k + 1)) as usize
 }
 
 /// `value` when it lies in 0..`limit`; a malformed stream otherwise.

@@ -24,6 +24,9 @@ struct LevelSize {
     level: usize,
     end_byte: Option<u64>,
     payload_bytes: Option<u64>,
+    /// Bytes of the level's appearance part, in streams whose levels have one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    appearance_bytes: Option<u64>,
     vertices: usize,
     triangles: usize,
     loose_edges: usize,
@@ -42,10 +45,15 @@ pub fn info(input: &Path, json: bool) -> Result<()> {
         } = decoder.mesh()?;
         let level = decoder.levels_decoded();
         let unit = info.layered.then(|| &info.units[level - 1]);
+        let part = info
+            .appearance
+            .as_ref()
+            .and_then(|a| a.level_parts.get(level - 1));
         level_sizes.push(LevelSize {
             level,
-            end_byte: unit.map(|u| u.end_byte),
+            end_byte: unit.map(|_| info.level_ends[level - 1]),
             payload_bytes: unit.map(|u| u.bytes),
+            appearance_bytes: part.map(|p| p.bytes),
             vertices: mesh.vertex_count(),
             triangles: mesh.face_count(),
             loose_edges: loose_edges.len(),
@@ -144,26 +152,40 @@ pub fn info(input: &Path, json: bool) -> Result<()> {
                 if u.present { "" } else { ", not present" }
             ),
             None if a.in_levels => "; in every level".to_string(),
+            None if !a.level_parts.is_empty() => {
+                "; a part after each level (appearance column)".to_string()
+            }
             None => String::new(),
         };
         let _ = writeln!(text, "appearance: {}{where_}", carried.join(", "));
     }
+    let parts = level_sizes.iter().any(|l| l.appearance_bytes.is_some());
     let _ = writeln!(
         text,
-        "{:>5} {:>10} {:>10} {:>10} {:>10}",
-        "level", "end byte", "bytes", "vertices", "triangles"
+        "{:>5} {:>10} {:>10} {:>10} {:>10}{}",
+        "level",
+        "end byte",
+        "bytes",
+        "vertices",
+        "triangles",
+        if parts { "  appearance" } else { "" }
     );
     // A table cell: a number, or a dash where there is none.
     let cell = |value: Option<u64>| value.map_or("—".to_string(), |v| v.to_string());
     for l in &level_sizes {
         let _ = writeln!(
             text,
-            "{:>5} {:>10} {:>10} {:>10} {:>10}",
+            "{:>5} {:>10} {:>10} {:>10} {:>10}{}",
             l.level,
             cell(l.end_byte),
             cell(l.payload_bytes),
             l.vertices,
-            l.triangles
+            l.triangles,
+            if parts {
+                format!(" {:>11}", cell(l.appearance_bytes))
+            } else {
+                String::new()
+            }
         );
     }
     if !info.layered {

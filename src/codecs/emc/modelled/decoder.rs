@@ -354,6 +354,12 @@ impl LevelDecoder for EmcDecoder<'_> {
     fn pass_stops(&mut self) -> Option<&mut dyn PassStops> {
         Some(self)
     }
+
+    /// `emc-ahead`'s vertices stand for the representatives their cells went ahead with, which
+    /// a split may hand to its new vertex; `emc`'s for the vertex that keeps their id.
+    fn representatives(&self) -> Option<Vec<u32>> {
+        (self.params.ahead_levels > 0).then(|| self.walker.representative.clone())
+    }
 }
 
 impl EmcDecoder<'_> {

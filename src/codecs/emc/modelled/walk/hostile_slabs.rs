@@ -21,6 +21,7 @@ fn the_ownership_check_is_on_in_the_crates_tests() {
         centres: std::ptr::null_mut(),
         marks: std::ptr::null(),
         agree: std::ptr::null_mut(),
+        representative: std::ptr::null_mut(),
         len: 1,
     };
     check(&lanes, 0, || false);

@@ -38,6 +38,7 @@ pub(super) struct Lanes {
     pub(super) centres: *mut [i32; 3],
     pub(super) marks: *const AtomicU64,
     pub(super) agree: *mut u32,
+    pub(super) representative: *mut u32,
     pub(super) len: usize,
 }
 
@@ -594,6 +595,7 @@ impl Run<'_> {
                 let depth = *depth;
                 *lane_mut!(self, depth, r) = depth;
                 *lane_mut!(self, agree, r) = 0;
+                *lane_mut!(self, representative, r) = r as u32;
             }
             Some(at) => {
                 // The half the cell went ahead into keeps it; the other starts at the split.
@@ -611,6 +613,11 @@ impl Run<'_> {
                 *lane_mut!(self, cells, starts) = fresh;
                 *lane_mut!(self, depth, starts) = at.steps as u16 + 1;
                 *lane_mut!(self, agree, starts) = 0;
+                // The representative went with the cell; the half that starts afresh stands
+                // for a new one, named by the new vertex.
+                let kept = *lane!(self, representative, v);
+                *lane_mut!(self, representative, keeps) = kept;
+                *lane_mut!(self, representative, starts) = r as u32;
             }
         }
         *lane_mut!(self, next_split, v) = NO_SPLIT;

@@ -181,6 +181,11 @@ pub struct Walker {
     /// Per vertex, for the steps its cell took ahead of its splits: bit j is set if the step
     /// `depth - 1 - j` took the predicted half (a split may wait there).
     agree: Vec<u32>,
+    /// Per vertex, the representative it stands for (docs/FORMAT.md §10), named by the vertex
+    /// a split created when it gave the representative a vertex of its own: a split's new
+    /// vertex, unless the representative went ahead into the new vertex's half
+    /// (`emc-ahead`), which then takes the old one's and leaves it the new name.
+    pub(super) representative: Vec<u32>,
     /// Levels each level's lookahead pass takes every vertex's cell ahead of the octree
     /// (0: none).
     pub ahead_levels: usize,
@@ -243,6 +248,7 @@ impl Walker {
             marks: vec![AtomicU64::new(0)],
             split_serial: 0,
             agree: vec![0],
+            representative: vec![0],
             ahead_levels: 0,
         };
         walker.centres.push(cell_centre([0; 3], walker.shifts[0]));
@@ -456,6 +462,7 @@ impl Walker {
         self.centres.resize(n, [0; 3]);
         self.marks.resize_with(n, AtomicU64::default);
         self.agree.resize(n, 0);
+        self.representative.resize(n, 0);
     }
 
     /// Drops the entries from `n` on (room [`Self::grow`] made that no split took).
@@ -468,6 +475,7 @@ impl Walker {
         self.centres.truncate(n);
         self.marks.truncate(n);
         self.agree.truncate(n);
+        self.representative.truncate(n);
     }
 
     /// The arrays a pass reads and writes, for [`Run`]s. Nothing else may touch them while
@@ -482,6 +490,7 @@ impl Walker {
             centres: self.centres.as_mut_ptr(),
             marks: self.marks.as_ptr(),
             agree: self.agree.as_mut_ptr(),
+            representative: self.representative.as_mut_ptr(),
             len: self.state.len(),
         }
     }
