@@ -33,8 +33,12 @@ pub struct RunOptions {
     /// (`None`: positions and triangles only, whatever the file holds).
     pub appearance: Option<AttributeBits>,
     /// With appearance, code it inside the levels by this rule for collapsed wedges, for codecs
-    /// that can (`pm`; `None`: an appearance unit after the last level).
+    /// that can (`pm`; `None`: the codec's own way).
     pub appearance_in_levels: Option<codecs::AttributeFit>,
+    /// With appearance, code it in an appearance unit after the last level whatever the
+    /// codec's own way (`emc`, `emc-ahead` code it with their levels): results as
+    /// STEM-appearance-unit.
+    pub appearance_unit: bool,
 }
 
 /// The encode options a run uses.
@@ -107,6 +111,7 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
         options: encode,
         appearance: options.appearance.filter(|_| carries),
         in_levels: options.appearance_in_levels,
+        appearance_unit: options.appearance_unit,
     };
     let progress = Progress::new(options.progress);
     let label = format!("{} {}", codec.name(), mesh_name(path));
@@ -234,7 +239,10 @@ pub fn run(codec: &dyn Codec, path: &Path, options: &RunOptions) -> Result<RunOu
                 .map(|b| b * 8.0)
                 .or_else(|| codec_stats.get_named("appearance_bits"))
                 .map_or(0, |b| b.round() as u64),
-            in_levels: options.appearance_in_levels.map(|f| f.name().to_string()),
+            in_levels: options
+                .appearance_in_levels
+                .map(|f| f.name().to_string())
+                .or_else(|| options.appearance_unit.then(|| "unit".to_string())),
             derived_normals: a.bits.derive_normals && a.normals.is_some(),
         }),
         codec_stats,

@@ -109,8 +109,11 @@ pub struct AppearanceRun {
     pub fields: Vec<String>,
     /// Bits of the appearance: its unit's, or what the levels spent on it.
     pub bits: u64,
-    /// The rule for collapsed wedges (`fit`, `keep`) when the levels carry the appearance
-    /// (`pm --attributes`); absent when an appearance unit follows the last level.
+    /// Where the appearance went when not the codec's own way: the rule for collapsed wedges
+    /// (`fit`, `keep`) when `pm`'s splits carry it (`--attributes fit|keep`), `unit` when an
+    /// appearance unit follows the last level of a codec whose own way is another
+    /// (`--attributes unit`); absent for the codec's own way (`pm`, `came`, `raw`: a unit after
+    /// the last level; `emc`, `emc-ahead`: a part after each level).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub in_levels: Option<String>,
     /// Whether normals were derived from the positions over the input's normal wedges

@@ -238,9 +238,11 @@ def encode(
             "came", "came-paper", "raw").
         quant_bits: bits per axis of the quantization grid (1 to 24 as the codec allows).
         grid: "cubic" (one cell size on every axis, the default) or "per-axis".
-        appearance: an :class:`Appearance` over these faces (e.g. ``load(path).appearance``),
-            coded in the stream's appearance unit and decoded with its full level; every
-            lossless codec carries it, ``came-paper`` refuses it.
+        appearance: an :class:`Appearance` over these faces (e.g. ``load(path).appearance``);
+            every lossless codec carries it, ``came-paper`` refuses it. ``emc`` and
+            ``emc-ahead`` code it with their levels, so that every level shows it
+            (``info(stream)["appearance"]["level_parts"]``); the other codecs in an appearance
+            unit decoded with the full level.
         uv_bits: bits per uv axis over the uvs' bounding box (default 12).
         normal_bits: bits per octahedral normal coordinate (default 10).
         derive_normals: True derives the normals from the positions over the appearance's
@@ -249,7 +251,8 @@ def encode(
         attributes: ``pm`` and ``pm-reordered`` only: "fit" or "keep" codes the appearance
             inside the vertex splits, so that every level carries it (a collapsed wedge takes
             the values interpolated to where its vertex went, or the survivor's); ``info``
-            then says ``appearance["in_levels"]``.
+            then says ``appearance["in_levels"]``. Any codec that carries appearance: "unit"
+            codes it in an appearance unit after the last level whatever the codec's own way.
 
     Raises:
         MeshcodecError: bad arrays, an unknown codec or option, or appearance the codec

@@ -339,7 +339,9 @@ fn encode<'py>(
     derive_normals: bool,
 ) -> PyResult<Bound<'py, PyBytes>> {
     let codec = codec(codec_name)?;
+    let appearance_unit = attributes == Some("unit");
     let in_levels = attributes
+        .filter(|_| !appearance_unit)
         .map(codecs::AttributeFit::by_name)
         .transpose()
         .map_err(to_py)?;
@@ -363,6 +365,7 @@ fn encode<'py>(
         options,
         appearance: attributes.is_some().then_some(bits),
         in_levels,
+        appearance_unit,
     };
     let mesh = AttributedMesh {
         mesh,

@@ -440,6 +440,12 @@ pub fn encode_with_appearance_unit(
     canonical: &CanonicalMesh,
     appearance: &CanonicalAttributes,
 ) -> Result<Encoded> {
+    if !codec.capabilities().contains(&Capability::Attributes) {
+        return Err(Error::Unsupported(format!(
+            "{} cannot carry normals, uvs, colours or materials (its full level is lossy)",
+            codec.name()
+        )));
+    }
     let mut encoded = codec.encode(canonical)?;
     let (full, _) = decode(&encoded.bytes, Stop::All)?;
     let (unit, fields) = appearance::encode(&full.mesh, canonical, appearance)?;

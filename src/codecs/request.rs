@@ -27,6 +27,10 @@ pub struct EncodeRequest<'c> {
     /// [`Capability::AppearanceInLevels`](super::Capability::AppearanceInLevels); `None`: in an
     /// appearance unit after the last level.
     pub in_levels: Option<AttributeFit>,
+    /// The appearance in an appearance unit after the last level (docs/FORMAT.md §9) even for
+    /// a codec whose own way is another (`emc`, `emc-ahead`: a part after each level): to
+    /// measure what that way costs.
+    pub appearance_unit: bool,
 }
 
 /// What a stream was made of: the canonical mesh, the canonical appearance it carries, the
@@ -48,6 +52,7 @@ impl EncodeRequest<'_> {
             options: codec.default_options(),
             appearance: None,
             in_levels: None,
+            appearance_unit: false,
         }
     }
 
@@ -77,7 +82,12 @@ impl EncodeRequest<'_> {
         canonical: &CanonicalMesh,
         appearance: Option<&CanonicalAttributes>,
     ) -> Result<Encoded> {
-        encode_attributed_with(self.codec, canonical, appearance, self.in_levels)
+        match appearance.filter(|a| !a.is_empty()) {
+            Some(appearance) if self.appearance_unit && self.in_levels.is_none() => {
+                super::encode_with_appearance_unit(self.codec, canonical, appearance)
+            }
+            _ => encode_attributed_with(self.codec, canonical, appearance, self.in_levels),
+        }
     }
 
     /// Quantizes `mesh` and its appearance and encodes them; `mesh` is taken so that a large

@@ -1,9 +1,11 @@
 //! Meshes made from a few numbers, for tests, benchmarks and examples: an icosphere, a torus, a
-//! terrain (Delaunay triangulation of seeded random points under a height function), and a
-//! "messy" mesh with every defect a codec must survive.
+//! terrain (Delaunay triangulation of seeded random points under a height function), a
+//! "messy" mesh with every defect a codec must survive, and a rounded cube of textured quads
+//! whose six faces are six charts of a texture atlas.
 
+use super::attributes::{AttributedMesh, Attributes};
 use super::{TriMesh, VertexId};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
@@ -116,6 +118,65 @@ pub fn torus(major: f64, minor: f64, u: u32, v: u32) -> TriMesh {
         }
     }
     TriMesh::new(positions, faces)
+}
+
+/// A cube of `n` × `n` quads a side (each split into two triangles), bulged towards a sphere,
+/// textured as a texture atlas of three by two squares, one a side: the cube's twelve edges are
+/// uv seams (two wedges at each of their vertices, three at the corners), and each side's uvs
+/// follow its quads. Closed, genus 0, 6n² + 2 vertices.
+pub fn textured_cube(n: u32) -> AttributedMesh {
+    let mut positions: Vec<DVec3> = Vec::new();
+    let mut at: HashMap<[i64; 3], VertexId> = HashMap::new();
+    let mut faces = Vec::new();
+    let mut uvs = Vec::new();
+    // (normal axis, sign): the six sides, and each side's two in-plane axes.
+    for side in 0..6u32 {
+        let (axis, sign) = ((side / 2) as usize, if side % 2 == 0 { 1 } else { -1 });
+        let (u_axis, v_axis) = ((axis + 1) % 3, (axis + 2) % 3);
+        let grid_point = |i: u32, j: u32| {
+            let mut p = [0i64; 3];
+            p[axis] = sign * n as i64;
+            // Mirrored on the negative sides, so that every side's faces turn outwards.
+            p[u_axis] = (2 * i as i64 - n as i64) * sign;
+            p[v_axis] = 2 * j as i64 - n as i64;
+            p
+        };
+        let atlas = DVec2::new((side % 3) as f64, (side / 3) as f64);
+        let mut vertex = |i: u32, j: u32| -> (VertexId, DVec2) {
+            let key = grid_point(i, j);
+            let id = *at.entry(key).or_insert_with(|| {
+                let q = DVec3::new(key[0] as f64, key[1] as f64, key[2] as f64) / n as f64;
+                // Halfway between the cube and the sphere.
+                positions.push((q + q.normalize() * 3f64.sqrt()) * 0.5);
+                (positions.len() - 1) as VertexId
+            });
+            let uv = (atlas + DVec2::new(i as f64, j as f64) / n as f64 * 0.9 + 0.05)
+                / DVec2::new(3.0, 2.0);
+            (id, uv)
+        };
+        for i in 0..n {
+            for j in 0..n {
+                let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(a, b)| vertex(a, b));
+                for tri in [[0, 1, 2], [0, 2, 3]] {
+                    faces.push(tri.map(|k| corners[k].0));
+                    uvs.push(tri.map(|k| corners[k].1));
+                }
+            }
+        }
+    }
+    let corners = (0..faces.len() as u32)
+        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+        .collect();
+    let wedge_vertex = faces.iter().flatten().copied().collect();
+    AttributedMesh {
+        mesh: TriMesh::new(positions, faces),
+        attributes: Attributes {
+            corners,
+            wedge_vertex,
+            uvs: Some(uvs.into_iter().flatten().collect()),
+            ..Attributes::default()
+        },
+    }
 }
 
 /// A terrain over the unit square: the Delaunay triangulation of `points` seeded random points
@@ -254,6 +315,33 @@ mod tests {
             torus.positions.len() as i64 * 2 - torus.faces.len() as i64,
             0
         );
+    }
+
+    #[test]
+    fn the_textured_cube_is_closed_with_seams_along_its_edges() {
+        let cube = textured_cube(4);
+        let mesh = &cube.mesh;
+        mesh.validate().unwrap();
+        cube.attributes.validate(mesh).unwrap();
+        let t = analyze(mesh);
+        assert!(t.boundary_edges == 0 && t.is_manifold() && t.components == 1);
+        assert_eq!(mesh.positions.len(), 6 * 16 + 2);
+        // Every face turns away from the centre.
+        for f in &mesh.faces {
+            let [a, b, c] = mesh.corners(*f);
+            assert!((b - a).cross(c - a).dot(a + b + c) > 0.0);
+        }
+        // Wedges: a vertex on an edge of the cube has two uvs, a corner three.
+        let uvs = cube.attributes.uvs.as_ref().unwrap();
+        let mut distinct: Vec<Vec<[u64; 2]>> = vec![Vec::new(); mesh.positions.len()];
+        for (w, &v) in cube.attributes.wedge_vertex.iter().enumerate() {
+            let key = [uvs[w].x.to_bits(), uvs[w].y.to_bits()];
+            if !distinct[v as usize].contains(&key) {
+                distinct[v as usize].push(key);
+            }
+        }
+        let count = |k: usize| distinct.iter().filter(|d| d.len() == k).count();
+        assert_eq!((count(1), count(2), count(3)), (6 * 9, 12 * 3, 8));
     }
 
     #[test]

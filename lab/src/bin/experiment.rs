@@ -67,8 +67,10 @@ struct Settings {
     derive_normals: bool,
     /// With --appearance, code it inside the levels (pm only: every level carries it), giving
     /// a collapsed wedge the values interpolated to where the vertex went (`fit`) or the
-    /// survivor's (`keep`); results as STEM-appearance-RULE.
-    #[arg(long, value_parser = ["fit", "keep"])]
+    /// survivor's (`keep`); or `unit`: in an appearance unit after the last level whatever the
+    /// codec's own way (emc and emc-ahead code it with their levels); results as
+    /// STEM-appearance-RULE.
+    #[arg(long, value_parser = ["fit", "keep", "unit"])]
     attributes: Option<String>,
 }
 
@@ -262,6 +264,7 @@ fn run_options(settings: &Settings, quant: Option<u8>) -> RunOptions {
             .attributes
             .as_deref()
             .and_then(|name| meshcodec::codecs::AttributeFit::by_name(name).ok()),
+        appearance_unit: settings.attributes.as_deref() == Some("unit"),
     }
 }
 
@@ -407,9 +410,9 @@ impl Set {
             derive_normals: settings.derive_normals || set.derive_normals,
             ..settings.clone()
         };
-        for rule in &set.attributes {
+        for rule in set.attributes.iter().filter(|r| *r != "unit") {
             meshcodec::codecs::AttributeFit::by_name(rule)
-                .with_context(|| format!("{}: attributes", file.display()))?;
+                .with_context(|| format!("{}: attributes (fit, keep, unit)", file.display()))?;
         }
         let rules = if set.attributes.is_empty() {
             vec![settings.attributes.clone()]
@@ -476,6 +479,7 @@ fn run_set(file: &Path, shard: Option<Shard>, settings: &Settings) -> Result<()>
         let options = RunOptions {
             appearance_in_levels: rule
                 .and_then(|r| meshcodec::codecs::AttributeFit::by_name(r).ok()),
+            appearance_unit: rule == Some("unit"),
             ..run_options(settings, quant)
         };
         let mesh = mesh_name(path);

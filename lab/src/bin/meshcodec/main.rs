@@ -57,10 +57,13 @@ enum Command {
         /// (Hoppe 1998's Table 4 mode); the other codecs carry the derived normals.
         #[arg(long)]
         derive_normals: bool,
-        /// pm only: code the appearance inside the vertex splits, so that every level carries
-        /// it, a collapsed wedge taking the values interpolated to where its vertex went (`fit`)
-        /// or the survivor's (`keep`). Without it, an appearance unit follows the last level.
-        #[arg(long, value_parser = ["fit", "keep"])]
+        /// Where the appearance goes when not the codec's own way (emc, emc-ahead: a part after
+        /// each level, so that every level shows it; the others: an appearance unit after the
+        /// last level): `fit` or `keep`, pm only, inside the vertex splits, so that every level
+        /// carries it, a collapsed wedge taking the values interpolated to where its vertex went
+        /// or the survivor's; `unit`, any codec that carries appearance, in an appearance unit
+        /// after the last level.
+        #[arg(long, value_parser = ["fit", "keep", "unit"])]
         attributes: Option<String>,
         /// Mesh file or name.
         input: String,
@@ -274,6 +277,7 @@ fn main() -> ExitCode {
                     attributes
                         .as_deref()
                         .and_then(|name| codecs::AttributeFit::by_name(name).ok()),
+                    attributes.as_deref() == Some("unit"),
                 )
             },
             &input,
@@ -453,7 +457,7 @@ fn load_attributed(name: &str) -> Result<(PathBuf, meshcodec::mesh::attributes::
 enum Attributes {
     /// Carries it at these bits (a codec that cannot is refused), inside the levels by this
     /// rule when given (pm).
-    Carry(AttributeBits, Option<codecs::AttributeFit>),
+    Carry(AttributeBits, Option<codecs::AttributeFit>, bool),
     /// Encodes the geometry alone.
     Drop,
 }
@@ -483,11 +487,12 @@ fn encode(
     request.options = options;
     let mut dropped = None;
     let mesh = match attributes {
-        Attributes::Carry(bits, in_levels)
+        Attributes::Carry(bits, in_levels, unit)
             if codec.capabilities().contains(&Capability::Attributes) =>
         {
             request.appearance = Some(bits);
             request.in_levels = in_levels;
+            request.appearance_unit = unit;
             read_attributed(&path).with_context(context)?
         }
         _ => {
