@@ -197,7 +197,7 @@ pub fn levels_csv(result: &RunResult) -> String {
     let appearance = result.appearance.is_some();
     if appearance {
         csv.pop();
-        csv.push_str(",uv_texels,normal_degrees,colour_steps,wrong_material\n");
+        csv.push_str(",uv_texels,uv_rms_texels,normal_degrees,colour_steps,wrong_material\n");
     }
     for r in &result.levels {
         csv.push_str(&format!(
@@ -217,8 +217,9 @@ pub fn levels_csv(result: &RunResult) -> String {
         if appearance {
             let a = &r.appearance;
             csv.push_str(&format!(
-                ",{},{},{},{}",
+                ",{},{},{},{},{}",
                 opt(a.uv_texels),
+                opt(a.uv_rms_texels),
                 opt(a.normal_degrees),
                 opt(a.colour_steps),
                 opt(a.wrong_material)

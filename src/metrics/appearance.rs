@@ -26,6 +26,10 @@ pub struct AppearanceError {
     /// a 1024² texture.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub uv_texels: Option<f64>,
+    /// Root mean square of the same distances (texels of a 1024² texture): weighs a point
+    /// carried across a seam more than many slightly off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub uv_rms_texels: Option<f64>,
     /// Mean angle between the original's and the level's normals, degrees.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub normal_degrees: Option<f64>,
@@ -143,6 +147,7 @@ fn material_of(a: &Attributes, face: u32) -> Option<u32> {
 #[derive(Clone, Copy, Debug, Default)]
 struct Sums {
     uv: (f64, usize),
+    uv_squared: f64,
     normal: (f64, usize),
     colour: (f64, usize),
     material: (f64, usize),
@@ -151,7 +156,9 @@ struct Sums {
 impl Sums {
     fn add(&mut self, original: &Values, level: &Values) {
         if let (Some(a), Some(b)) = (original.uv, level.uv) {
-            self.uv.0 += (a - b).length() * TEXTURE_SIZE;
+            let d = (a - b).length() * TEXTURE_SIZE;
+            self.uv.0 += d;
+            self.uv_squared += d * d;
             self.uv.1 += 1;
         }
         if let (Some(a), Some(b)) = (original.normal, level.normal) {
@@ -175,6 +182,7 @@ impl Sums {
         let add = |x: (f64, usize), y: (f64, usize)| (x.0 + y.0, x.1 + y.1);
         Sums {
             uv: add(a.uv, b.uv),
+            uv_squared: a.uv_squared + b.uv_squared,
             normal: add(a.normal, b.normal),
             colour: add(a.colour, b.colour),
             material: add(a.material, b.material),
@@ -185,6 +193,7 @@ impl Sums {
         let mean = |(sum, n): (f64, usize)| (n > 0).then(|| sum / n as f64);
         AppearanceError {
             uv_texels: mean(self.uv),
+            uv_rms_texels: mean((self.uv_squared, self.uv.1)).map(f64::sqrt),
             normal_degrees: mean(self.normal),
             colour_steps: mean(self.colour),
             wrong_material: mean(self.material),
@@ -261,6 +270,7 @@ mod tests {
         moved.materials.as_mut().unwrap().names.push("n".into());
         let e = reference.compare(&m.mesh, Some(&moved));
         assert!((e.uv_texels.unwrap() - 5.0).abs() < 1e-6, "{e:?}");
+        assert!((e.uv_rms_texels.unwrap() - 5.0).abs() < 1e-6, "{e:?}");
         assert!((e.normal_degrees.unwrap() - 10.0).abs() < 1e-6, "{e:?}");
         let share = e.wrong_material.unwrap();
         assert!(share > 0.0 && share < 0.05, "{e:?}");

@@ -18,10 +18,14 @@ pub const ATTRIBUTE_MESHES: [(&str, &str); 4] = [
 ];
 
 /// Our codecs in the table, the stem suffix of their 12-bit results (`pm`'s default is 16 bits,
-/// so its stem names the quantization), and the rule of appearance inside the levels, if any
-/// (`experiments/attributes-in-splits.toml`; otherwise the appearance unit).
-const OURS: [(&str, &str, Option<&str>); 9] = [
+/// so its stem names the quantization), and where the appearance goes when not the codec's own
+/// way: `fit`/`keep` inside `pm`'s splits (`experiments/attributes-in-splits.toml`), `unit` in an
+/// appearance unit (`experiments/attributes-unit.toml`).
+const OURS: [(&str, &str, Option<&str>); 12] = [
     ("emc", "", None),
+    ("emc", "", Some("unit")),
+    ("emc-ahead", "", None),
+    ("emc-ahead", "", Some("unit")),
     ("pm", "-q12", None),
     ("pm", "-q12", Some("fit")),
     ("pm", "-q12", Some("keep")),
@@ -33,13 +37,13 @@ const OURS: [(&str, &str, Option<&str>); 9] = [
 ];
 
 /// Draco's figures that its result file keeps beyond the common schema.
-struct DracoExtras {
+pub(super) struct DracoExtras {
     geometry_bytes: f64,
     split_vertices: f64,
 }
 
 /// Draco's result file, read once: the common schema and the extras beside it.
-fn read_draco(path: &Path) -> Result<(RunResult, DracoExtras)> {
+pub(super) fn read_draco(path: &Path) -> Result<(RunResult, DracoExtras)> {
     let text = std::fs::read_to_string(path).map_err(|e| missing(path, e))?;
     let value: serde_json::Value = serde_json::from_str(&text).map_err(|e| missing(path, e))?;
     let get = |key: &str| {
@@ -90,7 +94,7 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
     let mut md = String::new();
     let _ = writeln!(md, "# Appearance: whole meshes against Draco\n");
     let _ = writeln!(md, "Regenerate: `{ATTRIBUTES_COMMAND}` (our codecs with `--appearance`, then Draco through DracoPy in the same run, then this table).\n");
-    let _ = writeln!(md, "Positions at 12 bits (docs/CONTRACT.md §1), uvs at Qt = 12 bits over their bounding box, normals octahedral at Qn = 10 bits a coordinate, colours 8 bits a channel (§2.1), for us and for Draco (DracoPy, compression_level 10, quantization_bits 12, tex_coord_quantization_bits 12, normal_quantization_bits 10; colours as 8-bit channels). Bits per vertex are over the canonical mesh's vertex count. Our streams are progressive and their full decode is checked lossless, appearance included (§3); the appearance unit follows the last level, except in the rows *in the splits*, where `pm`'s vertex splits carry the appearance so that every level has it (docs/FORMAT.md §6.3; `fit` gives a collapsed wedge the values interpolated to where the vertex went, `keep` the survivor's) and the simplifier keeps seams, which costs geometry bits too. Draco is single-rate, fed the mesh with its vertices split at every seam (one vertex per wedge, as Draco needs; written by `meshcodec convert` as glTF), and its decode is not checked for losslessness. Draco's geometry column is a second file of the welded geometry alone; its appearance column is the difference. Appearance error (§5.1) is the mean over sample points of the original surface: uv distance in texels of a 1024² texture, normal angle, colour steps; it is the cost of quantization, since both full decodes keep every wedge. Draco carries no material ids here (DracoPy has no per-face attribute).\n");
+    let _ = writeln!(md, "Positions at 12 bits (docs/CONTRACT.md §1), uvs at Qt = 12 bits over their bounding box, normals octahedral at Qn = 10 bits a coordinate, colours 8 bits a channel (§2.1), for us and for Draco (DracoPy, compression_level 10, quantization_bits 12, tex_coord_quantization_bits 12, normal_quantization_bits 10; colours as 8-bit channels). Bits per vertex are over the canonical mesh's vertex count. Our streams are progressive and their full decode is checked lossless, appearance included (§3). Where the appearance goes: *with the levels* (`emc`, `emc-ahead`; docs/FORMAT.md §10), a part after each level, so that every level shows it — its first levels coding the vertices they stand for, the later ones which chart each lies in, the level whose faces are the full mesh's the whole appearance; *appearance unit*, one unit after the last level, so that no level before it has any (the same geometry: the difference is what showing it at every level costs); *in the splits* (`pm`'s vertex splits, §6.3; `fit` gives a collapsed wedge the values interpolated to where the vertex went, `keep` the survivor's), every level has it and the simplifier keeps seams, which costs geometry bits too; `came` and `raw` carry it in a unit. Each level's appearance error: [appearance-levels.md](appearance-levels.md). Draco is single-rate, fed the mesh with its vertices split at every seam (one vertex per wedge, as Draco needs; written by `meshcodec convert` as glTF), and its decode is not checked for losslessness. Draco's geometry column is a second file of the welded geometry alone; its appearance column is the difference. Appearance error (§5.1) is the mean over sample points of the original surface: uv distance in texels of a 1024² texture, normal angle, colour steps; it is the cost of quantization, since both full decodes keep every wedge. Draco carries no material ids here (DracoPy has no per-face attribute).\n");
     for (mesh, what) in ATTRIBUTE_MESHES {
         let draco_path = results::path(
             results_dir,
@@ -112,7 +116,9 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             let stem = format!("{mesh}{suffix}{APPEARANCE_SUFFIX}{rule_suffix}");
             let path = results::path(results_dir, codec, &stem, ".json");
             let label = match rule {
+                Some("unit") => format!("`{codec}`, appearance unit"),
                 Some(rule) => format!("`{codec}`, in the splits, {rule}"),
+                None if codec.starts_with("emc") => format!("`{codec}`, with the levels"),
                 None => format!("`{codec}`"),
             };
             let Ok(r) = read_result(&path) else {
@@ -220,8 +226,8 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
     }
     let _ = writeln!(md, "## Pictures\n");
     let _ = writeln!(md, "![bunny-10k-textured and spot with a checker through the file's uvs and through emc's full decode](attributes-checker.png)\n");
-    let _ = writeln!(md, "Intermediate levels of `pm-reordered` with appearance in its splits, each level textured through its own uvs; rows: bunny-10k-textured `fit`, `keep`, spot `fit`, `keep`. `keep` stretches the checker where a collapsed vertex's uv stays put while its position moves:\n");
-    let _ = writeln!(md, "![intermediate levels of pm-reordered in the splits, fit and keep, with a checker](attributes-levels.png)");
+    let _ = writeln!(md, "Intermediate levels, each textured with a checker through its own uvs; rows for bunny-10k-textured, then spot: `pm-reordered` in the splits, `fit` and `keep`, at 12%, 25% and 50% of the vertices, then `emc` and `emc-ahead` with their levels, each panel the level whose bits are nearest the `fit` panel's above it. `keep` stretches the checker where a collapsed vertex's uv stays put while its position moves; the `emc` levels carry more vertices for the same bits, but their faces cross the seams, which `pm`'s simplifier keeps:\n");
+    let _ = writeln!(md, "![intermediate levels of pm-reordered in the splits and of emc and emc-ahead with their levels, with a checker](attributes-levels.png)");
     std::fs::create_dir_all(out)?;
     let path = out.join("attributes.md");
     meshcodec::mesh::io::write_atomically(&path, md.as_bytes())?;
@@ -302,19 +308,36 @@ pub fn attributes_checker(results_dir: &Path, out: &Path) -> Result<PathBuf> {
 /// Shares of the full vertex count at which the levels figure shows each in-split stream.
 const LEVEL_SHARES: [f64; 3] = [0.12, 0.25, 0.5];
 
+/// One row of the levels figure: a mesh, a codec and where its appearance goes.
+struct LevelRow {
+    mesh: &'static str,
+    codec: &'static str,
+    rule: Option<&'static str>,
+}
+
 /// Writes paper-tables/attributes-levels.png: intermediate levels of `pm-reordered` with
-/// appearance in its splits, by either collapse rule, textured with a checker through the
-/// level's own uvs, so that what each rule does to the charts and the seams shows.
+/// appearance in its splits, by either collapse rule, and of `emc` and `emc-ahead` with their
+/// levels, each textured with a checker through the level's own uvs — so that what each rule
+/// does to the charts and the seams shows, and what each codec shows for the same bits: the
+/// `emc` panels are the levels whose bits are nearest those of the `pm-reordered`, `fit`, panel
+/// above.
 pub fn attributes_levels(results_dir: &Path, out: &Path) -> Result<PathBuf> {
     use crate::render::{render_textured, View};
     use meshcodec::codecs::pm::iter::PMeshIter;
     use plotters::prelude::*;
     const PANEL: u32 = 300;
     const CAPTION: u32 = 26;
-    const CODEC: &str = "pm-reordered";
-    let rows: Vec<(&str, &str)> = CHECKER_MESHES
+    let rows: Vec<LevelRow> = CHECKER_MESHES
         .iter()
-        .flat_map(|m| ["fit", "keep"].map(|rule| (*m, rule)))
+        .flat_map(|&mesh| {
+            [
+                ("pm-reordered", Some("fit")),
+                ("pm-reordered", Some("keep")),
+                ("emc", None),
+                ("emc-ahead", None),
+            ]
+            .map(|(codec, rule)| LevelRow { mesh, codec, rule })
+        })
         .collect();
     let width = PANEL * LEVEL_SHARES.len() as u32;
     let height = (PANEL + CAPTION) * rows.len() as u32;
@@ -323,21 +346,81 @@ pub fn attributes_levels(results_dir: &Path, out: &Path) -> Result<PathBuf> {
     let root = BitMapBackend::new(&path, (width, height)).into_drawing_area();
     let fail = |e: &dyn std::fmt::Display| Error::Io(std::io::Error::other(format!("plot: {e}")));
     root.fill(&WHITE).map_err(|e| fail(&e))?;
-    for (row, (mesh, rule)) in rows.iter().enumerate() {
+    // The bits per vertex of each mesh's `fit` panels, which the emc panels match.
+    let mut fit_bits: Vec<(&str, Vec<f64>)> = Vec::new();
+    for (row, line) in rows.iter().enumerate() {
         let view = View {
             up: 1,
-            yaw: if *mesh == "spot" { 210.0 } else { 30.0 },
+            yaw: if line.mesh == "spot" { 210.0 } else { 30.0 },
             pitch: 20.0,
         };
-        let stem = format!("{mesh}-q12{APPEARANCE_SUFFIX}-{rule}");
-        let stream_path = results::path(results_dir, CODEC, &stem, ".mc");
+        let quant = if line.codec == "pm-reordered" { "-q12" } else { "" };
+        let rule = line.rule.map_or(String::new(), |r| format!("-{r}"));
+        let stem = format!("{}{quant}{APPEARANCE_SUFFIX}{rule}", line.mesh);
+        let stream_path = results::path(results_dir, line.codec, &stem, ".mc");
         let stream = std::fs::read(&stream_path).map_err(|e| missing(&stream_path, e))?;
-        let mut iter = PMeshIter::from_stream(&stream)?;
-        let full = iter.header().vertices as f64;
+        let result_path = results::path(results_dir, line.codec, &stem, ".json");
+        let result = read_result(&result_path).map_err(|e| missing(&result_path, e))?;
+        let v = result.vertices as f64;
         let mut frame = None;
-        for (col, share) in LEVEL_SHARES.iter().enumerate() {
-            iter.goto_nvertices((full * share).round() as usize)?;
-            let level = iter.level_mesh();
+        // Each panel: the level's mesh, its uvs and caption.
+        let mut panels = Vec::new();
+        if line.codec == "pm-reordered" {
+            let mut iter = PMeshIter::from_stream(&stream)?;
+            let full = iter.header().vertices as f64;
+            let mut bits = Vec::new();
+            for share in LEVEL_SHARES {
+                iter.goto_nvertices((full * share).round() as usize)?;
+                let n = iter.nvertices() as f64;
+                // The stream's bits at n vertices, between its levels' (vertices, bits).
+                let at: Vec<(f64, f64)> = result
+                    .levels
+                    .iter()
+                    .map(|l| (l.vertices as f64, l.bits_per_vertex))
+                    .collect();
+                let bpv = super::log_log_interpolate(&at, n).unwrap_or(f64::NAN);
+                bits.push(bpv);
+                let caption = format!(
+                    "{} {}: {} / {} vertices, {bpv:.1} bits/vertex",
+                    line.codec,
+                    line.rule.unwrap_or(""),
+                    n,
+                    full
+                );
+                panels.push((iter.level_mesh(), caption));
+            }
+            if line.rule == Some("fit") {
+                fit_bits.push((line.mesh, bits));
+            }
+        } else {
+            let wanted = fit_bits
+                .iter()
+                .find(|(m, _)| *m == line.mesh)
+                .map(|(_, b)| b.clone())
+                .ok_or_else(|| Error::Unsupported("the fit row comes first".into()))?;
+            let mut decoder = meshcodec::codecs::open(&stream)?;
+            let mut levels = Vec::new();
+            while decoder.advance()? {
+                let bpv = result
+                    .levels
+                    .get(decoder.levels_decoded() - 1)
+                    .map_or(f64::NAN, |l| l.bits_per_vertex);
+                levels.push((bpv, decoder.mesh()?));
+            }
+            for bits in wanted {
+                let (bpv, level) = levels
+                    .iter()
+                    .min_by(|a, b| (a.0 - bits).abs().total_cmp(&(b.0 - bits).abs()))
+                    .ok_or_else(|| Error::Unsupported(format!("{stem}: no level")))?;
+                let caption = format!(
+                    "{} with the levels: {} / {v} vertices, {bpv:.1} bits/vertex",
+                    line.codec,
+                    level.mesh.positions.len()
+                );
+                panels.push((level.clone(), caption));
+            }
+        }
+        for (col, (level, caption)) in panels.iter().enumerate() {
             // Every panel of a row in the frame of its first level, so that they line up.
             let frame = *frame.get_or_insert(
                 level
@@ -353,8 +436,7 @@ pub fn attributes_levels(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             let picture = render_textured(&level.mesh, &uvs, &frame, view, PANEL, PANEL);
             let (x0, y0) = (col as u32 * PANEL, row as u32 * (PANEL + CAPTION));
             super::draw_panel(&root, &picture.pixels, PANEL, (x0, y0))?;
-            let caption = format!("{rule}: {} / {} vertices", iter.nvertices(), full as u64);
-            super::draw_caption(&root, &caption, 17, (x0 + 8, y0 + PANEL + 2))?;
+            super::draw_caption(&root, caption, 14, (x0 + 6, y0 + PANEL + 4))?;
         }
     }
     root.present().map_err(|e| fail(&e))?;

@@ -16,13 +16,14 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 mod anchors;
+mod appearance_levels;
 mod attributes;
 mod emc_renders;
 
 use crate::came;
 pub use crate::emc::tables::{emc_fig4, emc_fig5, emc_table1, EMC_TABLE1_COMMAND};
 pub use crate::pm::tables::{hoppe_tables, HOPPE_COMMAND};
-pub(crate) use anchors::ANCHORS_COMMAND;
+pub(crate) use anchors::{optional, ANCHORS_COMMAND};
 pub use anchors::{
     emc_rate_distortion, emc_rms_rate_distortion, emc_vs_anchors, log_log_interpolate,
 };
@@ -217,6 +218,10 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
     record(
         "attributes-levels",
         attributes::attributes_levels(results, out).map(one),
+    );
+    record(
+        "appearance-levels",
+        appearance_levels::appearance_levels(results, out),
     );
     (written, missing)
 }

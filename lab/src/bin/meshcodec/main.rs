@@ -799,8 +799,9 @@ fn distance(
         let show =
             |v: Option<f64>, unit: &str| v.map_or("-".to_string(), |x| format!("{x:.4}{unit}"));
         meshcodec_lab::outln!(
-            "appearance (mean over A's samples): uv {} , normal {} , colour {} , wrong material {}",
+            "appearance (mean over A's samples): uv {} (RMS {}), normal {} , colour {} , wrong material {}",
             show(e.uv_texels, " texels of 1024²"),
+            show(e.uv_rms_texels, ""),
             show(e.normal_degrees, "°"),
             show(e.colour_steps, " /255"),
             show(e.wrong_material, "")
