@@ -18,8 +18,7 @@ fn main() {
             let (canonical, appearance) =
                 canonical_attributed_for(&mesh, &options, AttributeBits::default()).unwrap();
             let plain = codec.encode(&canonical).unwrap();
-            let unit =
-                codecs::encode_with_appearance_unit(codec, &canonical, &appearance).unwrap();
+            let unit = codecs::encode_with_appearance_unit(codec, &canonical, &appearance).unwrap();
             let levels = codecs::encode_attributed(codec, &canonical, Some(&appearance)).unwrap();
             let v = canonical.vertex_count() as f64;
             let bpv = |n: usize| n as f64 * 8.0 / v;

@@ -61,7 +61,10 @@ fn every_shared_mesh_with_appearance_round_trips_losslessly_through_every_codec_
                 .contains(&Capability::AppearanceWithLevels)
             {
                 // Without the last level's last byte: the level before, with what it shows.
-                let shown = before.attributes.as_ref().expect("the level before shows appearance");
+                let shown = before
+                    .attributes
+                    .as_ref()
+                    .expect("the level before shows appearance");
                 assert_eq!(shown.corners.len(), before.mesh.faces.len(), "{name}");
             } else {
                 // Without the appearance unit's last byte: the whole geometry, no appearance.
@@ -152,7 +155,10 @@ fn the_harness_codes_appearance_when_asked_and_measures_it_at_the_level_that_car
         .map(|l| l.appearance.uv_texels.expect("every level has uvs"))
         .collect();
     assert!(errors.iter().all(|&e| e > uv), "{errors:?}");
-    assert!(errors.last().unwrap() < errors.first().unwrap(), "{errors:?}");
+    assert!(
+        errors.last().unwrap() < errors.first().unwrap(),
+        "{errors:?}"
+    );
     assert_eq!(last.bits, r.bytes as u64 * 8);
     let csv = meshcodec_lab::results::levels_csv(r);
     assert!(csv.lines().next().unwrap().ends_with("wrong_material"));
@@ -594,7 +600,11 @@ fn every_level_of_emc_shows_uvs_on_every_corner() {
             assert!(shown >= 4, "{name}: {shown} levels");
             let full = decoder.mesh().unwrap();
             assert_eq!(
-                appearance.check_lossless(&canonical, &full.mesh, full.attributes.as_ref().unwrap()),
+                appearance.check_lossless(
+                    &canonical,
+                    &full.mesh,
+                    full.attributes.as_ref().unwrap()
+                ),
                 Ok(()),
                 "{name} {}",
                 codec.name()

@@ -532,7 +532,10 @@ fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
             return Err(Error::malformed(
                 0,
                 5,
-                format!("{} streams do not carry appearance after each level", codec.name()),
+                format!(
+                    "{} streams do not carry appearance after each level",
+                    codec.name()
+                ),
             ));
         }
         let spec = reader.header().appearance.clone().unwrap_or_default();

@@ -149,7 +149,8 @@ impl AppearanceSpec {
             && (normal_modes == FLAG_DERIVED_NORMALS | FLAG_GEOMETRIC_NORMALS
                 || flags & (FLAG_NORMALS | FLAG_IN_LEVELS) != FLAG_NORMALS | FLAG_IN_LEVELS);
         // The values travel in the splits (16) or in units after the levels (128), not both.
-        let two_places = flags & (FLAG_IN_LEVELS | FLAG_LEVEL_PARTS) == FLAG_IN_LEVELS | FLAG_LEVEL_PARTS;
+        let two_places =
+            flags & (FLAG_IN_LEVELS | FLAG_LEVEL_PARTS) == FLAG_IN_LEVELS | FLAG_LEVEL_PARTS;
         if flags & attributes == 0 || bad_mode || two_places {
             return Err(Error::malformed(
                 0,

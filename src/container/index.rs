@@ -175,7 +175,7 @@ impl Index {
     /// (docs/FORMAT.md §10): the levels keep their own numbering; `at` is for errors.
     pub(super) fn split_level_parts(&mut self, at: usize) -> Result<()> {
         let listed = std::mem::take(&mut self.units);
-        if listed.len() % 2 != 0 {
+        if !listed.len().is_multiple_of(2) {
             return Err(Error::malformed(
                 0,
                 at,

@@ -125,7 +125,11 @@ impl StreamWriter {
     /// header: each follows its level, which a reader decodes with it. A stream of levels
     /// only, one part a level.
     pub fn set_level_parts(&mut self, spec: AppearanceSpec, parts: Vec<Vec<u8>>) -> Result<()> {
-        let layered = self.units.iter().enumerate().all(|(i, u)| u.1 == i.checked_sub(1));
+        let layered = self
+            .units
+            .iter()
+            .enumerate()
+            .all(|(i, u)| u.1 == i.checked_sub(1));
         if !layered || parts.len() != self.units.len() || self.marks.len() != self.units.len() {
             return Err(Error::Unsupported(
                 "appearance parts need a stream of levels, one part a level".into(),

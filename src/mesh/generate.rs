@@ -156,7 +156,8 @@ pub fn textured_cube(n: u32) -> AttributedMesh {
         };
         for i in 0..n {
             for j in 0..n {
-                let corners = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(a, b)| vertex(a, b));
+                let corners =
+                    [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)].map(|(a, b)| vertex(a, b));
                 for tri in [[0, 1, 2], [0, 2, 3]] {
                     faces.push(tri.map(|k| corners[k].0));
                     uvs.push(tri.map(|k| corners[k].1));

@@ -124,7 +124,9 @@ pub fn appearance_levels(results_dir: &Path, out: &Path) -> Result<Vec<PathBuf>>
             .unwrap_or_default();
         let _ = writeln!(md, "## {mesh} ({what}; {})\n", measure.unit());
         for codec in ["emc", "emc-ahead"] {
-            let Some((_, _, r)) = runs.iter().find(|(c, rule, _)| *c == codec && rule.is_none())
+            let Some((_, _, r)) = runs
+                .iter()
+                .find(|(c, rule, _)| *c == codec && rule.is_none())
             else {
                 continue;
             };
@@ -194,7 +196,10 @@ pub fn appearance_levels(results_dir: &Path, out: &Path) -> Result<Vec<PathBuf>>
             series,
         });
     }
-    let _ = writeln!(md, "![appearance error against bits for every level](appearance-rate-distortion.png)");
+    let _ = writeln!(
+        md,
+        "![appearance error against bits for every level](appearance-rate-distortion.png)"
+    );
     std::fs::create_dir_all(out)?;
     let path = out.join("appearance-levels.md");
     meshcodec::mesh::io::write_atomically(&path, md.as_bytes())?;

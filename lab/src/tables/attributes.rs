@@ -226,7 +226,7 @@ pub fn attributes_table(results_dir: &Path, out: &Path) -> Result<PathBuf> {
     }
     let _ = writeln!(md, "## Pictures\n");
     let _ = writeln!(md, "![bunny-10k-textured and spot with a checker through the file's uvs and through emc's full decode](attributes-checker.png)\n");
-    let _ = writeln!(md, "Intermediate levels, each textured with a checker through its own uvs; rows for bunny-10k-textured, then spot: `pm-reordered` in the splits, `fit` and `keep`, at 12%, 25% and 50% of the vertices, then `emc` and `emc-ahead` with their levels, each panel the level whose bits are nearest the `fit` panel's above it. `keep` stretches the checker where a collapsed vertex's uv stays put while its position moves; the `emc` levels carry more vertices for the same bits, but their faces cross the seams, which `pm`'s simplifier keeps:\n");
+    let _ = writeln!(md, "Intermediate levels, each textured with a checker through its own uvs; rows for bunny-10k-textured, then spot: `pm-reordered` in the splits, `fit` and `keep`, at 12%, 25% and 50% of the vertices, then `emc` and `emc-ahead` with their levels, each panel the level whose bits are nearest the `fit` panel's above it; captions give each level's vertices (v) and its stream's bits per vertex of the full mesh (b/v). `keep` stretches the checker where a collapsed vertex's uv stays put while its position moves; the `emc` levels carry more vertices for the same bits, but their faces cross the seams, which `pm`'s simplifier keeps:\n");
     let _ = writeln!(md, "![intermediate levels of pm-reordered in the splits and of emc and emc-ahead with their levels, with a checker](attributes-levels.png)");
     std::fs::create_dir_all(out)?;
     let path = out.join("attributes.md");
@@ -354,14 +354,17 @@ pub fn attributes_levels(results_dir: &Path, out: &Path) -> Result<PathBuf> {
             yaw: if line.mesh == "spot" { 210.0 } else { 30.0 },
             pitch: 20.0,
         };
-        let quant = if line.codec == "pm-reordered" { "-q12" } else { "" };
+        let quant = if line.codec == "pm-reordered" {
+            "-q12"
+        } else {
+            ""
+        };
         let rule = line.rule.map_or(String::new(), |r| format!("-{r}"));
         let stem = format!("{}{quant}{APPEARANCE_SUFFIX}{rule}", line.mesh);
         let stream_path = results::path(results_dir, line.codec, &stem, ".mc");
         let stream = std::fs::read(&stream_path).map_err(|e| missing(&stream_path, e))?;
         let result_path = results::path(results_dir, line.codec, &stem, ".json");
         let result = read_result(&result_path).map_err(|e| missing(&result_path, e))?;
-        let v = result.vertices as f64;
         let mut frame = None;
         // Each panel: the level's mesh, its uvs and caption.
         let mut panels = Vec::new();
@@ -381,11 +384,9 @@ pub fn attributes_levels(results_dir: &Path, out: &Path) -> Result<PathBuf> {
                 let bpv = super::log_log_interpolate(&at, n).unwrap_or(f64::NAN);
                 bits.push(bpv);
                 let caption = format!(
-                    "{} {}: {} / {} vertices, {bpv:.1} bits/vertex",
+                    "{} {}: {n} v, {bpv:.1} b/v",
                     line.codec,
-                    line.rule.unwrap_or(""),
-                    n,
-                    full
+                    line.rule.unwrap_or("")
                 );
                 panels.push((iter.level_mesh(), caption));
             }
@@ -413,7 +414,7 @@ pub fn attributes_levels(results_dir: &Path, out: &Path) -> Result<PathBuf> {
                     .min_by(|a, b| (a.0 - bits).abs().total_cmp(&(b.0 - bits).abs()))
                     .ok_or_else(|| Error::Unsupported(format!("{stem}: no level")))?;
                 let caption = format!(
-                    "{} with the levels: {} / {v} vertices, {bpv:.1} bits/vertex",
+                    "{}: {} v, {bpv:.1} b/v",
                     line.codec,
                     level.mesh.positions.len()
                 );

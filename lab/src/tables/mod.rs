@@ -23,10 +23,10 @@ mod emc_renders;
 use crate::came;
 pub use crate::emc::tables::{emc_fig4, emc_fig5, emc_table1, EMC_TABLE1_COMMAND};
 pub use crate::pm::tables::{hoppe_tables, HOPPE_COMMAND};
-pub(crate) use anchors::{optional, ANCHORS_COMMAND};
 pub use anchors::{
     emc_rate_distortion, emc_rms_rate_distortion, emc_vs_anchors, log_log_interpolate,
 };
+pub(crate) use anchors::{optional, ANCHORS_COMMAND};
 pub use attributes::{ATTRIBUTES_COMMAND, ATTRIBUTE_MESHES};
 pub use emc_renders::emc_levels_beside_pm;
 

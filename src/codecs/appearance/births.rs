@@ -192,7 +192,11 @@ impl Births {
                     if let Some(known) = self.values[tw] {
                         let q = level.positions[w as usize];
                         wedges.extend(known.code.uv.map(|t| (q, at(t))));
-                        wedges.extend(self.seams[tw].iter().filter_map(|c| c.uv.map(|t| (q, at(t)))));
+                        wedges.extend(
+                            self.seams[tw]
+                                .iter()
+                                .filter_map(|c| c.uv.map(|t| (q, at(t)))),
+                        );
                     }
                 }
                 wedges.sort_by(|a, b| {
@@ -287,7 +291,9 @@ impl Births {
             .collect();
         let neighbours = Neighbours::build(level);
         let mut known = Vec::new();
-        let mut left: Vec<u32> = (0..n as u32).filter(|&v| shown[v as usize].is_none()).collect();
+        let mut left: Vec<u32> = (0..n as u32)
+            .filter(|&v| shown[v as usize].is_none())
+            .collect();
         while !left.is_empty() {
             let before = left.len();
             left.retain(|&v| {

@@ -8,8 +8,8 @@
 use super::births::{faces_normal, in_chart, LevelView, Neighbours, RepValue};
 use super::predict::uv_by_fit;
 use super::Appearance;
-use crate::mesh::canonical_attributes::CornerCode;
 use crate::mesh::attribute_quantization::UvGrid;
+use crate::mesh::canonical_attributes::CornerCode;
 use glam::{DVec2, DVec3};
 
 /// Two corners share a chart when their uvs lie within this many times the uv distance
@@ -127,7 +127,8 @@ pub fn faces_in_charts(
     for f in 0..level.faces.len() {
         let vertices = level.faces[f];
         let wedges = shown.corners[f];
-        let agree = |i: usize, j: usize| same_corner(vertices[i], wedges[i], vertices[j], wedges[j]);
+        let agree =
+            |i: usize, j: usize| same_corner(vertices[i], wedges[i], vertices[j], wedges[j]);
         if agree(0, 1) && agree(1, 2) && agree(2, 0) {
             continue;
         }

@@ -156,7 +156,14 @@ pub fn run(
     // Wedges of each vertex as a list through `next_wedge`, newest first.
     let mut first_wedge = vec![NONE; mesh.positions.len()];
     // Wedges made at each vertex so far: the n-th takes the n-th known one.
-    let mut wedges_at = vec![0u8; if first.is_some() { mesh.positions.len() } else { 0 }];
+    let mut wedges_at = vec![
+        0u8;
+        if first.is_some() {
+            mesh.positions.len()
+        } else {
+            0
+        }
+    ];
     let mut next_wedge: Vec<u32> = Vec::new();
     let mut previous_uv = [0u32; 2];
     let mut previous_colour = [0u8; 4];
@@ -285,7 +292,8 @@ pub fn run(
                     wedges_at[v] = n.saturating_add(1);
                     f[v].get(n as usize).copied()
                 });
-                out.codes.push(known_first.map(|f| f.code).unwrap_or_default());
+                out.codes
+                    .push(known_first.map(|f| f.code).unwrap_or_default());
                 next_wedge.push(first_wedge[v]);
                 first_wedge[v] = chosen;
                 // A first wedge whose uv is whole is known; one with low bits left goes
@@ -457,8 +465,7 @@ pub fn run(
                             let top = base as i64 + (1i64 << low) - 1;
                             let guess = (predicted[axis] as i64).clamp(base as i64, top);
                             let d = symbols.int(
-                                &mut c.uv_low[(low as usize - 1).min(UV_LOW_SETS - 1)][scale]
-                                    [axis],
+                                &mut c.uv_low[(low as usize - 1).min(UV_LOW_SETS - 1)][scale][axis],
                                 value[axis] as i64 - guess,
                                 "uv_low",
                             )?;

@@ -58,10 +58,16 @@ impl Progress {
     /// count: 0 exactly, else the precision plus one).
     fn plan(&mut self, symbols: &mut impl Symbols, plan: Option<PartsPlan>) -> Result<()> {
         let mut context = crate::coding::arith::UintContext::default();
-        let coded = plan.and_then(|p| p.uv_precision).map_or(0, |p| p as u64 + 1);
+        let coded = plan
+            .and_then(|p| p.uv_precision)
+            .map_or(0, |p| p as u64 + 1);
         let precision = symbols.uint(&mut context, coded, "plan")?;
         if precision > 32 {
-            return Err(Error::malformed(0, 0, "appearance: uv precision past 31 bits"));
+            return Err(Error::malformed(
+                0,
+                0,
+                "appearance: uv precision past 31 bits",
+            ));
         }
         self.births.uv_precision = precision.checked_sub(1).map(|p| p as u8);
         Ok(())
@@ -108,11 +114,23 @@ impl Progress {
         };
         let births_truth = truth.map(|(t, _, _)| (&t.reps[..], &t.seams[..]));
         if self.coding_births {
-            self.births
-                .code(symbols, &view, &born, |v| tokens[v as usize], spec, births_truth)?;
+            self.births.code(
+                symbols,
+                &view,
+                &born,
+                |v| tokens[v as usize],
+                spec,
+                births_truth,
+            )?;
         } else {
-            self.births
-                .sketch(symbols, &view, &born, |v| tokens[v as usize], spec, births_truth)?;
+            self.births.sketch(
+                symbols,
+                &view,
+                &born,
+                |v| tokens[v as usize],
+                spec,
+                births_truth,
+            )?;
         }
         let settles = symbols.bit(
             &mut self.settled,
@@ -131,10 +149,14 @@ impl Progress {
                         code: v.code,
                         uv_low_bits: v.uv_low_bits,
                     });
-                    known.extend(self.births.seams[t as usize].iter().map(|&code| FirstValue {
-                        code,
-                        uv_low_bits: 0,
-                    }));
+                    known.extend(
+                        self.births.seams[t as usize]
+                            .iter()
+                            .map(|&code| FirstValue {
+                                code,
+                                uv_low_bits: 0,
+                            }),
+                    );
                 }
                 first.push(known);
             }
@@ -183,10 +205,14 @@ impl Progress {
         });
         let seams: Vec<&[CornerCode]> = tokens
             .iter()
-            .map(|&t| self.births.seams.get(t as usize).map_or(&[][..], |s| &s[..]))
+            .map(|&t| {
+                self.births
+                    .seams
+                    .get(t as usize)
+                    .map_or(&[][..], |s| &s[..])
+            })
             .collect();
-        let shown =
-            super::charts::faces_in_charts(&view, &values, &seams, spec.uv_grid, materials);
+        let shown = super::charts::faces_in_charts(&view, &values, &seams, spec.uv_grid, materials);
         Ok(to_attributes(&shown, spec))
     }
 }
@@ -268,10 +294,9 @@ fn encoder_truth(
     let mut reps = vec![None; full.positions.len()];
     let mut seams = vec![Seams::new(); full.positions.len()];
     for &f in &traversal.order {
-        for k in 0..3 {
-            let v = full.faces[f as usize][k] as usize;
-            let token = final_tokens[v] as usize;
-            let code = corners[f as usize][k];
+        let face = full.faces[f as usize];
+        for (&v, &code) in face.iter().zip(&corners[f as usize]) {
+            let token = final_tokens[v as usize] as usize;
             match &reps[token] {
                 None => {
                     reps[token] = Some(RepValue {
@@ -462,11 +487,7 @@ impl<'a> WithLevelParts<'a> {
         let coder = crate::coding::arith::ArithDecoder::new(part.bytes).ok_or_else(|| {
             Error::malformed(unit, start, "appearance part is not whole 32-bit words")
         })?;
-        let mut reader = coder::Reader {
-            coder,
-            unit,
-            start,
-        };
+        let mut reader = coder::Reader { coder, unit, start };
         let mesh = self.inner.mesh()?;
         let tokens = tokens_of(self.inner.as_ref(), mesh.mesh.positions.len());
         if level == 0 {

@@ -108,7 +108,13 @@ pub fn encode(
         materials: materials.as_deref(),
     };
     let mut encoder = ArithEncoder::default();
-    coder::run(&mut encoder, decoded, &spec_of(appearance), Some(&truth), None)?;
+    coder::run(
+        &mut encoder,
+        decoded,
+        &spec_of(appearance),
+        Some(&truth),
+        None,
+    )?;
     let fields = encoder.field_bits.clone();
     let (bytes, _) = encoder.finish();
     Ok((bytes, fields))
