@@ -723,27 +723,56 @@ pub(super) struct Neighbours {
 impl Neighbours {
     pub(super) fn build(level: &LevelView) -> Neighbours {
         let n = level.positions.len();
-        let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(level.faces.len() * 6);
+        // Each vertex's row holds its faces' other corners and its loose edges' other ends,
+        // then is sorted and deduplicated on its own (short rows, not one long sort).
+        let mut start = vec![0u32; n + 1];
         for f in level.faces {
-            for k in 0..3 {
-                pairs.push((f[k], f[(k + 1) % 3]));
-                pairs.push((f[(k + 1) % 3], f[k]));
+            for &v in f {
+                start[v as usize + 1] += 2;
             }
         }
         for &[a, b] in level.loose_edges {
-            pairs.push((a, b));
-            pairs.push((b, a));
-        }
-        pairs.sort_unstable();
-        pairs.dedup();
-        let mut start = vec![0u32; n + 1];
-        for &(a, _) in &pairs {
             start[a as usize + 1] += 1;
+            start[b as usize + 1] += 1;
         }
         for i in 1..start.len() {
             start[i] += start[i - 1];
         }
-        let list = pairs.iter().map(|&(_, b)| b).collect();
+        let mut fill = start.clone();
+        let mut list = vec![0u32; start[n] as usize];
+        let mut put = |v: u32, w: u32| {
+            list[fill[v as usize] as usize] = w;
+            fill[v as usize] += 1;
+        };
+        for f in level.faces {
+            for k in 0..3 {
+                let (v, a, b) = (f[k], f[(k + 1) % 3], f[(k + 2) % 3]);
+                put(v, a);
+                put(v, b);
+            }
+        }
+        for &[a, b] in level.loose_edges {
+            put(a, b);
+            put(b, a);
+        }
+        // Compacted in place, row by row.
+        let mut kept = 0usize;
+        let mut row_start = vec![0u32; n + 1];
+        for v in 0..n {
+            let row = &mut list[start[v] as usize..start[v + 1] as usize];
+            row.sort_unstable();
+            let mut last = None;
+            for i in start[v] as usize..start[v + 1] as usize {
+                let w = list[i];
+                if last != Some(w) {
+                    list[kept] = w;
+                    kept += 1;
+                    last = Some(w);
+                }
+            }
+            row_start[v + 1] = kept as u32;
+        }
+        list.truncate(kept);
         let mut face_start = vec![0u32; n + 1];
         for f in level.faces {
             for &v in f {
@@ -762,7 +791,7 @@ impl Neighbours {
             }
         }
         Neighbours {
-            start,
+            start: row_start,
             list,
             face_start,
             face_list,

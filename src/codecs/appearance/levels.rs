@@ -32,6 +32,39 @@ pub struct LevelParts {
     pub level_bits: Vec<f64>,
 }
 
+/// A level's mesh, made the first time a part needs it.
+struct LazyMesh<'m> {
+    /// Makes it (`None` once it is made).
+    make: Option<&'m dyn Fn() -> Result<LevelMesh>>,
+    mesh: Option<LevelMesh>,
+}
+
+impl LazyMesh<'_> {
+    /// A mesh already made.
+    fn made(mesh: LevelMesh) -> LazyMesh<'static> {
+        LazyMesh {
+            make: None,
+            mesh: Some(mesh),
+        }
+    }
+
+    /// The mesh, which must have `vertices` vertices (one a representative).
+    fn get(&mut self, vertices: usize) -> Result<&LevelMesh> {
+        if let Some(make) = self.make.take() {
+            let mesh = make()?;
+            if mesh.mesh.positions.len() != vertices {
+                return Err(Error::malformed(
+                    0,
+                    0,
+                    "appearance: representatives and vertices disagree",
+                ));
+            }
+            self.mesh = Some(mesh);
+        }
+        Ok(self.mesh.as_ref().expect("made above"))
+    }
+}
+
 /// The state both sides keep between levels.
 struct Progress {
     births: Births,
@@ -76,23 +109,17 @@ impl Progress {
     /// Codes or reads one level's part: the births of the representatives that `tokens` (per
     /// vertex of `level`) names and that have no values yet, then whether the level's faces
     /// are final and, if so, the full appearance. `truth`: the encoder's values.
+    /// `level` gives the level's mesh, made only when the part needs it: to code births, to
+    /// sketch uvs, or to settle.
     fn level(
         &mut self,
         symbols: &mut impl Symbols,
-        level: &LevelMesh,
+        level: &mut LazyMesh,
         tokens: &[u32],
         spec: &AppearanceSpec,
         truth: Option<(&EncoderTruth, bool, bool)>,
     ) -> Result<()> {
-        let positions = &level.mesh.positions;
-        if tokens.len() != positions.len() {
-            return Err(Error::malformed(
-                0,
-                0,
-                "appearance: representatives and vertices disagree",
-            ));
-        }
-        let born: Vec<u32> = (0..positions.len() as u32)
+        let born: Vec<u32> = (0..tokens.len() as u32)
             .filter(|&v| {
                 self.births
                     .values
@@ -107,30 +134,24 @@ impl Progress {
                 "births_coded",
             )?;
         }
-        let view = LevelView {
-            positions,
-            faces: &level.mesh.faces,
-            loose_edges: &level.loose_edges,
-        };
         let births_truth = truth.map(|(t, _, _)| (&t.reps[..], &t.seams[..]));
-        if self.coding_births {
-            self.births.code(
-                symbols,
-                &view,
-                &born,
-                |v| tokens[v as usize],
-                spec,
-                births_truth,
-            )?;
-        } else {
-            self.births.sketch(
-                symbols,
-                &view,
-                &born,
-                |v| tokens[v as usize],
-                spec,
-                births_truth,
-            )?;
+        // A sketch without uvs codes nothing: what a level shows of those representatives, it
+        // works out when shown.
+        if !born.is_empty() && (self.coding_births || spec.uv_grid.is_some()) {
+            let level = level.get(tokens.len())?;
+            let view = LevelView {
+                positions: &level.mesh.positions,
+                faces: &level.mesh.faces,
+                loose_edges: &level.loose_edges,
+            };
+            let token = |v: u32| tokens[v as usize];
+            if self.coding_births {
+                self.births
+                    .code(symbols, &view, &born, token, spec, births_truth)?;
+            } else {
+                self.births
+                    .sketch(symbols, &view, &born, token, spec, births_truth)?;
+            }
         }
         let settles = symbols.bit(
             &mut self.settled,
@@ -138,7 +159,8 @@ impl Progress {
             "settled",
         )?;
         if settles {
-            let mut first = Vec::with_capacity(positions.len());
+            let level = level.get(tokens.len())?;
+            let mut first = Vec::with_capacity(tokens.len());
             for &t in tokens {
                 let value = self.births.values.get(t as usize).ok_or_else(|| {
                     Error::malformed(0, 0, "appearance: a vertex with no representative")
@@ -323,12 +345,12 @@ fn encoder_truth(
     })
 }
 
-/// The representatives a decoder's vertices stand for: its own answer, or every vertex its
-/// own.
-fn tokens_of(decoder: &dyn LevelDecoder, vertices: usize) -> Vec<u32> {
-    decoder
-        .representatives()
-        .unwrap_or_else(|| (0..vertices as u32).collect())
+/// The representatives a decoder's vertices stand for, which codecs that carry appearance
+/// with their levels say.
+fn tokens_of(decoder: &dyn LevelDecoder) -> Result<Vec<u32>> {
+    decoder.representatives().ok_or_else(|| {
+        Error::Unsupported("the codec does not say what its levels' vertices stand for".into())
+    })
 }
 
 /// How the encoder spends the levels' appearance before the faces settle.
@@ -381,7 +403,7 @@ pub fn encode(
     let mut decoder = crate::codecs::open(stream)?;
     while decoder.advance()? {}
     let full = decoder.mesh()?;
-    let final_tokens = tokens_of(decoder.as_ref(), full.mesh.positions.len());
+    let final_tokens = tokens_of(decoder.as_ref())?;
     let truth = encoder_truth(&full.mesh, &final_tokens, canonical, appearance)?;
     let mut decoder = crate::codecs::open(stream)?;
     let mut progress = Progress::new(full.mesh.positions.len());
@@ -396,7 +418,7 @@ pub fn encode(
             continue;
         }
         let level = decoder.mesh()?;
-        let tokens = tokens_of(decoder.as_ref(), level.mesh.positions.len());
+        let tokens = tokens_of(decoder.as_ref())?;
         let settles = tokens == final_tokens && level.mesh.faces == full.mesh.faces;
         let mut encoder = ArithEncoder::default();
         let births = parts.len() < plan.birth_levels;
@@ -405,7 +427,7 @@ pub fn encode(
         }
         progress.level(
             &mut encoder,
-            &level,
+            &mut LazyMesh::made(level),
             &tokens,
             &spec,
             Some((&truth, births, settles)),
@@ -488,15 +510,20 @@ impl<'a> WithLevelParts<'a> {
             Error::malformed(unit, start, "appearance part is not whole 32-bit words")
         })?;
         let mut reader = coder::Reader { coder, unit, start };
-        let mesh = self.inner.mesh()?;
-        let tokens = tokens_of(self.inner.as_ref(), mesh.mesh.positions.len());
+        let tokens = tokens_of(self.inner.as_ref())?;
         if level == 0 {
             self.progress.plan(&mut reader, None).map_err(malformed)?;
         }
+        let inner = &self.inner;
+        let make = || inner.mesh();
+        let mut mesh = LazyMesh {
+            make: Some(&make),
+            mesh: None,
+        };
         self.progress
-            .level(&mut reader, &mesh, &tokens, &self.spec, None)
+            .level(&mut reader, &mut mesh, &tokens, &self.spec, None)
             .map_err(malformed)?;
-        self.last = Some(mesh);
+        self.last = mesh.mesh;
         Ok(())
     }
 }
@@ -526,7 +553,14 @@ impl LevelDecoder for WithLevelParts<'_> {
             Some(mesh) if self.inner.levels_decoded() == self.decoded => mesh.clone(),
             _ => self.inner.mesh()?,
         };
-        let tokens = tokens_of(self.inner.as_ref(), mesh.mesh.positions.len());
+        let tokens = tokens_of(self.inner.as_ref())?;
+        if tokens.len() != mesh.mesh.positions.len() {
+            return Err(Error::malformed(
+                0,
+                0,
+                "appearance: representatives and vertices disagree",
+            ));
+        }
         mesh.attributes = Some(self.progress.shown(&mesh, &tokens, &self.spec)?);
         Ok(mesh)
     }

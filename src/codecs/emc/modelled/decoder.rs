@@ -358,7 +358,11 @@ impl LevelDecoder for EmcDecoder<'_> {
     /// `emc-ahead`'s vertices stand for the representatives their cells went ahead with, which
     /// a split may hand to its new vertex; `emc`'s for the vertex that keeps their id.
     fn representatives(&self) -> Option<Vec<u32>> {
-        (self.params.ahead_levels > 0).then(|| self.walker.representative.clone())
+        Some(if self.params.ahead_levels > 0 {
+            self.walker.representative.clone()
+        } else {
+            (0..self.walker.state.len() as u32).collect()
+        })
     }
 }
 
