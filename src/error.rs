@@ -79,6 +79,30 @@ impl Error {
             what: what.into(),
         }
     }
+
+    /// The same error, its text prefixed with `what` it concerns ("mesh 2 primitive 0: …"),
+    /// its kind kept.
+    pub fn context(self, what: &str) -> Self {
+        match self {
+            Error::Malformed {
+                level,
+                byte,
+                what: w,
+            } => Error::Malformed {
+                level,
+                byte,
+                what: format!("{what}: {w}"),
+            },
+            Error::Truncated(w) => Error::Truncated(format!("{what}: {w}")),
+            Error::Unsupported(w) => Error::Unsupported(format!("{what}: {w}")),
+            Error::Limit(w) => Error::Limit(format!("{what}: {w}")),
+            Error::InvalidMesh(f) => Error::InvalidMesh(MeshFault {
+                line: f.line,
+                what: format!("{what}: {}", f.what),
+            }),
+            Error::Io(e) => Error::Io(std::io::Error::new(e.kind(), format!("{what}: {e}"))),
+        }
+    }
 }
 
 /// Result with the crate's error.

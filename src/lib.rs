@@ -47,6 +47,7 @@ pub mod error;
 pub mod hierarchy;
 pub mod limits;
 pub mod mesh;
+pub mod packing;
 mod prefetch;
 
 #[cfg(feature = "metrics")]

@@ -56,8 +56,9 @@ export class MeshcodecLoader extends Loader {
     return new Promise((resolve, reject) => this.load(url, resolve, onProgress, reject));
   }
 
-  decode(request, onLoad, onProgress, onError, onLevel, transfer = []) {
-    const geometry = new BufferGeometry();
+  /** Decodes `request` into `geometry` (a new one unless given: a primitive's own, which
+   * every mesh sharing it then shows refined). */
+  decode(request, onLoad, onProgress, onError, onLevel, transfer = [], geometry = new BufferGeometry()) {
     const id = nextId++;
     this.manager.itemStart(id);
     const end = () => {
@@ -142,10 +143,17 @@ function setView(geometry, view) {
   });
 }
 
+/** Streams the byte range [start, end) of `url` (a stream inside a larger file) into a
+ * geometry, as `load` does a whole file. */
+MeshcodecLoader.prototype.loadRange = function (url, start, end, onLoad, onProgress, onError, onLevel, geometry) {
+  const resolved = new URL(this.manager.resolveURL(this.path + url), globalThis.location?.href).href;
+  return this.decode({ url: resolved, range: [start, end] }, onLoad, onProgress, onError, onLevel, [], geometry);
+};
+
 /** Puts a decoded level into `geometry`: single-precision positions for drawing (a vertex a
  * wedge where the level carries appearance: normals, uvs and colours as attributes, a group a
  * material), the level's own double-precision positions and figures in `userData.meshcodec`. */
-function setLevel(geometry, level) {
+export function setLevel(geometry, level) {
   for (const name of ["normal", "uv", "color"]) geometry.deleteAttribute(name);
   geometry.clearGroups();
   if (level.appearance) {

@@ -32,12 +32,33 @@ async function* chunksOfResponse(response) {
   }
 }
 
-/** The chunks of `request` (a URL to fetch, or bytes already read) and the bytes expected. */
+/** The chunks of `request` (a URL to fetch, a byte range [start, end) of one, or bytes
+ * already read) and the bytes expected. */
 async function open(request) {
   if (request.bytes) return [chunksOfBytes(request.bytes), request.bytes.byteLength];
+  if (request.range) {
+    const [start, end] = request.range;
+    const response = await fetch(request.url, { headers: { Range: `bytes=${start}-${end - 1}` } });
+    if (!response.ok) throw new Error(`${request.url}: HTTP ${response.status} ${response.statusText}`);
+    if (response.status === 206) return [chunksOfResponse(response), end - start];
+    // A server without Range: the whole file, the range cut out of it as it arrives.
+    return [sliceOf(chunksOfResponse(response), start, end), end - start];
+  }
   const response = await fetch(request.url);
   if (!response.ok) throw new Error(`${request.url}: HTTP ${response.status} ${response.statusText}`);
   return [chunksOfResponse(response), Number(response.headers.get("content-length")) || 0];
+}
+
+/** The bytes [start, end) of a stream of chunks. */
+async function* sliceOf(chunks, start, end) {
+  let at = 0;
+  for await (const chunk of chunks) {
+    const from = Math.max(start - at, 0);
+    const to = Math.min(end - at, chunk.length);
+    if (to > from) yield chunk.subarray(from, to);
+    at += chunk.length;
+    if (at >= end) return;
+  }
 }
 
 /** The first bytes of `url` by one Range request (more while its header and index run on):

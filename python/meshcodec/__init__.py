@@ -49,7 +49,9 @@ __all__ = [
     "level_ends",
     "levels",
     "load",
+    "pack",
     "save",
+    "unpack",
     "view",
 ]
 
@@ -465,6 +467,54 @@ def save(mesh: Union[Mesh, tuple], path: PathLike) -> None:
     vertices, faces = _arrays_of(mesh, "mesh")
     appearance = mesh.appearance if isinstance(mesh, Mesh) else None
     _core.save(vertices, faces, os.fspath(path), None if appearance is None else appearance._dict())
+
+
+def pack(
+    input: PathLike,
+    output: PathLike,
+    codec: str = "emc",
+    quant_bits: int = 12,
+    uv_bits: int = 12,
+    normal_bits: int = 10,
+    fallback: Optional[float] = 0.02,
+    fallback_faces: int = 256,
+    external: bool = False,
+) -> List[Dict[str, Any]]:
+    """Packs a glTF scene (``.gltf`` with its files, ``.glb``) or any mesh file into the GLB
+    ``output`` whose triangle primitives are progressive streams (docs/GLTF.md: the
+    ``MESHCODEC_progressive`` extension), the rest of the scene kept.
+
+    Each primitive's own accessors hold a coarse level — the one whose triangles are nearest
+    ``fallback`` (a share) of its triangles and at least ``fallback_faces`` — that any glTF
+    viewer draws; ``fallback=None`` stores none (the extension is then required).
+    ``external=True`` writes the streams to ``output`` with the extension ``.streams.bin``,
+    beside the GLB, for clients that fetch their levels by HTTP Range requests.
+
+    Returns one dict a primitive: ``mesh``, ``primitive``, ``name`` and, for those coded,
+    ``faces``, ``stream_bytes``, ``levels``, ``fallback_level``, ``fallback_faces``; for those
+    kept as they are (points, lines, skinned, morphed, other attributes), ``kept``: why.
+    """
+    if fallback is not None and not (0.0 < float(fallback) <= 1.0):
+        raise MeshcodecError("fallback must be a share in (0, 1], or None")
+    report = _core.pack(
+        os.fspath(input),
+        os.fspath(output),
+        str(codec),
+        int(quant_bits),
+        int(uv_bits),
+        int(normal_bits),
+        None if fallback is None else float(fallback),
+        int(fallback_faces),
+        bool(external),
+    )
+    return json.loads(report)
+
+
+def unpack(input: PathLike, output: PathLike) -> int:
+    """Decodes every progressive stream of the packed GLB ``input`` back into ordinary
+    accessors (each primitive's full level, lossless at the stream's quantization) and writes
+    the GLB ``output``; returns how many primitives it decoded."""
+    return _core.unpack(os.fspath(input), os.fspath(output))
 
 
 def distance(

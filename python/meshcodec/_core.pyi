@@ -67,6 +67,18 @@ def save(
     path: str,
     appearance: Optional[_Appearance] = None,
 ) -> None: ...
+def pack(
+    input: str,
+    output: str,
+    codec_name: str,
+    quant_bits: int,
+    uv_bits: int,
+    normal_bits: int,
+    fallback_share: Optional[float],
+    fallback_faces: int,
+    external: bool,
+) -> str: ...
+def unpack(input: str, output: str) -> int: ...
 def distance(
     a_vertices: npt.NDArray[np.float64],
     a_faces: npt.NDArray[np.int64],

@@ -661,6 +661,96 @@ fn save<'py>(
     .map_err(|e| about_file(e, &path))
 }
 
+/// Packs a glTF scene or mesh file into a GLB whose triangle primitives are progressive
+/// streams (docs/GLTF.md); returns the report as JSON (one entry a primitive).
+#[pyfunction]
+#[pyo3(signature = (input, output, codec_name, quant_bits, uv_bits, normal_bits, fallback_share, fallback_faces, external))]
+#[allow(clippy::too_many_arguments)]
+fn pack(
+    py: Python<'_>,
+    input: PathBuf,
+    output: PathBuf,
+    codec_name: &str,
+    quant_bits: u8,
+    uv_bits: u8,
+    normal_bits: u8,
+    fallback_share: Option<f64>,
+    fallback_faces: usize,
+    external: bool,
+) -> PyResult<String> {
+    let options = meshcodec::packing::PackOptions {
+        codec: codec(codec_name)?,
+        quant_bits,
+        bits: AttributeBits {
+            uv: uv_bits,
+            normal: normal_bits,
+            derive_normals: false,
+        },
+        fallback: fallback_share.map(|share| meshcodec::packing::Fallback {
+            share,
+            min_faces: fallback_faces,
+        }),
+    };
+    let streams_path = output.with_extension("streams.bin");
+    let uri = streams_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let report = py
+        .detach(|| -> meshcodec::Result<_> {
+            let scene = meshcodec::mesh::scene::Scene::open(&input)?;
+            let packed =
+                meshcodec::packing::pack(&scene, &options, external.then_some(uri.as_str()))?;
+            io::write_atomically(&output, &packed.glb)?;
+            if let Some(streams) = &packed.streams {
+                io::write_atomically(&streams_path, streams)?;
+            }
+            Ok(packed.report)
+        })
+        .map_err(|e| about_file(e, &input))?;
+    let entries: Vec<serde_json::Value> = report
+        .iter()
+        .map(|p| {
+            let mut entry = serde_json::json!({
+                "mesh": p.mesh,
+                "primitive": p.primitive,
+                "name": p.name,
+            });
+            match &p.outcome {
+                meshcodec::packing::Outcome::Packed {
+                    stream_bytes,
+                    levels,
+                    fallback_level,
+                    fallback_faces,
+                    faces,
+                } => {
+                    entry["stream_bytes"] = (*stream_bytes).into();
+                    entry["levels"] = (*levels).into();
+                    entry["fallback_level"] = (*fallback_level).into();
+                    entry["fallback_faces"] = (*fallback_faces).into();
+                    entry["faces"] = (*faces).into();
+                }
+                meshcodec::packing::Outcome::Kept(why) => entry["kept"] = why.clone().into(),
+            }
+            entry
+        })
+        .collect();
+    Ok(serde_json::Value::Array(entries).to_string())
+}
+
+/// Every progressive stream of a packed GLB back into ordinary accessors; returns how many.
+#[pyfunction]
+fn unpack(py: Python<'_>, input: PathBuf, output: PathBuf) -> PyResult<usize> {
+    py.detach(|| -> meshcodec::Result<usize> {
+        let bytes = std::fs::read(&input)?;
+        let scene = meshcodec::mesh::scene::Scene::read(&bytes, input.parent())?;
+        let unpacked = meshcodec::packing::unpack(&scene)?;
+        io::write_atomically(&output, &unpacked.glb)?;
+        Ok(unpacked.primitives)
+    })
+    .map_err(|e| about_file(e, &input))
+}
+
 /// Distances both ways between mesh `a` (the reference) and mesh `b` — a decoded level, which
 /// may have loose edges and even no face yet — over samples of both (docs/CONTRACT.md §5).
 #[pyfunction]
@@ -777,6 +867,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(save, m)?)?;
     m.add_function(wrap_pyfunction!(distance, m)?)?;
+    m.add_function(wrap_pyfunction!(pack, m)?)?;
+    m.add_function(wrap_pyfunction!(unpack, m)?)?;
     m.add_function(wrap_pyfunction!(codec_list, m)?)?;
     Ok(())
 }

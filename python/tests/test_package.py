@@ -240,13 +240,20 @@ def test_appearance_is_loaded_coded_decoded_and_saved(tmp_path):
     assert a is not None and a.wedge_count == 6451 and a.uvs.shape == (6451, 2)
     assert a.corners.shape == (mesh.face_count, 3) and a.material_names == ["01_-_Default"]
     assert meshcodec.load(MESHES / "bunny-10k-textured.obj", drop_attributes=True).appearance is None
+    # emc codes the appearance with its levels: every level shows it.
     stream = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc", appearance=a)
     about = meshcodec.info(stream)
-    assert about["appearance"]["unit"] is not None and not about["appearance"]["in_levels"]
+    assert about["appearance"]["unit"] is None and not about["appearance"]["in_levels"]
+    assert len(about["appearance"]["level_parts"]) == about["levels"]
     plain = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc")
     assert len(plain) < len(stream) and meshcodec.info(plain)["appearance"] is None
     levels = list(meshcodec.levels(stream))
-    assert all(l.appearance is None for l in levels[:-1])
+    assert all(l.appearance is not None for l in levels)
+    # In one unit after the last level instead: the levels before it have none.
+    unit = meshcodec.encode(mesh.vertices, mesh.faces, codec="emc", appearance=a,
+                            attributes="unit")
+    assert meshcodec.info(unit)["appearance"]["unit"] is not None
+    assert all(l.appearance is None for l in list(meshcodec.levels(unit))[:-1])
     full = meshcodec.decode(stream)
     assert full.appearance is not None and full.appearance.wedge_count == 6451
     # Each decoded corner's uv is the original's to within half a cell of the 12-bit grid.
@@ -268,7 +275,7 @@ def test_appearance_is_loaded_coded_decoded_and_saved(tmp_path):
     pm_levels = list(meshcodec.levels(in_levels))
     assert len(pm_levels) > 1 and all(l.appearance is not None for l in pm_levels)
     assert pm_levels[-1].appearance.wedge_count == 6451
-    with pytest.raises(meshcodec.MeshcodecError, match="after its last level"):
+    with pytest.raises(meshcodec.MeshcodecError, match="is for pm"):
         meshcodec.encode(mesh.vertices, mesh.faces, codec="emc", appearance=a, attributes="fit")
     # came-paper's full level is lossy: it refuses appearance.
     with pytest.raises(meshcodec.MeshcodecError, match="cannot carry"):

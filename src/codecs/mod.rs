@@ -385,7 +385,7 @@ pub fn encode_attributed_with(
             .encode_with_appearance(canonical, appearance, fit)
             .unwrap_or_else(|| {
                 Err(Error::Unsupported(format!(
-                    "{} codes appearance after its last level only (--attributes is for pm)",
+                    "{} does not code appearance in vertex splits (--attributes fit|keep is for pm)",
                     codec.name()
                 )))
             });

@@ -11,6 +11,7 @@ pub mod generate;
 pub mod io;
 pub mod manifold;
 pub mod quantize;
+pub mod scene;
 pub mod topology;
 
 pub use canonical::CanonicalMesh;

@@ -2,6 +2,7 @@
 //! measure the distance between two meshes (Metro-style).
 
 mod info;
+mod pack;
 
 use anyhow::{Context, Result};
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
@@ -155,6 +156,52 @@ enum Command {
         /// and materials.
         #[arg(long)]
         drop_attributes: bool,
+    },
+    /// Pack a glTF scene (.gltf with its files, .glb) or any mesh file into a GLB whose
+    /// triangle primitives are progressive streams (docs/GLTF.md: the MESHCODEC_progressive
+    /// extension), each primitive's own accessors a coarse level that any glTF viewer shows;
+    /// the rest of the scene kept. Primitives the codecs cannot take are kept as they are and
+    /// listed on stderr.
+    Pack {
+        /// Scene or mesh file (a .gltf's buffers and images are read from beside it).
+        input: String,
+        /// GLB to write.
+        output: PathBuf,
+        /// Codec of the streams (emc carries the appearance with every level).
+        #[arg(long, default_value = DEFAULT_CODEC)]
+        codec: String,
+        /// Quantization bits per axis of the positions.
+        #[arg(long, default_value_t = 12)]
+        quant: u8,
+        /// Bits per texture-coordinate axis (Qt).
+        #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_UV_BITS)]
+        uv_bits: u8,
+        /// Bits per octahedral normal coordinate (Qn).
+        #[arg(long, default_value_t = meshcodec::mesh::attribute_quantization::DEFAULT_NORMAL_BITS)]
+        normal_bits: u8,
+        /// The fallback level: the one whose triangles are nearest this share of the
+        /// primitive's ...
+        #[arg(long, default_value_t = 0.02)]
+        fallback_share: f64,
+        /// ... and at least this many triangles (or all of a smaller primitive's).
+        #[arg(long, default_value_t = 256)]
+        fallback_faces: usize,
+        /// No fallback: the primitives' accessors hold no data, and the extension is
+        /// required (a loader without it cannot draw them).
+        #[arg(long)]
+        no_fallback: bool,
+        /// The streams in a file of their own beside the GLB (OUT.streams.bin), so that a
+        /// client fetches their levels by HTTP Range requests.
+        #[arg(long)]
+        external: bool,
+    },
+    /// Decode every progressive stream of a packed GLB back into ordinary accessors (each
+    /// primitive's full level, lossless at the stream's quantization); the rest as it was.
+    Unpack {
+        /// Packed GLB.
+        input: PathBuf,
+        /// GLB to write.
+        output: PathBuf,
     },
     /// Distance between two meshes' surfaces: one-sided both ways, Hausdorff, RMS; and, when
     /// both have appearance, its error (uv texels, normal degrees, colour steps, materials).
@@ -323,6 +370,34 @@ fn main() -> ExitCode {
             output,
             drop_attributes,
         } => convert(&input, &output, drop_attributes),
+        Command::Pack {
+            input,
+            output,
+            codec,
+            quant,
+            uv_bits,
+            normal_bits,
+            fallback_share,
+            fallback_faces,
+            no_fallback,
+            external,
+        } => pack::pack(&pack::PackArgs {
+            input: &input,
+            output: &output,
+            codec: &codec,
+            quant,
+            bits: AttributeBits {
+                uv: uv_bits,
+                normal: normal_bits,
+                derive_normals: false,
+            },
+            fallback: (!no_fallback).then_some(meshcodec::packing::Fallback {
+                share: fallback_share,
+                min_faces: fallback_faces,
+            }),
+            external,
+        }),
+        Command::Unpack { input, output } => pack::unpack(&input, &output),
         Command::Render {
             input,
             output,
