@@ -12,14 +12,30 @@ use gltf_json::validation::{Checked, USize64};
 use gltf_json::Index;
 use std::collections::{BTreeMap, HashMap};
 
+/// How an accessor stores its floats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Storage {
+    /// 32-bit floats.
+    F32,
+    /// Normalized unsigned shorts, for values in [0, 1] (uvs; core glTF).
+    U16Norm,
+    /// Normalized unsigned bytes, for values in [0, 1] (colours; core glTF).
+    U8Norm,
+    /// Normalized signed bytes, for values in [−1, 1], each element padded to four bytes
+    /// (normals; `KHR_mesh_quantization`).
+    I8Norm,
+}
+
 /// An accessor's new data.
 #[derive(Clone, Debug)]
 pub enum Data {
-    /// Floats, `components` an element (positions carry their bounds, as glTF requires).
+    /// Floats, `components` an element (positions carry their bounds, as glTF requires), stored
+    /// as `storage` says.
     Float {
         values: Vec<f32>,
         components: usize,
         bounds: bool,
+        storage: Storage,
     },
     /// Triangle indices (written as unsigned shorts when they fit).
     Indices(Vec<u32>),
@@ -413,6 +429,7 @@ fn push_accessor(
             values,
             components,
             bounds,
+            storage,
         } => {
             let type_ = type_of(*components);
             let (min, max) = if *bounds {
@@ -428,16 +445,73 @@ fn push_accessor(
             } else {
                 (None, None)
             };
-            let bytes: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
-            (
-                ComponentType::F32,
-                type_,
-                values.len() / components,
-                Some(bytes),
+            let (component, bytes, stride): (_, Vec<u8>, _) = match storage {
+                Storage::F32 => (
+                    ComponentType::F32,
+                    values.iter().flat_map(|x| x.to_le_bytes()).collect(),
+                    None,
+                ),
+                Storage::U16Norm => (
+                    ComponentType::U16,
+                    values
+                        .iter()
+                        .flat_map(|&x| ((x.clamp(0.0, 1.0) * 65535.0).round() as u16).to_le_bytes())
+                        .collect(),
+                    None,
+                ),
+                Storage::U8Norm => (
+                    ComponentType::U8,
+                    values
+                        .iter()
+                        .map(|&x| (x.clamp(0.0, 1.0) * 255.0).round() as u8)
+                        .collect(),
+                    None,
+                ),
+                Storage::I8Norm => {
+                    // Elements of three bytes take four (glTF aligns a vertex attribute's
+                    // elements to four bytes).
+                    let padded = components.next_multiple_of(4);
+                    let mut bytes = vec![0u8; values.len() / components * padded];
+                    for (e, element) in values.chunks_exact(*components).enumerate() {
+                        for (k, &x) in element.iter().enumerate() {
+                            bytes[e * padded + k] =
+                                ((x.clamp(-1.0, 1.0) * 127.0).round() as i8) as u8;
+                        }
+                    }
+                    (
+                        ComponentType::I8,
+                        bytes,
+                        (padded != *components).then_some(padded),
+                    )
+                }
+            };
+            let normalized = *storage != Storage::F32;
+            let buffer_view = {
+                let offset = append(bin, &bytes);
+                views.push(view(
+                    0,
+                    offset,
+                    bytes.len(),
+                    stride,
+                    Some(Target::ArrayBuffer),
+                ));
+                Index::new(views.len() as u32 - 1)
+            };
+            accessors.push(gltf_json::Accessor {
+                buffer_view: Some(buffer_view),
+                byte_offset: None,
+                count: USize64((values.len() / components) as u64),
+                component_type: Checked::Valid(GenericComponentType(component)),
+                extensions: None,
+                extras: Default::default(),
+                type_: Checked::Valid(type_),
                 min,
                 max,
-                Some(Target::ArrayBuffer),
-            )
+                name: None,
+                normalized,
+                sparse: None,
+            });
+            return Index::new(accessors.len() as u32 - 1);
         }
         Data::Indices(indices) => {
             let short = indices.iter().all(|&i| i < u16::MAX as u32);

@@ -17,7 +17,7 @@ use crate::container::FORMAT_VERSION;
 use crate::error::{Error, Result};
 use crate::mesh::attribute_quantization::AttributeBits;
 use crate::mesh::scene::{Content, Scene};
-use assemble::{write_glb, Data, Replacement, Streams};
+use assemble::{write_glb, Data, Replacement, Storage, Streams};
 use extension::{Level, Progressive, NAME};
 use std::collections::HashMap;
 
@@ -149,17 +149,19 @@ pub fn pack(scene: &Scene, options: &PackOptions, external: Option<&str>) -> Res
         Some(uri) => Streams::External(uri.to_string()),
         None => Streams::Embedded,
     };
-    let required: &[&str] = if options.fallback.is_none() && !replacements.is_empty() {
-        &[NAME]
-    } else {
-        &[]
-    };
-    let used: &[&str] = if replacements.is_empty() {
-        &[]
-    } else {
-        &[NAME]
-    };
-    let (glb, streams) = write_glb(scene, &replacements, used, required, &[], &streams)?;
+    let mut used = Vec::new();
+    let mut required = Vec::new();
+    if !replacements.is_empty() {
+        used.push(NAME);
+        if options.fallback.is_none() {
+            required.push(NAME);
+        }
+    }
+    if replacements.values().any(quantized) {
+        used.push(QUANTIZATION);
+        required.push(QUANTIZATION);
+    }
+    let (glb, streams) = write_glb(scene, &replacements, &used, &required, &[], &streams)?;
     Ok(Packed {
         glb,
         streams,
@@ -212,7 +214,7 @@ fn pack_one(
         Some(fallback) => {
             let level = fallback_level(&levels, faces, fallback);
             let (mesh, _) = codecs::decode(&stream, Stop::Levels(level))?;
-            (level, gltf_arrays(&mesh, &attributes)?)
+            (level, compact(gltf_arrays(&mesh, &attributes)?))
         }
         None => (0, empty_arrays(&full, &attributes)?),
     };
@@ -297,6 +299,7 @@ pub fn gltf_arrays(level: &LevelMesh, names: &[&str]) -> Result<Arrays> {
         values,
         components,
         bounds,
+        storage: Storage::F32,
     };
     let (vertex_of, indices): (Vec<u32>, Vec<u32>) = match &level.attributes {
         Some(a) => (
@@ -356,6 +359,59 @@ pub fn gltf_arrays(level: &LevelMesh, names: &[&str]) -> Result<Arrays> {
     }
     Ok((out, Some(Data::Indices(indices))))
 }
+
+/// A fallback's arrays stored small, as a coarse preview needs: normals as normalized bytes
+/// (`KHR_mesh_quantization`), uvs in [0, 1] as normalized shorts, colours as normalized bytes;
+/// positions stay floats (quantized positions would need the node's transform to scale them).
+fn compact((attributes, indices): Arrays) -> Arrays {
+    let attributes = attributes
+        .into_iter()
+        .map(|(name, data)| {
+            let data = match data {
+                Data::Float {
+                    values,
+                    components,
+                    bounds,
+                    ..
+                } => {
+                    let storage = match name.as_str() {
+                        "NORMAL" => Storage::I8Norm,
+                        "TEXCOORD_0" if values.iter().all(|x| (0.0..=1.0).contains(x)) => {
+                            Storage::U16Norm
+                        }
+                        "COLOR_0" => Storage::U8Norm,
+                        _ => Storage::F32,
+                    };
+                    Data::Float {
+                        values,
+                        components,
+                        bounds,
+                        storage,
+                    }
+                }
+                other => other,
+            };
+            (name, data)
+        })
+        .collect();
+    (attributes, indices)
+}
+
+/// Whether `replacement` stores an attribute as `KHR_mesh_quantization` allows only.
+fn quantized(replacement: &Replacement) -> bool {
+    replacement.attributes.iter().any(|(_, d)| {
+        matches!(
+            d,
+            Data::Float {
+                storage: Storage::I8Norm,
+                ..
+            }
+        )
+    })
+}
+
+/// The extension that lets a fallback's normals be bytes.
+const QUANTIZATION: &str = "KHR_mesh_quantization";
 
 /// Accessors with a count and no data, sized as the full level's (`--no-fallback`).
 fn empty_arrays(full: &LevelMesh, names: &[&str]) -> Result<Arrays> {

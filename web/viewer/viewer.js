@@ -4,9 +4,15 @@
 // A `came` stream named by ?src= is refined to the camera as it moves, its meta-nodes fetched by
 // Range requests (?view=levels downloads it level by level instead); the figures then say the
 // faces, the bytes read and the adaptation time.
+// A glTF scene (.glb or .gltf; `meshcodec pack` makes progressive ones) is opened with three.js's
+// GLTFLoader and the meshcodec plugin (gltf-plugin.js): the scene at once with each packed
+// primitive's coarse fallback, then each primitive refined level by level; ?plugin=off opens it
+// with the stock loader alone, as a viewer that has never heard of the extension would.
 import * as THREE from "three";
 import { OrbitControls } from "three/addons/controls/OrbitControls.js";
+import { GLTFLoader } from "three/addons/loaders/GLTFLoader.js";
 import { MeshcodecLoader } from "../loader.js";
+import { MeshcodecGLTFPlugin } from "../gltf-plugin.js";
 
 const canvas = document.getElementById("view");
 const fill = document.getElementById("fill");
@@ -129,7 +135,7 @@ function frameBox([low, high]) {
 
 /** Asks the worker to adapt the came stream's mesh to the camera now (it adapts to the newest). */
 function refineToCamera() {
-  if (!mesh?.geometry.userData.meshcodec?.came) return;
+  if (!mesh?.geometry?.userData.meshcodec?.came) return;
   const size = renderer.getDrawingBufferSize(new THREE.Vector2());
   // The address's camera exactly as given (`meshcodec view` takes the same numbers) until the
   // controls move it.
@@ -171,6 +177,8 @@ function open(request, name) {
     error: null,
     appearance: [],
     appearanceShown: false,
+    levelsWithUvs: [],
+    gltf: null,
     came: null,
     tolerance: Number(new URLSearchParams(location.search).get("tolerance")) || 1,
   });
@@ -178,7 +186,7 @@ function open(request, name) {
   framed = false;
   if (mesh) {
     scene.remove(mesh);
-    mesh.geometry.dispose();
+    mesh.geometry?.dispose();
   }
   const onProgress = ({ loaded, total }) => {
     state.received = loaded;
@@ -224,6 +232,7 @@ function open(request, name) {
       codec: level.codec,
     });
     state.levelsSeen.push(level.level);
+    if (geometry.getAttribute("uv")) state.levelsWithUvs.push(level.level);
     state.appearance = level.appearance
       ? Object.keys(level.appearance).filter((k) => ["normals", "uvs", "colours", "materials"].includes(k))
       : [];
@@ -273,8 +282,89 @@ addEventListener("drop", async (e) => {
   e.preventDefault();
   document.body.classList.remove("dragging");
   const file = e.dataTransfer.files[0];
-  if (file) open({ bytes: await file.arrayBuffer() }, file.name);
+  if (!file) return;
+  const bytes = await file.arrayBuffer();
+  if (/\.(glb|gltf)$/i.test(file.name)) openScene({ bytes }, file.name);
+  else open({ bytes }, file.name);
 });
+
+/** Triangles drawn by the scene's meshes. */
+function sceneFaces(root) {
+  let faces = 0;
+  root.traverse((o) => {
+    if (o.isMesh) faces += (o.geometry.index ? o.geometry.index.count : o.geometry.getAttribute("position").count) / 3;
+  });
+  return faces;
+}
+
+function showScene() {
+  const g = state.gltf;
+  const packed = g.packed ? ` · ${g.refined} of ${g.packed} progressive primitives refined` : "";
+  figures.textContent = `${state.faces.toLocaleString()} faces · ${g.meshes} meshes${packed}` +
+    (g.firstFrameMs === undefined ? "" : ` · first frame ${g.firstFrameMs.toFixed(0)} ms`) +
+    (g.doneMs === undefined ? "" : ` · full ${g.doneMs.toFixed(0)} ms`);
+  fill.style.width = g.packed ? `${(100 * g.refined) / g.packed}%` : "100%";
+}
+
+/** Opens a glTF scene (see the top); its state in state.gltf. */
+async function openScene(request, name) {
+  source.textContent = name;
+  const started = performance.now();
+  const usePlugin = new URLSearchParams(location.search).get("plugin") !== "off";
+  Object.assign(state, { status: "loading", error: null, faces: 0, levelsSeen: [], levelsWithUvs: [] });
+  state.gltf = { plugin: usePlugin, meshes: 0, packed: 0, refined: 0, levels: {}, errors: [] };
+  errorLine.textContent = "";
+  const gltfLoader = new GLTFLoader();
+  let plugin = null;
+  if (usePlugin) {
+    gltfLoader.register((parser) => {
+      plugin = new MeshcodecGLTFPlugin(parser, {
+        loader,
+        onLevel: ({ meshIndex, primitive, level, levels, mesh }) => {
+          state.gltf.levels[`${meshIndex}/${primitive}`] = level;
+          state.levelsSeen.push(level);
+          if (mesh.geometry.getAttribute("uv")) state.levelsWithUvs.push(level);
+          if (level === levels) state.gltf.refined++;
+          state.faces = sceneFaces(window.viewer.scene);
+          showScene();
+        },
+        onError: (error, where) => {
+          state.gltf.errors.push(`mesh ${where.meshIndex} primitive ${where.primitive}: ${error.message}`);
+          errorLine.textContent = state.gltf.errors.join("; ");
+        },
+      });
+      return plugin;
+    });
+  }
+  try {
+    const gltf = request.url
+      ? await gltfLoader.loadAsync(request.url)
+      : await gltfLoader.parseAsync(request.bytes, "");
+    if (mesh) scene.remove(mesh);
+    mesh = gltf.scene;
+    window.viewer.mesh = mesh;
+    window.viewer.gltf = gltf;
+    scene.add(mesh);
+    const json = gltf.parser.json;
+    state.gltf.meshes = json.meshes?.length ?? 0;
+    state.gltf.packed = (json.meshes ?? []).flatMap((m) => m.primitives).filter((p) => usePlugin && p.extensions?.MESHCODEC_progressive).length;
+    state.faces = sceneFaces(mesh);
+    const box = new THREE.Box3().setFromObject(mesh);
+    frame({ boundingSphere: box.getBoundingSphere(new THREE.Sphere()) });
+    state.gltf.firstFrameMs = performance.now() - started;
+    showScene();
+    if (plugin) await plugin.done;
+    state.gltf.doneMs = performance.now() - started;
+    state.faces = sceneFaces(mesh);
+    state.status = state.gltf.errors.length ? "error" : "done";
+    state.error = state.gltf.errors[0] ?? null;
+    showScene();
+  } catch (error) {
+    state.status = "error";
+    state.error = error.message;
+    errorLine.textContent = error.message;
+  }
+}
 
 resize();
 renderer.setAnimationLoop(() => {
@@ -286,4 +376,5 @@ renderer.setAnimationLoop(() => {
 const params = new URLSearchParams(location.search);
 const fixedCamera = cameraFromAddress(params);
 const src = params.get("src");
-if (src) open({ url: src }, src);
+if (src && /\.(glb|gltf)(\?|$)/i.test(src)) openScene({ url: src }, src);
+else if (src) open({ url: src }, src);
