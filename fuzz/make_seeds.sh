@@ -250,3 +250,15 @@ for body in $seeds/decode_came/*.body; do
     > "$seeds/adapt_came/$(basename "$body")"
 done
 rm -f "$stream"
+
+# glTF scenes for pack_gltf: the torus as .gltf and .glb, and packed (so unpack reads streams
+# and the extension), embedded and with a fallback of every face.
+mkdir -p $seeds/pack_gltf
+cp $seeds/read_gltf/torus.gltf $seeds/read_gltf/torus.glb $seeds/pack_gltf/
+target/release/meshcodec pack --quant 8 $seeds/read_gltf/torus.glb $seeds/pack_gltf/torus-packed.glb >/dev/null 2>&1
+target/release/meshcodec pack --quant 8 --no-fallback $seeds/read_obj/torus.obj $seeds/pack_gltf/torus-obj-packed.glb >/dev/null 2>&1
+# The torus compressed by gltfpack (EXT_meshopt_compression), when experiments/gltf's tools are
+# installed (bash experiments/gltf.sh installs them).
+if [ -x experiments/gltf/node_modules/.bin/gltfpack ]; then
+  experiments/gltf/node_modules/.bin/gltfpack -i $seeds/read_gltf/torus.glb -o $seeds/pack_gltf/torus-gltfpack.glb -cc >/dev/null
+fi

@@ -20,6 +20,7 @@ fn replay(target: &str, bytes: &[u8]) {
             }
         }
         "adapt_came" => exercise::adapt_came(bytes),
+        "pack_gltf" => exercise::pack_gltf(bytes),
         "decode_appearance" => exercise::decode_with_appearance(bytes),
         "decode_pm_wedges" | "decode_level_parts" => exercise::decode_with_appearance(bytes),
         "roundtrip" => {
@@ -84,6 +85,8 @@ regressions! {
     obj_writer_colours_every_vertex_when_some_are_in_no_face: "read_ply" / "colours-with-vertices-no-face-uses-written-as-obj";
     came_guard_skips_a_corner_not_above_its_leaf: "adapt_came" / "guard-corner-not-above-its-leaf";
     came_node_decoded_beyond_the_grid_is_refused: "decode_came" / "node-position-beyond-the-grid";
+    level_unit_in_while_its_appearance_part_is_cut_is_present: "decode_level_parts" / "level-unit-in-while-its-part-is-cut";
+    a_primitive_packed_already_is_refused_though_extensions_used_misses_it: "pack_gltf" / "extension-on-a-primitive-not-in-extensions-used";
 }
 
 #[test]

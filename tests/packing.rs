@@ -8,6 +8,7 @@ use meshcodec::mesh::generate;
 use meshcodec::mesh::scene::{Content, Scene};
 use meshcodec::packing::{self, extension, Outcome, PackOptions};
 use meshcodec::Error;
+use std::path::Path;
 
 /// A scene of two meshes — a textured cube and a plain torus — placed by two nodes, with a
 /// material and a camera and an extra, written as a GLB by the library's writer first and
@@ -200,6 +201,37 @@ fn primitives_the_codecs_cannot_take_are_kept_and_listed() {
     let position = points.attributes.values().next().unwrap().value();
     let (values, _) = again.accessor(position).unwrap();
     assert_eq!(values.len() / 3, 24 * 12);
+    // A scene with nothing to code, packed with `--external`, names no streams' file (a glTF
+    // buffer may not be empty).
+    let mut points_only = scene;
+    points_only.document.meshes.remove(0);
+    points_only
+        .document
+        .nodes
+        .retain(|n| n.mesh.is_some_and(|m| m.value() == 1));
+    for node in &mut points_only.document.nodes {
+        node.mesh = Some(gltf_json::Index::new(0));
+    }
+    points_only.document.scenes[0].nodes = vec![gltf_json::Index::new(0)];
+    let glb = meshcodec::packing::assemble::write_glb(
+        &points_only,
+        &Default::default(),
+        &[],
+        &[],
+        &[],
+        &meshcodec::packing::assemble::Streams::Embedded,
+    )
+    .unwrap()
+    .0;
+    let points_only = Scene::read(&glb, None).unwrap();
+    let packed = packing::pack(&points_only, &PackOptions::new().unwrap(), Some("s.bin")).unwrap();
+    assert!(packed.streams.is_none());
+    let doc: gltf_json::Root =
+        serde_json::from_slice(&gltf::binary::Glb::from_slice(&packed.glb).unwrap().json).unwrap();
+    assert!(doc
+        .buffers
+        .iter()
+        .all(|b| b.uri.is_none() && b.byte_length.0 > 0));
 }
 
 #[test]
@@ -279,4 +311,49 @@ fn bad_gltf_is_an_error_never_a_panic() {
         let e = outcome.expect_err(what);
         assert!(!e.to_string().contains('\n'), "{what}: {e}");
     }
+}
+
+/// A scene gltfpack compressed with EXT_meshopt_compression (fuzz/seeds/pack_gltf: the torus
+/// seed through `gltfpack -cc`: quantized positions, octahedral normals, compressed indices)
+/// reads as the plain scene does: the same triangles, unit normals (the filter undone), and it
+/// packs and unpacks.
+#[test]
+#[cfg_attr(
+    not(feature = "meshopt"),
+    ignore = "reads EXT_meshopt_compression with the meshopt feature"
+)]
+fn a_scene_compressed_with_meshopt_is_decoded() {
+    let seeds = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/seeds/pack_gltf");
+    let plain = Scene::open(&seeds.join("torus.glb")).unwrap();
+    let compressed = Scene::open(&seeds.join("torus-gltfpack.glb")).unwrap();
+    assert!(compressed
+        .document
+        .extensions_used
+        .iter()
+        .all(|e| e != "EXT_meshopt_compression"));
+    let faces = |scene: &Scene| -> usize {
+        scene
+            .primitives
+            .iter()
+            .map(|p| p.content.triangles().expect("triangles").mesh.faces.len())
+            .sum()
+    };
+    assert_eq!(faces(&compressed), faces(&plain));
+    for primitive in &compressed.primitives {
+        let mesh = primitive.content.triangles().unwrap();
+        let normals = mesh.attributes.normals.as_ref().expect("normals");
+        for n in normals {
+            assert!(
+                (n.length() - 1.0).abs() < 0.02,
+                "a normal of length {}",
+                n.length()
+            );
+        }
+    }
+    let packed = packing::pack(&compressed, &PackOptions::new().unwrap(), None).unwrap();
+    let again = Scene::read(&packed.glb, None).unwrap();
+    assert_eq!(
+        packing::unpack(&again).unwrap().primitives,
+        compressed.primitives.len()
+    );
 }

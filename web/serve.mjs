@@ -19,14 +19,61 @@ const TYPES = {
   ".png": "image/png",
 };
 
-/** Serves `root` on 127.0.0.1:`port` (0: any free port), `.mc` streams at `rate` bytes a second
- * when given (so that levels arrive one after another, as over a slow network); resolves to
+/** Files sent over the slow link when a rate is given: streams and the scenes, buffers, images
+ * and Draco files they are compared with. Code and the decoders' wasm come at once (a returning
+ * visitor has them cached). */
+const THROTTLED = new Set([".mc", ".glb", ".gltf", ".bin", ".drc", ".png", ".jpg", ".jpeg", ".ktx2", ".webp"]);
+
+/** One link of `rate` bytes a second that every throttled response shares, as one network
+ * connection does: 20 times a second a twentieth of the rate, split evenly among the responses
+ * still sending (what one leaves unused goes to the others). */
+function slowLink(rate) {
+  const sending = new Set();
+  let ticking = false;
+  const tick = () => {
+    let budget = Math.max(1, Math.floor(rate / 20));
+    while (budget > 0 && sending.size > 0) {
+      const share = Math.max(1, Math.floor(budget / sending.size));
+      for (const s of [...sending]) {
+        const chunk = s.bytes.subarray(s.at, s.at + Math.min(share, budget));
+        s.at += chunk.length;
+        budget -= chunk.length;
+        s.count(chunk);
+        s.response.write(chunk);
+        if (s.at >= s.bytes.length) {
+          sending.delete(s);
+          s.response.end();
+        }
+        if (budget <= 0) break;
+      }
+    }
+    ticking = sending.size > 0;
+    if (ticking) setTimeout(tick, 50);
+  };
+  return {
+    send(bytes, response, count) {
+      if (bytes.length === 0) return response.end();
+      const s = { bytes, at: 0, response, count };
+      sending.add(s);
+      response.on("close", () => sending.delete(s));
+      if (!ticking) {
+        ticking = true;
+        tick();
+      }
+    },
+  };
+}
+
+/** Serves `root` on 127.0.0.1:`port` (0: any free port), streams, scenes and their files at
+ * `rate` bytes a second when given (one link they share, so that levels arrive one after
+ * another, as over a slow network); resolves to
  * {server, port, sent, requests}: `sent` the bytes sent a path, `requests` each request as
  * {path, start, end (inclusive), status} in the order they came. */
 export function serve({ root, port = 0, rate = 0 }) {
   root = resolve(root);
   const sent = new Map();
   const requests = [];
+  const link = slowLink(rate);
   const server = createServer((request, response) => {
     const path = decodeURIComponent(new URL(request.url, "http://localhost").pathname);
     const file = normalize(join(root, path));
@@ -74,20 +121,8 @@ export function serve({ root, port = 0, rate = 0 }) {
       return;
     }
     const count = (chunk) => sent.set(path, (sent.get(path) ?? 0) + chunk.length);
-    if (rate > 0 && extname(file) === ".mc") {
-      // 20 pieces a second, each a twentieth of the rate.
-      const bytes = readFileSync(file).subarray(start, end + 1);
-      const piece = Math.max(1, Math.floor(rate / 20));
-      let at = 0;
-      const next = () => {
-        if (at >= bytes.length) return response.end();
-        const chunk = bytes.subarray(at, at + piece);
-        at += chunk.length;
-        count(chunk);
-        response.write(chunk);
-        setTimeout(next, 50);
-      };
-      next();
+    if (rate > 0 && THROTTLED.has(extname(file))) {
+      link.send(readFileSync(file).subarray(start, end + 1), response, count);
       return;
     }
     const stream = createReadStream(file, { start, end });

@@ -656,3 +656,48 @@ fn adapt_came_external(stream: &[u8], views: &[u8]) {
         }
     }
 }
+
+/// `meshcodec pack` and `unpack` on arbitrary bytes read as a glTF scene (.gltf JSON with
+/// embedded buffers, or .glb): reading, packing, reading the packed GLB back and unpacking it
+/// either succeed or end in one error line. A scene that packs unpacks to the full level of
+/// every stream, and the fallback level never has more faces than the full one. Arbitrary bytes
+/// that already are a packed scene (the seeds are) exercise `unpack`'s stream and extension
+/// reading directly.
+pub fn pack_gltf(bytes: &[u8]) {
+    use meshcodec::mesh::scene::Scene;
+    use meshcodec::packing::{self, Outcome, PackOptions};
+    let Ok(scene) = Scene::read(bytes, None) else {
+        return;
+    };
+    if let Err(e) = packing::unpack(&scene) {
+        assert!(!e.to_string().contains('\n'), "a two-line error: {e}");
+    }
+    let mut options = PackOptions::new().expect("emc is registered");
+    options.quant_bits = 10;
+    let packed = match packing::pack(&scene, &options, None) {
+        Ok(packed) => packed,
+        Err(e) => {
+            assert!(!e.to_string().contains('\n'), "a two-line error: {e}");
+            return;
+        }
+    };
+    for primitive in &packed.report {
+        if let Outcome::Packed {
+            fallback_faces,
+            faces,
+            ..
+        } = primitive.outcome
+        {
+            assert!(fallback_faces <= faces, "a fallback finer than the mesh");
+        }
+    }
+    let back = Scene::read(&packed.glb, None).expect("a packed scene reads");
+    let unpacked = packing::unpack(&back).expect("a packed scene unpacks");
+    let coded = packed
+        .report
+        .iter()
+        .filter(|p| matches!(p.outcome, Outcome::Packed { .. }))
+        .count();
+    assert_eq!(unpacked.primitives, coded, "a stream lost in the GLB");
+    Scene::read(&unpacked.glb, None).expect("an unpacked scene reads");
+}

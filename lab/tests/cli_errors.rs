@@ -766,3 +766,38 @@ fn info_lists_the_levels_of_a_came_stream_of_one_meta_node() {
         assert!(info.stdout.contains("766"), "{}", info.stdout);
     }
 }
+
+/// `info` on a mesh file describes the mesh (what a user checks before encoding); on a packed
+/// glTF scene, each primitive's stream; on a `.mc` file that is none, the stream's error.
+#[test]
+fn info_describes_a_mesh_file_and_a_packed_scene() {
+    let dir = scratch();
+    let d = dir.path();
+    let info = run(MESHCODEC, &["info", "spot.obj"], d);
+    assert_eq!(info.code, Some(0), "{}", info.stderr);
+    assert!(
+        info.stdout.contains("2,930 vertices, 5,856 triangles; uvs"),
+        "{}",
+        info.stdout
+    );
+    assert!(info.stdout.contains("boundary edges 0"), "{}", info.stdout);
+    let json = run(MESHCODEC, &["info", "bunny", "--json"], d);
+    assert_eq!(json.code, Some(0), "{}", json.stderr);
+    let report: serde_json::Value = serde_json::from_str(&json.stdout).unwrap();
+    assert_eq!(report["primitives"][0]["triangles"], 69_451);
+    assert_eq!(report["primitives"][0]["topology"]["boundary_edges"], 223);
+    let packed = run(MESHCODEC, &["pack", "spot", "spot.glb"], d);
+    assert_eq!(packed.code, Some(0), "{}", packed.stderr);
+    let info = run(MESHCODEC, &["info", "spot.glb"], d);
+    assert_eq!(info.code, Some(0), "{}", info.stderr);
+    assert!(
+        info.stdout.contains("stream of codec emc") && info.stdout.contains("5,856 triangles"),
+        "{}",
+        info.stdout
+    );
+    write(d, "not-a-stream.mc", b"hello");
+    assert_clean_failure(
+        &run(MESHCODEC, &["info", "not-a-stream.mc"], d),
+        "bad magic",
+    );
+}

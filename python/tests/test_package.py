@@ -457,3 +457,30 @@ def test_the_interpreter_lock_is_released_while_encoding():
     worker.join()
     # Holding the lock, the encode would stop this loop for its whole length.
     assert max(gaps) < one / 2, (max(gaps), one)
+
+
+def test_a_glb_packs_and_unpacks_to_the_canonical_mesh(tmp_path):
+    """pack: spot's one primitive coded, with a fallback of about 2% of its faces; unpack: the
+    full level back, spot's canonical mesh at 12 bits (as single-precision floats), its uvs too."""
+    packed = tmp_path / "spot.glb"
+    report = meshcodec.pack(MESHES / "spot.obj", packed)
+    assert len(report) == 1 and report[0]["faces"] == 5856, report
+    assert 256 <= report[0]["fallback_faces"] < 5856 / 10
+    assert packed.read_bytes()[:4] == b"glTF"
+    full = tmp_path / "spot-full.glb"
+    assert meshcodec.unpack(packed, full) == 1
+    back = meshcodec.load(full)
+    spot = shared("spot.obj")
+    original = meshcodec.canonical(spot.vertices, spot.faces, quant_bits=12)
+    assert len(back.faces) == len(original.faces) == 5856
+    as_f32 = lambda v: sorted(map(tuple, np.asarray(v, dtype=np.float32).tolist()))
+    assert as_f32(np.unique(back.vertices, axis=0)) == as_f32(np.unique(original.vertices, axis=0))
+    assert back.appearance is not None and back.appearance.uvs is not None
+
+
+def test_pack_refuses_what_it_cannot_read_in_one_line(tmp_path):
+    bad = tmp_path / "bad.gltf"
+    bad.write_text('{"asset": ')
+    with pytest.raises(meshcodec.MeshcodecError) as error:
+        meshcodec.pack(bad, tmp_path / "out.glb")
+    assert "\n" not in str(error.value)

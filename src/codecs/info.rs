@@ -117,19 +117,22 @@ impl StreamInfo {
         let codec: &dyn Codec = for_header(header)?;
         let index = reader.index();
         let start = reader.payload_start() as u64;
-        let unit = |i: usize, entry: &crate::container::UnitEntry, present: bool| UnitInfo {
+        // Present: its bytes are all in (a level's unit may be, while the reader holds the
+        // level back until its appearance part is in too).
+        let received = bytes.len() as u64;
+        let unit = |i: usize, entry: &crate::container::UnitEntry| UnitInfo {
             unit: i,
             parent: entry.parent,
             first_byte: start + entry.offset,
             end_byte: start + entry.end(),
             bytes: entry.length,
-            present,
+            present: start + entry.end() <= received,
         };
         let units = index
             .units
             .iter()
             .enumerate()
-            .map(|(i, entry)| unit(i, entry, reader.unit(i).is_some()))
+            .map(|(i, entry)| unit(i, entry))
             .collect();
         let appearance = header.appearance.as_ref().map(|spec| AppearanceInfo {
             normal_bits: spec.normal_bits,
@@ -141,14 +144,12 @@ impl StreamInfo {
             materials: spec.materials.as_ref().map(|m| m.names.clone()),
             material_library: spec.materials.as_ref().and_then(|m| m.library.clone()),
             in_levels: spec.in_levels,
-            unit: index
-                .appearance
-                .map(|entry| unit(index.len(), &entry, reader.appearance_unit().is_some())),
+            unit: index.appearance.map(|entry| unit(index.len(), &entry)),
             level_parts: index
                 .level_parts
                 .iter()
                 .enumerate()
-                .map(|(i, entry)| unit(i, entry, reader.level_part(i).is_some()))
+                .map(|(i, entry)| unit(i, entry))
                 .collect(),
         });
         let ends = level_ends_of(&reader)?;

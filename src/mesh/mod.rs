@@ -10,6 +10,7 @@ pub mod derived_normals;
 pub mod generate;
 pub mod io;
 pub mod manifold;
+pub mod meshopt_views;
 pub mod quantize;
 pub mod scene;
 pub mod topology;

@@ -12,6 +12,7 @@
 
 use crate::error::{Error, Result};
 use crate::mesh::attributes::{AttributedMesh, Attributes, Corner};
+use crate::mesh::meshopt_views;
 use crate::mesh::TriMesh;
 use base64::Engine as _;
 use glam::{DVec2, DVec3};
@@ -112,7 +113,7 @@ impl Scene {
         } else {
             (bytes.to_vec(), None)
         };
-        let document: gltf_json::Root = serde_json::from_slice(&json).map_err(fault)?;
+        let mut document: gltf_json::Root = serde_json::from_slice(&json).map_err(fault)?;
         if document
             .extensions_used
             .iter()
@@ -124,6 +125,11 @@ impl Scene {
         }
         let mut buffers = Vec::with_capacity(document.buffers.len());
         for (i, buffer) in document.buffers.iter().enumerate() {
+            if meshopt_views::is_fallback(buffer) {
+                // Stands in for compressed views' bytes, which are decoded below.
+                buffers.push(Vec::new());
+                continue;
+            }
             let data = match &buffer.uri {
                 None => bin.clone().ok_or_else(|| {
                     fault(format!(
@@ -141,6 +147,7 @@ impl Scene {
             }
             buffers.push(data);
         }
+        meshopt_views::decode_views(&mut document, &mut buffers)?;
         let mut image_files = Vec::with_capacity(document.images.len());
         for image in &document.images {
             image_files.push(match (&image.uri, &image.buffer_view) {

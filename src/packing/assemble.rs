@@ -72,6 +72,38 @@ pub enum Streams {
     External(String),
 }
 
+/// Extensions known to name no accessor and no buffer view (materials, textures, lights,
+/// quantized attributes), and this crate's own, which `pack` refuses and `unpack` removes.
+fn names_no_accessor(name: &str) -> bool {
+    name.starts_with("KHR_materials_")
+        || name.starts_with("KHR_texture_")
+        || name.starts_with("EXT_texture_")
+        || matches!(
+            name,
+            "KHR_lights_punctual" | "KHR_mesh_quantization" | super::extension::NAME
+        )
+}
+
+/// Whether any object of `document` carries an extension that might name accessors or
+/// buffer views (EXT_mesh_gpu_instancing's attributes, say), which the writer cannot renumber.
+fn names_unknown_extensions(document: &gltf_json::Root) -> Result<bool> {
+    fn walk(value: &serde_json::Value) -> bool {
+        match value {
+            serde_json::Value::Object(map) => map.iter().any(|(key, v)| {
+                (key == "extensions"
+                    && v.as_object()
+                        .is_some_and(|e| e.keys().any(|name| !names_no_accessor(name))))
+                    || walk(v)
+            }),
+            serde_json::Value::Array(items) => items.iter().any(walk),
+            _ => false,
+        }
+    }
+    let value = serde_json::to_value(document)
+        .map_err(|e| Error::mesh(format!("glTF: the document does not serialize: {e}")))?;
+    Ok(walk(&value))
+}
+
 /// The GLB of `scene` with `replacements` (by mesh and primitive), extension `used` added to
 /// `extensionsUsed` (and `required`, when given, to `extensionsRequired`) and `removed` taken
 /// from both; with external streams, also the streams' buffer.
@@ -85,8 +117,10 @@ pub fn write_glb(
 ) -> Result<(Vec<u8>, Option<Vec<u8>>)> {
     let old = &scene.document;
     let mut doc = old.clone();
-    // Accessors still named, by what names them.
-    let mut accessor_used = vec![false; old.accessors.len()];
+    // Accessors still named, by what names them; all of them, and every buffer view, when an
+    // extension this writer does not know might name some.
+    let keep_all = names_unknown_extensions(old)?;
+    let mut accessor_used = vec![keep_all; old.accessors.len()];
     let mark = |i: usize, used: &mut Vec<bool>| -> Result<()> {
         *used.get_mut(i).ok_or_else(|| {
             Error::mesh(format!("glTF: accessor {i} of {}", old.accessors.len()))
@@ -126,7 +160,7 @@ pub fn write_glb(
         }
     }
     // Buffer views still named: by those accessors and by images.
-    let mut view_used = vec![false; old.buffer_views.len()];
+    let mut view_used = vec![keep_all; old.buffer_views.len()];
     let mark_view = |i: usize, used: &mut Vec<bool>| -> Result<()> {
         *used.get_mut(i).ok_or_else(|| {
             Error::mesh(format!(

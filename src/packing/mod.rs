@@ -111,11 +111,19 @@ pub struct Packed {
 /// Codes `scene`'s triangle primitives as progressive streams (see the module docs);
 /// `external`: the URI, beside the GLB, of a file to hold the streams instead.
 pub fn pack(scene: &Scene, options: &PackOptions, external: Option<&str>) -> Result<Packed> {
-    if scene
-        .document
-        .extensions_used
-        .iter()
-        .any(|e| e == extension::NAME)
+    let on_a_primitive = scene.document.meshes.iter().any(|m| {
+        m.primitives.iter().any(|p| {
+            p.extensions
+                .as_ref()
+                .is_some_and(|e| e.others.contains_key(NAME))
+        })
+    });
+    if on_a_primitive
+        || scene
+            .document
+            .extensions_used
+            .iter()
+            .any(|e| e == extension::NAME)
     {
         return Err(Error::Unsupported(format!(
             "the scene is packed already ({NAME}); `meshcodec unpack` it first"
@@ -145,9 +153,10 @@ pub fn pack(scene: &Scene, options: &PackOptions, external: Option<&str>) -> Res
             outcome,
         });
     }
+    // No stream, no streams' file (a glTF buffer may not be empty).
     let streams = match external {
-        Some(uri) => Streams::External(uri.to_string()),
-        None => Streams::Embedded,
+        Some(uri) if !replacements.is_empty() => Streams::External(uri.to_string()),
+        _ => Streams::Embedded,
     };
     let mut used = Vec::new();
     let mut required = Vec::new();

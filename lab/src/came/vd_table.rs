@@ -5,6 +5,7 @@
 
 use crate::came::flythrough::{Flythrough, ORBIT_FRAMES};
 use crate::came::vd::{stem, VdReport};
+use crate::tables::thousands;
 use meshcodec::error::{Error, Result};
 use meshcodec::mesh::io::write_atomically;
 use serde::Deserialize;
@@ -73,18 +74,6 @@ fn quantile(values: &[f64], q: f64) -> f64 {
         return f64::NAN;
     }
     sorted[((sorted.len() - 1) as f64 * q).round() as usize]
-}
-
-fn thousands(n: usize) -> String {
-    let digits = n.to_string();
-    let mut out = String::new();
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }
 
 /// Writes paper-tables/came-vd.md.

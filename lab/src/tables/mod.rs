@@ -226,6 +226,20 @@ pub fn regenerate(results: &Path, out: &Path) -> (Vec<PathBuf>, Vec<String>) {
     (written, missing)
 }
 
+/// `n` with its digits grouped by threes (12,345,678), as the tables and `meshcodec info` print
+/// counts.
+pub fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -252,3 +266,4 @@ mod tests {
         }
     }
 }
+

@@ -285,8 +285,9 @@ pub fn known_names() -> Vec<String> {
     names
 }
 
-/// Turns a path or a bare name into a mesh file: a path that exists is used as it is; a name is
-/// looked up as `<name>.*` in [`data_dirs`] (extensions in the order of [`EXTENSIONS`]). The path
+/// Turns a path or a bare name into a mesh file: a path that exists is used as it is; a file
+/// name (`spot.obj`) is looked up as it is in [`data_dirs`], a bare name as `<name>.*` there
+/// (extensions in the order of [`EXTENSIONS`]). The path
 /// returned is absolute, so that it still names the file from another working directory (a
 /// program run in a scratch folder, a test's temporary directory).
 pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
@@ -294,8 +295,21 @@ pub fn resolve(name_or_path: &str) -> Result<PathBuf> {
     if as_path.is_file() {
         return Ok(std::path::absolute(as_path)?);
     }
-    let looks_like_path = name_or_path.contains('/') || !extension(as_path).is_empty();
-    if looks_like_path {
+    if name_or_path.contains('/') {
+        return Err(Error::Io(std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            "no such file",
+        )));
+    }
+    // A file name with its extension (`spot.obj`) is looked up as it is.
+    if !extension(as_path).is_empty() {
+        if let Some(found) = data_dirs()
+            .iter()
+            .map(|dir| dir.join(name_or_path))
+            .find(|candidate| candidate.is_file())
+        {
+            return Ok(std::fs::canonicalize(&found)?);
+        }
         return Err(Error::Io(std::io::Error::new(
             std::io::ErrorKind::NotFound,
             "no such file",

@@ -34,6 +34,14 @@ struct LevelSize {
 
 pub fn info(input: &Path, json: bool) -> Result<()> {
     let stream = read_stream(input)?;
+    // Anything but a stream (a mesh or glTF file) is described as a mesh; a `.mc` file is
+    // always read as a stream (and refused as one when it is not).
+    let mc = input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("mc"));
+    if !mc && !stream.starts_with(&meshcodec::container::MAGIC) {
+        return super::describe::describe(input, json);
+    }
     let context = || input.display().to_string();
     let info = StreamInfo::of(&stream).with_context(context)?;
     // Mesh sizes from decoding every level present; where each unit is a level, its bytes.

@@ -1,6 +1,7 @@
 //! `meshcodec`: encode a mesh, decode a stream (whole or any prefix), describe a stream, and
 //! measure the distance between two meshes (Metro-style).
 
+mod describe;
 mod info;
 mod pack;
 
@@ -93,10 +94,12 @@ enum Command {
         #[arg(long, conflicts_with_all = ["level", "bytes"])]
         passes: Option<usize>,
     },
-    /// Describe a stream: header, grid, levels.
+    /// Describe a stream (header, levels, units, appearance), or a mesh or glTF file (vertices,
+    /// triangles, appearance, components, boundary and non-manifold edges; a packed scene's
+    /// streams).
     Info {
-        /// Stream file.
-        input: PathBuf,
+        /// Stream, mesh or glTF file (or a mesh's bare name).
+        input: String,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -338,7 +341,9 @@ fn main() -> ExitCode {
             bytes,
             passes,
         } => decode(&input, &output, drop_attributes, level, bytes, passes),
-        Command::Info { input, json } => info::info(&input, json),
+        Command::Info { input, json } => resolve(&input)
+            .with_context(|| input.clone())
+            .and_then(|path| info::info(&path, json)),
         Command::View {
             input,
             output,
