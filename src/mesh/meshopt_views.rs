@@ -162,8 +162,12 @@ fn decode(c: &Compressed, encoded: &[u8]) -> std::result::Result<Vec<u8>, String
 }
 
 #[cfg(not(feature = "meshopt"))]
-fn decode(_: &Compressed, _: &[u8]) -> std::result::Result<Vec<u8>, String> {
-    Err("this build reads it only with the `meshopt` feature (the CLI and the Python package have it)".into())
+fn decode(c: &Compressed, _: &[u8]) -> std::result::Result<Vec<u8>, String> {
+    Err(format!(
+        "{} data (filter {}): this build reads it only with the `meshopt` feature (the CLI and the Python package have it)",
+        c.mode,
+        c.filter.as_deref().unwrap_or("NONE")
+    ))
 }
 
 /// Little-endian bytes of integers.
