@@ -21,6 +21,7 @@
 
 pub mod came;
 pub mod cli;
+pub mod data;
 pub mod emc;
 pub mod harness;
 pub mod plot;

@@ -60,6 +60,26 @@ impl Progress {
         self.bar.reset_eta();
     }
 
+    /// A download of `total` bytes (0: unknown), `what`, advanced with [`Progress::at_byte`].
+    pub fn bytes(&self, what: impl Into<String>, total: u64) {
+        self.bar.set_style(
+            ProgressStyle::with_template(
+                "{msg} {wide_bar} {bytes}/{total_bytes} ({bytes_per_sec}, eta {eta})",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        self.bar.set_message(what.into());
+        self.bar.set_length(total);
+        self.bar.set_position(0);
+        self.bar.reset_elapsed();
+        self.bar.reset_eta();
+    }
+
+    /// `n` bytes of a [`Progress::bytes`] step in.
+    pub fn at_byte(&self, n: u64) {
+        self.bar.set_position(n);
+    }
+
     /// One more part of a [`Progress::count`] step done.
     pub fn advance(&self) {
         self.bar.inc(1);

@@ -5,8 +5,9 @@
 use anyhow::{Context, Result};
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 use meshcodec::codecs::Codec;
-use meshcodec::mesh::io::{mesh_name, resolve};
+use meshcodec::mesh::io::mesh_name;
 use meshcodec::mesh::quantize::GridShape;
+use meshcodec_lab::data::resolve;
 use meshcodec_lab::harness::{self, RunOptions};
 use meshcodec_lab::plot;
 use meshcodec_lab::progress::Progress;

@@ -4,10 +4,11 @@
 //! streams of the bunny at 3 and 5 bits per component for the Fig. 4 analogue. Writes
 //! results/came/extras.json and the streams beside it.
 
+use crate::data::resolve;
 use meshcodec::codecs::came::paper::CamePaper;
 use meshcodec::codecs::{self, Codec, EncodeOptions, Stop};
 use meshcodec::error::{Error, Result};
-use meshcodec::mesh::io::{read_mesh, resolve, vrml::write_vrml, write_atomically};
+use meshcodec::mesh::io::{read_mesh, vrml::write_vrml, write_atomically};
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::mesh::{generate, TriMesh};
 use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SEED};
@@ -106,7 +107,7 @@ pub fn path(results: &Path) -> PathBuf {
 
 /// Shared mesh `name` read and subdivided `subdivisions` times at edge midpoints.
 pub fn table_mesh(name: &str, subdivisions: u32) -> Result<(PathBuf, TriMesh)> {
-    let path = resolve(name)?;
+    let path = resolve(name).map_err(|e| Error::Unsupported(format!("{name}: {e:#}")))?;
     let mut mesh = read_mesh(&path)?;
     for _ in 0..subdivisions {
         mesh = generate::subdivide(&mesh);

@@ -2,10 +2,10 @@
 //! subdivided), beside the time to check or cut the mesh to an oriented manifold. Writes
 //! results/pm/decimation.json (`experiment decimation`).
 
+use crate::data::resolve;
 use crate::progress::Progress;
 use anyhow::{Context, Result};
 use meshcodec::codecs;
-use meshcodec::mesh::io::resolve;
 use meshcodec::mesh::quantize::GridShape;
 use std::path::Path;
 

@@ -2,10 +2,11 @@
 //! both orderings, against the same mesh's other codecs' sizes. Writes
 //! results/pm/repair-cost.json (`experiment repair-cost`).
 
+use crate::data::resolve;
 use crate::progress::Progress;
 use anyhow::{Context, Result};
 use meshcodec::codecs;
-use meshcodec::mesh::io::{mesh_name, resolve};
+use meshcodec::mesh::io::mesh_name;
 use meshcodec::mesh::quantize::GridShape;
 use std::path::{Path, PathBuf};
 

@@ -258,15 +258,37 @@ fn extension(path: &Path) -> String {
 }
 
 /// Folders searched for a bare mesh name: `$MESHCODEC_DATA`, then `../shared/meshes` from the
-/// working directory and from the crate's own folder.
+/// working directory, then the per-user cache ([`cache_dir`], where `meshcodec data fetch`
+/// puts the meshes it downloads). (Within the repository, cargo sets `MESHCODEC_DATA` to the
+/// `../shared/meshes` beside it for the programs and tests it runs: .cargo/config.toml.)
 pub fn data_dirs() -> Vec<PathBuf> {
     let mut dirs = Vec::new();
-    if let Some(d) = std::env::var_os("MESHCODEC_DATA") {
+    if let Some(d) = std::env::var_os("MESHCODEC_DATA").filter(|d| !d.is_empty()) {
         dirs.push(PathBuf::from(d));
     }
     dirs.push(PathBuf::from("../shared/meshes"));
-    dirs.push(Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/meshes"));
+    if let Some(cache) = cache_dir() {
+        dirs.push(cache);
+    }
     dirs
+}
+
+/// The per-user folder of downloaded meshes: `$MESHCODEC_CACHE`, else
+/// `$XDG_CACHE_HOME/meshcodec/meshes`, else `~/.cache/meshcodec/meshes` (`%LOCALAPPDATA%` on
+/// Windows); `None` when none of these is set.
+pub fn cache_dir() -> Option<PathBuf> {
+    let var = |name: &str| {
+        std::env::var_os(name)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
+    if let Some(dir) = var("MESHCODEC_CACHE") {
+        return Some(dir);
+    }
+    let base = var("XDG_CACHE_HOME")
+        .or_else(|| var("HOME").map(|h| h.join(".cache")))
+        .or_else(|| var("LOCALAPPDATA"))?;
+    Some(base.join("meshcodec").join("meshes"))
 }
 
 /// Mesh names (file stems with a readable extension) found in the data folders.

@@ -1,20 +1,23 @@
 //! `meshcodec`: encode a mesh, decode a stream (whole or any prefix), describe a stream, and
 //! measure the distance between two meshes (Metro-style).
 
+mod data;
 mod describe;
 mod info;
 mod pack;
 
 use anyhow::{Context, Result};
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
+use data::DataAction;
 use meshcodec::codecs::{self, Capability, EncodeRequest, EncodedMesh, LevelMesh, Stop};
 use meshcodec::mesh::attribute_quantization::AttributeBits;
 use meshcodec::mesh::attributes::AttributedMesh;
 use meshcodec::mesh::io::{
-    read_attributed, read_mesh, resolve, write_atomically, write_attributed, write_mesh,
+    read_attributed, read_mesh, write_atomically, write_attributed, write_mesh,
 };
 use meshcodec::mesh::quantize::GridShape;
 use meshcodec::metrics::{Reference, SampleBudget, DEFAULT_SAMPLES_PER_TRIANGLE, DEFAULT_SEED};
+use meshcodec_lab::data::resolve;
 use meshcodec_lab::harness::{encode_options, RunOptions};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -159,6 +162,14 @@ enum Command {
         /// and materials.
         #[arg(long)]
         drop_attributes: bool,
+    },
+    /// The test meshes a bare name calls up (data/meshes.tsv): `list` says where each is, or
+    /// that it is not here; `fetch NAME|--all` downloads into the per-user cache
+    /// ($MESHCODEC_CACHE, else ~/.cache/meshcodec/meshes) from $MESHCODEC_MIRROR when set, else
+    /// from its public source, checking its sha256.
+    Data {
+        #[command(subcommand)]
+        action: DataAction,
     },
     /// Pack a glTF scene (.gltf with its files, .glb) or any mesh file into a GLB whose
     /// triangle primitives are progressive streams (docs/GLTF.md: the MESHCODEC_progressive
@@ -375,6 +386,7 @@ fn main() -> ExitCode {
             output,
             drop_attributes,
         } => convert(&input, &output, drop_attributes),
+        Command::Data { action } => data::run(action),
         Command::Pack {
             input,
             output,

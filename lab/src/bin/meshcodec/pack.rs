@@ -3,9 +3,10 @@
 
 use anyhow::{Context, Result};
 use meshcodec::mesh::attribute_quantization::AttributeBits;
-use meshcodec::mesh::io::{resolve, write_atomically};
+use meshcodec::mesh::io::write_atomically;
 use meshcodec::mesh::scene::Scene;
 use meshcodec::packing::{self, Fallback, Outcome, PackOptions};
+use meshcodec_lab::data::resolve;
 use std::path::Path;
 
 /// What `pack` is asked.
