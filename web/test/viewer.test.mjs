@@ -163,6 +163,9 @@ test("a stream with appearance is drawn with its uvs through the checker, a vert
   const state = await page.evaluate(() => window.viewer.state);
   assert.equal(state.status, "done", state.error ?? "");
   assert.ok(state.appearance.includes("uvs"), `appearance: ${state.appearance}`);
+  // emc carries the appearance with its levels: every level drawn had its uvs.
+  assert.ok(state.levelsSeen.length >= 1);
+  assert.deepEqual(state.levelsWithUvs, state.levelsSeen);
   const drawn = await page.evaluate(() => {
     const { geometry, material } = window.viewer.mesh;
     const data = geometry.userData.meshcodec;
