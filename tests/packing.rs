@@ -174,14 +174,10 @@ fn external_streams_and_no_fallback() {
     );
 }
 
-#[test]
-fn primitives_the_codecs_cannot_take_are_kept_and_listed() {
-    let mut scene = Scene::read(&two_mesh_scene(), None).unwrap();
-    // The torus as points.
-    scene.document.meshes[1].primitives[0].mode =
-        gltf_json::validation::Checked::Valid(gltf_json::mesh::Mode::Points);
+/// `scene` edited by hand, written as a GLB and read again.
+fn rewritten(scene: &Scene) -> Scene {
     let glb = meshcodec::packing::assemble::write_glb(
-        &scene,
+        scene,
         &Default::default(),
         &[],
         &[],
@@ -190,7 +186,16 @@ fn primitives_the_codecs_cannot_take_are_kept_and_listed() {
     )
     .unwrap()
     .0;
-    let scene = Scene::read(&glb, None).unwrap();
+    Scene::read(&glb, None).unwrap()
+}
+
+#[test]
+fn primitives_the_codecs_cannot_take_are_kept_and_listed() {
+    let mut scene = Scene::read(&two_mesh_scene(), None).unwrap();
+    // The torus as points.
+    scene.document.meshes[1].primitives[0].mode =
+        gltf_json::validation::Checked::Valid(gltf_json::mesh::Mode::Points);
+    let scene = rewritten(&scene);
     assert!(matches!(&scene.primitives[1].content, Content::Kept(why) if why.contains("Points")));
     let packed = packing::pack(&scene, &PackOptions::new().unwrap(), None).unwrap();
     assert!(matches!(packed.report[0].outcome, Outcome::Packed { .. }));
@@ -213,17 +218,7 @@ fn primitives_the_codecs_cannot_take_are_kept_and_listed() {
         node.mesh = Some(gltf_json::Index::new(0));
     }
     points_only.document.scenes[0].nodes = vec![gltf_json::Index::new(0)];
-    let glb = meshcodec::packing::assemble::write_glb(
-        &points_only,
-        &Default::default(),
-        &[],
-        &[],
-        &[],
-        &meshcodec::packing::assemble::Streams::Embedded,
-    )
-    .unwrap()
-    .0;
-    let points_only = Scene::read(&glb, None).unwrap();
+    let points_only = rewritten(&points_only);
     let packed = packing::pack(&points_only, &PackOptions::new().unwrap(), Some("s.bin")).unwrap();
     assert!(packed.streams.is_none());
     let doc: gltf_json::Root =

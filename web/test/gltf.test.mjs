@@ -8,24 +8,13 @@ import assert from "node:assert/strict";
 import { execFileSync } from "node:child_process";
 import { mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
-import { chromium } from "playwright-core";
 import validator from "gltf-validator";
 
+import { launchChromium } from "../chromium.mjs";
 import { serve } from "../serve.mjs";
 import { assertSameBits, native, nativeLevel, root } from "./native.mjs";
 
 const scratch = join(root, "target/web-test/gltf");
-const CHROMIUM_FLAGS = [
-  "--headless",
-  "--no-sandbox",
-  "--disable-gpu",
-  "--enable-unsafe-swiftshader",
-  "--disable-quic",
-  "--no-first-run",
-  "--disable-background-networking",
-  "--disable-component-update",
-  "--disable-sync",
-];
 
 /** A GLB's JSON and binary chunk. */
 function readGlb(bytes) {
@@ -85,7 +74,7 @@ before(async () => {
   pack("spot", "spot-cut.glb", "--external");
   writeFileSync(join(scratch, "spot-cut.streams.bin"), streams.subarray(0, Math.floor(streams.length * 0.5)));
   server = await serve({ root, rate: 2_000_000 });
-  browser = await chromium.launch({ executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium", args: CHROMIUM_FLAGS });
+  browser = await launchChromium();
 });
 
 after(async () => {

@@ -8,23 +8,12 @@ import assert from "node:assert/strict";
 import { execFileSync } from "node:child_process";
 import { mkdirSync, readFileSync, writeFileSync } from "node:fs";
 import { join } from "node:path";
-import { chromium } from "playwright-core";
 
+import { launchChromium } from "../chromium.mjs";
 import { serve } from "../serve.mjs";
 import { assertSameBits, native, nativeLevel, readPly, root, triangleSet } from "./native.mjs";
 
 const scratch = join(root, "target/web-test");
-const CHROMIUM_FLAGS = [
-  "--headless",
-  "--no-sandbox",
-  "--disable-gpu",
-  "--enable-unsafe-swiftshader",
-  "--disable-quic",
-  "--no-first-run",
-  "--disable-background-networking",
-  "--disable-component-update",
-  "--disable-sync",
-];
 
 let browser;
 let server;
@@ -37,10 +26,7 @@ before(async () => {
   execFileSync(native, ["encode", "--codec", "came", "bunny", join(scratch, "bunny-came-viewer.mc")]);
   // 200 KB a second: bunny's 68 KB arrive over a third of a second, its levels one by one.
   server = await serve({ root, rate: 200_000 });
-  browser = await chromium.launch({
-    executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
-    args: CHROMIUM_FLAGS,
-  });
+  browser = await launchChromium();
 });
 
 after(async () => {
