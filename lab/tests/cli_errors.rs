@@ -590,14 +590,24 @@ fn pm_encodes_a_mesh_that_is_no_manifold_and_info_says_it_was_cut() {
 
 #[test]
 fn a_mesh_name_and_a_resolved_path_work_from_any_working_directory() {
-    // No data folder beside the scratch folder and none in the environment: the name is found
-    // where the binary was built to look, and `resolve`'s path names the file from anywhere.
+    // No data folder beside the scratch folder and none in the environment (nor any lookup
+    // through the folder the binary was built in): the name is found in the per-user cache,
+    // and `resolve`'s path names the file from anywhere.
     let dir = scratch();
     let d = dir.path();
+    let cache = tempfile::tempdir().unwrap();
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/meshes");
+    std::fs::copy(
+        shared.join("bunny-res4.ply"),
+        cache.path().join("bunny-res4.ply"),
+    )
+    .unwrap();
     let out = Command::new(MESHCODEC)
         .args(["encode", "--codec", "raw", "bunny-res4", "named.mc"])
         .current_dir(d)
         .env_remove("MESHCODEC_DATA")
+        .env("MESHCODEC_CACHE", cache.path())
+        .env("MESHCODEC_MIRROR", "http://127.0.0.1:1")
         .output()
         .unwrap();
     assert!(
