@@ -35,7 +35,7 @@ pub fn read_attributed(bytes: &[u8], dir: Option<&Path>) -> Result<AttributedMes
                 .blob
                 .clone()
                 .ok_or_else(|| fault("a buffer refers to a binary chunk the file lacks"))?,
-            gltf::buffer::Source::Uri(uri) => load_uri(uri, dir)?,
+            gltf::buffer::Source::Uri(uri) => crate::mesh::scene::load_uri(uri, dir)?,
         };
         if data.len() < buffer.length() {
             return Err(Error::Truncated(format!(
@@ -158,28 +158,6 @@ fn check_before_the_crate(bytes: &[u8]) -> Result<()> {
         }
     }
     Ok(())
-}
-
-fn load_uri(uri: &str, dir: Option<&Path>) -> Result<Vec<u8>> {
-    if let Some(rest) = uri.strip_prefix("data:") {
-        let (_, data) = rest
-            .split_once(";base64,")
-            .ok_or_else(|| fault("a data URI that is not base64"))?;
-        return base64::engine::general_purpose::STANDARD
-            .decode(data)
-            .map_err(|e| fault(format!("a base64 buffer: {e}")));
-    }
-    let Some(dir) = dir else {
-        return Err(Error::Unsupported(format!(
-            "glTF buffer '{uri}' is a file of its own, and only the glTF's bytes were given"
-        )));
-    };
-    if uri.contains("://") || Path::new(uri).is_absolute() || uri.split('/').any(|p| p == "..") {
-        return Err(Error::Unsupported(format!(
-            "glTF buffer '{uri}' is not a file beside the glTF"
-        )));
-    }
-    Ok(std::fs::read(dir.join(uri))?)
 }
 
 /// The mesh as it is read: positions welded by exact place, faces with their corners'
