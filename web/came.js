@@ -2,14 +2,14 @@
 // views need them (HTTP `Range` requests, or bytes already read), as `meshcodec view` refines
 // it natively. Works in browsers, Web Workers and Node 20:
 //
-//   await init({ module_or_path });                    // the package, once
+//   await init();                                      // the package, once (index.js)
 //   const stream = await CameStream.open("dragon.mc"); // header, index and first unit only
 //   const { mesh, faces, bytesRead } = await stream.refine(camera, { tolerance: 1 });
 //
 // `camera` is {eye, target, up: [x, y, z], fov (vertical, degrees), width, height (pixels)}.
 // Each round adapts to the camera with the units at hand, then fetches the units it asked for
 // (neighbours in the stream in one request) and hands them over, until the front settles.
-import { CameView, cameHeadLength } from "./pkg/meshcodec.js";
+import { CameView, MeshcodecError, cameHeadLength } from "./index.js";
 
 /** Reads byte ranges of `url` with HTTP Range requests: `read(start, end)` → Uint8Array of
  * bytes start … end − 1 (fewer where the stream ends). */
@@ -17,7 +17,7 @@ export function rangeReader(url, fetchOptions = {}) {
   return async (start, end) => {
     const response = await fetch(url, { ...fetchOptions, headers: { ...fetchOptions.headers, Range: `bytes=${start}-${end - 1}` } });
     if (response.status === 416) return new Uint8Array(0);
-    if (!response.ok) throw new Error(`${url}: HTTP ${response.status} ${response.statusText}`);
+    if (!response.ok) throw new MeshcodecError(`${url}: HTTP ${response.status} ${response.statusText}`, "network");
     const bytes = new Uint8Array(await response.arrayBuffer());
     // A server that ignores Range sends the whole stream: take the part asked for.
     return response.status === 206 ? bytes : bytes.subarray(start, end);
@@ -38,21 +38,19 @@ export function concat(a, b) {
   return out;
 }
 
-/** The units wanted ([unit, start, end, …]) in runs, each fetched with one request: units
+/** The units wanted ([{unit, start, end}]) in runs, each fetched with one request: units
  * neighbouring in the stream, or apart by at most `gap` bytes (read and dropped: fewer
- * requests for a few more bytes). [{start, end, units: [[unit, start, end], …]}] */
+ * requests for a few more bytes). [{start, end, units: [{unit, start, end}, …]}] */
 function runs(wanted, gap) {
-  const units = [];
-  for (let i = 0; i < wanted.length; i += 3) units.push([wanted[i], wanted[i + 1], wanted[i + 2]]);
-  units.sort((a, b) => a[1] - b[1]);
+  const units = [...wanted].sort((a, b) => a.start - b.start);
   const out = [];
   for (const unit of units) {
     const last = out[out.length - 1];
-    if (last && unit[1] - last.end <= gap) {
-      last.end = unit[2];
+    if (last && unit.start - last.end <= gap) {
+      last.end = unit.end;
       last.units.push(unit);
     } else {
-      out.push({ start: unit[1], end: unit[2], units: [unit] });
+      out.push({ start: unit.start, end: unit.end, units: [unit] });
     }
   }
   return out;
@@ -140,7 +138,9 @@ export class CameStream {
     while (need === undefined) {
       const more = await read(head.length, head.length * 4);
       requests++;
-      if (more.length === 0) throw new Error(`the stream ends after ${head.length} bytes, inside its header or index`);
+      if (more.length === 0) {
+        throw new MeshcodecError(`truncated: the stream ends after ${head.length} bytes, inside its header or index`, "truncated");
+      }
       head = concat(head, more);
       need = cameHeadLength(head);
     }
@@ -157,21 +157,15 @@ export class CameStream {
    * (without handing them over). Returns {adapted, fetched: Promise of [[unit, bytes], …]}. */
   round(camera, { tolerance = 1, twoSided = false } = {}) {
     const started = performance.now();
-    const adapted = this.view.adapt(camera.eye, camera.target, camera.up ?? [0, 1, 0], camera.fov, camera.width, camera.height, tolerance, twoSided);
+    const { eye, target, up, fov, width, height } = camera;
+    const adapted = this.view.adapt({ eye, target, up, fov, width, height, tolerance, twoSided });
     adapted.ms = performance.now() - started;
     // Units held already (read through a gap before) are not fetched again; the others are
     // fetched in runs, and all are handed back in the order the adaptation asked for them.
     const wanted = this.view.wanted();
-    const missing = [];
-    for (let i = 0; i < wanted.length; i += 3) {
-      if (!this.heldBytes(wanted[i + 1], wanted[i + 2])) missing.push(wanted[i], wanted[i + 1], wanted[i + 2]);
-    }
+    const missing = wanted.filter(({ start, end }) => !this.heldBytes(start, end));
     const fetches = Promise.all(runs(missing, this.gap).map((run) => this.fetchMissing(run.start, run.end)));
-    const fetched = fetches.then(() => {
-      const units = [];
-      for (let i = 0; i < wanted.length; i += 3) units.push([wanted[i], this.heldBytes(wanted[i + 1], wanted[i + 2])]);
-      return units;
-    });
+    const fetched = fetches.then(() => wanted.map(({ unit, start, end }) => [unit, this.heldBytes(start, end)]));
     return { adapted, fetched };
   }
 

@@ -16,7 +16,8 @@
 // alone, each level decoded as soon as its bytes have arrived. `onLevel({ mesh, meshIndex,
 // primitive, level, levels, done })` runs after each level; `onError(error, where)` when a
 // stream cannot be decoded (the primitive keeps the last level it had). `plugin.done` is a
-// Promise of every stream's last level.
+// Promise of every stream's last level. `signal` (an AbortSignal) stops the refinement. Types:
+// gltf-plugin.d.ts.
 import { MeshcodecLoader } from "./loader.js";
 
 export const EXTENSION = "MESHCODEC_progressive";
@@ -25,8 +26,10 @@ export const EXTENSION = "MESHCODEC_progressive";
 let shared = null;
 
 export class MeshcodecGLTFPlugin {
-  constructor(parser, { loader, onLevel, onError } = {}) {
+  constructor(parser, { loader, onLevel, onError, signal } = {}) {
     this.name = EXTENSION;
+    /** Aborting it stops every stream's refinement (each primitive keeps the level it has). */
+    this.signal = signal;
     this.parser = parser;
     this.loader = loader ?? (shared ??= new MeshcodecLoader());
     this.onLevel = onLevel;
@@ -77,12 +80,12 @@ export class MeshcodecGLTFPlugin {
         // In the GLB: the view's bytes, copied (the worker takes them).
         this.parser.getDependency("bufferView", extension.bufferView).then((bytes) => {
           const copy = bytes.slice(0);
-          this.loader.decode({ bytes: copy }, onLoad, undefined, onError, onLevel, [copy], geometry);
+          this.loader.decode({ bytes: copy }, onLoad, undefined, onError, { onLevel, signal: this.signal, transfer: [copy], geometry });
         }, onError);
       } else {
         const url = new URL(buffer.uri, new URL(this.parser.options.path || "./", globalThis.location?.href)).href;
         const start = view.byteOffset ?? 0;
-        this.loader.loadRange(url, start, start + view.byteLength, onLoad, undefined, onError, onLevel, geometry);
+        this.loader.loadRange(url, start, start + view.byteLength, onLoad, undefined, onError, { onLevel, signal: this.signal, geometry });
       }
     });
     this.pending.push(finished);

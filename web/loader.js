@@ -1,13 +1,16 @@
 // MeshcodecLoader: meshcodec streams into three.js, as DRACOLoader brings Draco's. `load` hands
 // over a BufferGeometry at once and refines it in place level by level as the stream arrives,
-// decoded in a Web Worker (worker.js) so that the page never waits on the decoder:
+// decoded in Web Workers (worker.js) so that the page never waits on the decoder:
 //
-//   const loader = new MeshcodecLoader();
-//   loader.load("bunny.mc", (geometry) => {...}, onProgress, onError, (geometry, level) => {...});
+//   const loader = new MeshcodecLoader().setDecoderPath("/meshcodec/").setWorkerLimit(2);
+//   loader.load("bunny.mc", (geometry) => {...}, onProgress, onError, { onLevel, signal });
+//   const geometry = await loader.loadAsync("bunny.mc", onProgress, { onLevel, signal });
 //
-// `onLoad` runs once the last level is in; `onLevel` after each level (geometry.userData.meshcodec
-// holds its figures and its positions in double precision). Errors arrive at `onError` as
-// `Error`s with the library's one-line message.
+// `onLoad` runs once the last level is in; `onLevel(geometry, figures)` after each level
+// (geometry.userData.meshcodec holds its figures and its positions in double precision).
+// Errors arrive at `onError` as MeshcodecErrors with the library's one-line message and a
+// `code`; an aborted load (its `signal` aborted) ends in the signal's reason, as `fetch` does.
+// Types: loader.d.ts.
 //
 // View-dependent `came` streams: with `loader.viewDependent = true`, a `came` stream is not
 // downloaded: its first bytes are read, `onLevel` runs with userData.meshcodec.came set (and
@@ -15,60 +18,133 @@
 // the geometry to a three.js camera, the worker fetching the meta-nodes it needs by Range
 // requests; `onLevel` runs after each adaptation with faces, bytes read and adaptation time.
 import { BufferAttribute, BufferGeometry, Loader } from "three";
+import { MeshcodecError, integerArgument, optionsArgument } from "./index.js";
 
 let nextId = 1;
+
+/** The 5th argument of `load` and the like: an `onLevel` function, or {onLevel, signal}. */
+function loadOptions(value) {
+  if (typeof value === "function") return { onLevel: value };
+  const o = optionsArgument(value, "options", ["onLevel", "signal"]);
+  if (o.onLevel !== undefined && typeof o.onLevel !== "function") {
+    throw new TypeError("onLevel: a function expected");
+  }
+  if (o.signal !== undefined && !(typeof AbortSignal !== "undefined" && o.signal instanceof AbortSignal)) {
+    throw new TypeError("signal: an AbortSignal expected");
+  }
+  return o;
+}
 
 export class MeshcodecLoader extends Loader {
   constructor(manager) {
     super(manager);
-    this.worker = null;
+    /** Where meshcodec_bg.wasm is served from ("" for the package's own, beside worker.js). */
+    this.decoderPath = "";
+    /** At most this many workers decode at once, one stream each. */
+    this.workerLimit = 4;
+    /** The workers started: {worker, tasks}. */
+    this.workers = [];
     this.pending = new Map();
     /** Refine came streams to a camera rather than download them. */
     this.viewDependent = false;
   }
 
-  /** The worker, started on first use. */
-  start() {
-    if (!this.worker) {
-      this.worker = new Worker(new URL("./worker.js", import.meta.url), { type: "module" });
-      this.worker.onmessage = ({ data }) => this.pending.get(data.id)?.(data);
-      this.worker.onerror = (event) => {
-        for (const handle of this.pending.values()) handle({ type: "error", message: event.message });
-      };
-    }
-    return this.worker;
+  /** The folder (a URL, absolute or relative to the page) holding meshcodec_bg.wasm, as
+   * DRACOLoader's; set before the first load. */
+  setDecoderPath(path) {
+    if (typeof path !== "string") throw new TypeError("path: a string expected");
+    this.decoderPath = path;
+    return this;
   }
 
-  /** Streams `url` into a BufferGeometry, returned at once and refined as levels arrive. */
-  load(url, onLoad, onProgress, onError, onLevel) {
+  /** How many workers may decode at once (default 4): a stream is decoded in one worker, and
+   * streams loaded together share them. */
+  setWorkerLimit(limit) {
+    this.workerLimit = integerArgument(limit, "limit", 1, 64);
+    return this;
+  }
+
+  /** A worker for a new task: an idle one, else a new one while under the limit, else the
+   * least busy. */
+  start() {
+    let slot = this.workers.reduce((best, w) => (!best || w.tasks < best.tasks ? w : best), null);
+    if (!slot || (slot.tasks > 0 && this.workers.length < this.workerLimit)) {
+      const worker = new Worker(new URL("./worker.js", import.meta.url), { type: "module" });
+      slot = { worker, tasks: 0 };
+      worker.onmessage = ({ data }) => this.pending.get(data.id)?.handle(data);
+      worker.onerror = (event) => {
+        for (const task of this.pending.values()) {
+          if (task.slot === slot) task.handle({ type: "error", message: event.message, code: "internal" });
+        }
+      };
+      const wasm = this.decoderPath
+        ? new URL("meshcodec_bg.wasm", new URL(this.decoderPath, globalThis.location?.href).href.replace(/\/?$/, "/")).href
+        : undefined;
+      worker.postMessage({ type: "init", wasm });
+      this.workers.push(slot);
+    }
+    return slot;
+  }
+
+  /** Streams `url` into a BufferGeometry, returned at once and refined as levels arrive.
+   * `options`: an `onLevel` function, or {onLevel, signal}. */
+  load(url, onLoad, onProgress, onError, options) {
+    if (typeof url !== "string" && !(url instanceof URL)) throw new TypeError("url: a string or URL expected");
+    const { onLevel, signal } = loadOptions(options);
     const resolved = this.manager.resolveURL(this.path + url);
     const request = { url: new URL(resolved, globalThis.location?.href).href, viewDependent: this.viewDependent };
-    return this.decode(request, onLoad, onProgress, onError, onLevel);
+    return this.decode(request, onLoad, onProgress, onError, { onLevel, signal });
   }
 
   /** The same for bytes already read (an ArrayBuffer, handed over to the worker). */
-  parse(buffer, onLoad, onError, onLevel) {
-    return this.decode({ bytes: buffer }, onLoad, undefined, onError, onLevel, [buffer]);
+  parse(buffer, onLoad, onError, options) {
+    if (!(buffer instanceof ArrayBuffer)) throw new TypeError("buffer: an ArrayBuffer expected");
+    const { onLevel, signal } = loadOptions(options);
+    return this.decode({ bytes: buffer }, onLoad, undefined, onError, { onLevel, signal, transfer: [buffer] });
   }
 
-  /** A Promise of the geometry once its last level is in. */
-  loadAsync(url, onProgress) {
-    return new Promise((resolve, reject) => this.load(url, resolve, onProgress, reject));
+  /** A Promise of the geometry once its last level is in; `options`: {onLevel, signal}. */
+  loadAsync(url, onProgress, options) {
+    return new Promise((resolve, reject) => this.load(url, resolve, onProgress, reject, options));
   }
 
   /** Decodes `request` into `geometry` (a new one unless given: a primitive's own, which
    * every mesh sharing it then shows refined). */
-  decode(request, onLoad, onProgress, onError, onLevel, transfer = [], geometry = new BufferGeometry()) {
+  decode(request, onLoad, onProgress, onError, { onLevel, signal, transfer = [], geometry = new BufferGeometry() } = {}) {
     const id = nextId++;
+    const report = (error) => {
+      if (onError) onError(error);
+      else console.error(error);
+    };
+    if (signal?.aborted) {
+      queueMicrotask(() => report(signal.reason));
+      return geometry;
+    }
+    const slot = this.start();
+    slot.tasks++;
     this.manager.itemStart(id);
     const end = () => {
-      this.pending.delete(id);
+      if (!this.pending.delete(id)) return false;
+      slot.tasks--;
+      signal?.removeEventListener("abort", abort);
       this.manager.itemEnd(id);
+      return true;
     };
-    this.pending.set(id, (message) => {
+    const abort = () => {
+      slot.worker.postMessage({ type: "abort", id });
+      if (end()) {
+        this.manager.itemError(id);
+        report(signal.reason);
+      }
+    };
+    signal?.addEventListener("abort", abort, { once: true });
+    const handle = (message) => {
       switch (message.type) {
         case "progress":
-          onProgress?.({ loaded: message.received, total: message.total, lengthComputable: message.total > 0 });
+          if (onProgress) {
+            const figures = { loaded: message.received, total: message.total, lengthComputable: message.total > 0 };
+            onProgress(typeof ProgressEvent === "function" ? new ProgressEvent("progress", figures) : figures);
+          }
           break;
         case "level":
           setLevel(geometry, message);
@@ -87,16 +163,15 @@ export class MeshcodecLoader extends Loader {
           onLevel?.(geometry, geometry.userData.meshcodec);
           break;
         case "error": {
-          end();
-          const error = new Error(message.message);
+          if (!end()) break;
           this.manager.itemError(id);
-          if (onError) onError(error);
-          else console.error(error);
+          report(new MeshcodecError(message.message, message.code ?? "internal"));
           break;
         }
       }
-    });
-    this.start().postMessage({ ...request, id }, transfer);
+    };
+    this.pending.set(id, { slot, handle });
+    slot.worker.postMessage({ ...request, id }, transfer);
     return geometry;
   }
 
@@ -116,12 +191,14 @@ export class MeshcodecLoader extends Loader {
       : { eye: camera.eye, target: camera.target, up: camera.up ?? [0, 1, 0], fov: camera.fov };
     view.width = Math.max(1, Math.round(width));
     view.height = Math.max(1, Math.round(height));
-    this.start().postMessage({ type: "camera", id: data.id, camera: view, tolerance, twoSided });
+    const task = this.pending.get(data.id);
+    if (!task) throw new MeshcodecError("the view's stream is closed (it failed or was aborted)", "internal");
+    task.slot.worker.postMessage({ type: "camera", id: data.id, camera: view, tolerance, twoSided });
   }
 
   dispose() {
-    this.worker?.terminate();
-    this.worker = null;
+    for (const { worker } of this.workers) worker.terminate();
+    this.workers = [];
     this.pending.clear();
     return this;
   }
@@ -145,9 +222,11 @@ function setView(geometry, view) {
 
 /** Streams the byte range [start, end) of `url` (a stream inside a larger file) into a
  * geometry, as `load` does a whole file. */
-MeshcodecLoader.prototype.loadRange = function (url, start, end, onLoad, onProgress, onError, onLevel, geometry) {
+MeshcodecLoader.prototype.loadRange = function (url, start, end, onLoad, onProgress, onError, { onLevel, signal, geometry } = {}) {
+  integerArgument(start, "start", 0, Number.MAX_SAFE_INTEGER);
+  integerArgument(end, "end", start, Number.MAX_SAFE_INTEGER);
   const resolved = new URL(this.manager.resolveURL(this.path + url), globalThis.location?.href).href;
-  return this.decode({ url: resolved, range: [start, end] }, onLoad, onProgress, onError, onLevel, [], geometry);
+  return this.decode({ url: resolved, range: [start, end] }, onLoad, onProgress, onError, { onLevel, signal, geometry });
 };
 
 /** Puts a decoded level into `geometry`: single-precision positions for drawing (a vertex a

@@ -450,7 +450,10 @@ def info(stream: Bytes) -> Dict[str, Any]:
 
 def load(path: PathLike, drop_attributes: bool = False) -> Mesh:
     """Reads a mesh file (PLY, OBJ, OFF, .m, STL, glTF) with its normals, texture coordinates,
-    colours and materials as :attr:`Mesh.appearance` (None when it has none).
+    colours and materials as :attr:`Mesh.appearance` (None when it has none). A path naming no
+    file is looked up as a test mesh's name (``"bunny"``, ``"spot.obj"``) in ``$MESHCODEC_DATA``,
+    ``../shared/meshes`` and the per-user cache, as the commands do (``meshcodec data fetch``
+    downloads one there).
 
     ``drop_attributes=True`` reads positions and faces only. A file holding appearance its
     reader cannot keep (OFF colours, ``.m`` normals) is refused, naming it, unless dropped.

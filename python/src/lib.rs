@@ -603,7 +603,8 @@ fn about_file(e: meshcodec::Error, path: &std::path::Path) -> PyErr {
 }
 
 /// Reads a mesh file (PLY, OBJ, OFF, .m, STL, glTF) with its appearance; with
-/// `drop_attributes`, positions and faces only.
+/// `drop_attributes`, positions and faces only. A path that names no file is looked up as a
+/// test mesh's name (`bunny`, `spot.obj`) in the data folders, as the commands do.
 #[pyfunction]
 #[pyo3(signature = (path, drop_attributes=false))]
 #[allow(clippy::type_complexity)]
@@ -612,6 +613,11 @@ fn load(
     path: PathBuf,
     drop_attributes: bool,
 ) -> PyResult<(MeshArrays<'_>, Option<Bound<'_, PyDict>>)> {
+    // Not found as a name either: the error names the path as given.
+    let path = match path.is_file() {
+        true => path,
+        false => io::resolve(&path.to_string_lossy()).unwrap_or(path),
+    };
     let read = py
         .detach(|| {
             if drop_attributes {

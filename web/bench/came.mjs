@@ -7,7 +7,7 @@
 // (EYE and TARGET as x,y,z; 50° vertical field of view, 1 px, one-sided.)
 import { fstatSync, openSync, readFileSync, readSync } from "node:fs";
 import { fileURLToPath } from "node:url";
-import init from "../pkg/meshcodec.js";
+import { init } from "../index.js";
 import { CameStream } from "../came.js";
 
 const [stream, eye, target, size = "1280x720", gap = "1024"] = process.argv.slice(2);
@@ -15,7 +15,7 @@ if (!target) {
   console.error("usage: node web/bench/came.mjs STREAM.mc EYE TARGET [WIDTHxHEIGHT] [GAP]");
   process.exit(2);
 }
-await init({ module_or_path: readFileSync(fileURLToPath(new URL("../pkg/meshcodec_bg.wasm", import.meta.url))) });
+await init();
 const file = openSync(stream, "r");
 const length = fstatSync(file).size;
 const read = async (start, end) => {

@@ -5,25 +5,52 @@
 //! `bash web/build.sh` writes `web/pkg/meshcodec.js` (an ES module: `await init({module_or_path})`,
 //! then the functions), its `.wasm` and TypeScript types; Node 20 and browsers load the same
 //! files. Errors are JavaScript `Error`s carrying the library's one-line message
-//! (docs/CONTRACT.md §7); a corrupt or cut stream ends in one, never in a trap.
+//! (docs/CONTRACT.md §7) and a `code`; a corrupt or cut stream ends in one, never in a trap.
+//!
+//! These are the raw bindings: web/index.js is the package's API over them (options objects,
+//! every argument validated, `MeshcodecError`), with its TypeScript declarations in
+//! web/index.d.ts.
 
 use glam::DVec3;
-use js_sys::{Array, Float64Array, Object, Reflect, Uint32Array};
+use js_sys::{Array, Float32Array, Float64Array, Object, Reflect, Uint32Array};
 use meshcodec::codecs::came::refine::{head_length, Budget, Camera, Fetch, View, ViewMesh};
 use meshcodec::codecs::{self, LevelMesh, Progressive, Stop};
 use meshcodec::container::Header;
 use meshcodec::mesh::attributes::Attributes;
 use wasm_bindgen::prelude::*;
 
-/// A library error as a JavaScript `Error` with its one-line message.
-fn to_js(e: meshcodec::Error) -> JsError {
-    JsError::new(&e.to_string().replace(['\n', '\t'], " "))
+/// What every binding returns: its value, or a JavaScript `Error` with a `code`.
+type JsResult<T> = Result<T, JsValue>;
+
+/// A JavaScript `Error` named `MeshcodecError` with its one-line `message` and a `code` saying
+/// what kind of fault it is (`corrupt`, `truncated`, `unsupported`, `limit`, `invalid-mesh`,
+/// `io`, `internal`): what the package's `MeshcodecError` carries (web/index.js).
+fn error(code: &str, message: &str) -> JsValue {
+    let e = js_sys::Error::new(&message.replace(['\n', '\t'], " "));
+    e.set_name("MeshcodecError");
+    // Setting a property on a fresh Error cannot fail.
+    let _ = Reflect::set(&e, &JsValue::from_str("code"), &JsValue::from_str(code));
+    e.into()
 }
 
-fn set(object: &Object, key: &str, value: impl Into<JsValue>) -> Result<(), JsError> {
+/// A library error as a JavaScript one, its code from the library's kind of error.
+fn to_js(e: meshcodec::Error) -> JsValue {
+    use meshcodec::Error as E;
+    let code = match &e {
+        E::Malformed { .. } => "corrupt",
+        E::Truncated(_) => "truncated",
+        E::Unsupported(_) => "unsupported",
+        E::Limit(_) => "limit",
+        E::InvalidMesh(_) => "invalid-mesh",
+        E::Io(_) => "io",
+    };
+    error(code, &e.to_string())
+}
+
+fn set(object: &Object, key: &str, value: impl Into<JsValue>) -> JsResult<()> {
     Reflect::set(object, &JsValue::from_str(key), &value.into())
         .map(|_| ())
-        .map_err(|_| JsError::new(&format!("cannot set {key}")))
+        .map_err(|_| error("internal", &format!("cannot set {key}")))
 }
 
 /// A level's appearance as Hoppe's wedges, the library's own values: `corners` (Uint32Array, the
@@ -31,7 +58,7 @@ fn set(object: &Object, key: &str, value: impl Into<JsValue>) -> Result<(), JsEr
 /// and where the stream carries them `normals` (Float64Array, x, y, z a wedge), `uvs` (u, v a
 /// wedge), `colours` (r, g, b, a in [0, 1] a wedge), `materials` ({`face`: Uint32Array of each
 /// face's material, `names`: an Array of strings}).
-fn appearance_object(a: &Attributes) -> Result<Object, JsError> {
+fn appearance_object(a: &Attributes) -> JsResult<Object> {
     let object = Object::new();
     let corners: Vec<u32> = a.corners.iter().flatten().copied().collect();
     set(&object, "corners", Uint32Array::from(corners.as_slice()))?;
@@ -65,7 +92,22 @@ fn appearance_object(a: &Attributes) -> Result<Object, JsError> {
     Ok(object)
 }
 
-/// A decoded level as a plain object: `positions` (Float64Array of x, y, z), `indices`
+/// Positions as x, y, z: a Float64Array (the library's own values), or a Float32Array (for GPU
+/// upload, rounded once here).
+fn positions_array(positions: &[DVec3], float32: bool) -> JsValue {
+    if float32 {
+        let flat: Vec<f32> = positions
+            .iter()
+            .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
+            .collect();
+        Float32Array::from(flat.as_slice()).into()
+    } else {
+        let flat: Vec<f64> = positions.iter().flat_map(|p| [p.x, p.y, p.z]).collect();
+        Float64Array::from(flat.as_slice()).into()
+    }
+}
+
+/// A decoded level as a plain object: `positions` (Float64Array of x, y, z, or Float32Array), `indices`
 /// (Uint32Array of triangle corners), `level`, `levels`, `codec`, `vertices`, `triangles`,
 /// `meshVertices` (of the full mesh), and `appearance` where the level carries normals, uvs,
 /// colours or materials ([`appearance_object`]; `null` otherwise).
@@ -74,20 +116,15 @@ fn level_object(
     level: usize,
     levels: usize,
     header: &Header,
-) -> Result<Object, JsError> {
+    float32: bool,
+) -> JsResult<Object> {
     let codec = codecs::by_id(header.codec_id).map_err(to_js)?.name();
-    let positions: Vec<f64> = mesh
-        .mesh
-        .positions
-        .iter()
-        .flat_map(|p| [p.x, p.y, p.z])
-        .collect();
     let indices: Vec<u32> = mesh.mesh.faces.iter().flatten().copied().collect();
     let object = Object::new();
     set(
         &object,
         "positions",
-        Float64Array::from(positions.as_slice()),
+        positions_array(&mesh.mesh.positions, float32),
     )?;
     set(&object, "indices", Uint32Array::from(indices.as_slice()))?;
     set(&object, "level", level as u32)?;
@@ -105,27 +142,33 @@ fn level_object(
 }
 
 /// Decodes a stream, or the levels a prefix of it holds: every level, or the first `level`
-/// levels, of the first `nbytes` bytes (all when absent).
+/// levels, of the first `nbytes` bytes (all when absent); positions as a Float32Array when
+/// `float32`. Arguments are taken as they come: web/index.js's `decode` validates them.
 #[wasm_bindgen]
-pub fn decode(bytes: &[u8], level: Option<u32>, nbytes: Option<u32>) -> Result<Object, JsError> {
+pub fn decode(
+    bytes: &[u8],
+    level: Option<u32>,
+    nbytes: Option<u32>,
+    float32: Option<bool>,
+) -> JsResult<Object> {
     let prefix = &bytes[..nbytes.map_or(bytes.len(), |n| (n as usize).min(bytes.len()))];
     let stop = level.map_or(Stop::All, |l| Stop::Levels(l as usize));
     let mut decoder = codecs::open(prefix).map_err(to_js)?;
     let levels = decoder.levels();
     let (mesh, decoded) = codecs::decode_with(decoder.as_mut(), stop).map_err(to_js)?;
     if mesh.mesh.positions.is_empty() {
-        return Err(JsError::new(&format!(
-            "the first {} bytes hold no complete level",
-            prefix.len()
-        )));
+        return Err(error(
+            "truncated",
+            &format!("the first {} bytes hold no complete level", prefix.len()),
+        ));
     }
     let header = decoder.header().clone();
-    level_object(&mesh, decoded, levels, &header)
+    level_object(&mesh, decoded, levels, &header, float32.unwrap_or(false))
 }
 
 /// The byte each level of a stream ends at, from a prefix holding its header and index.
 #[wasm_bindgen(js_name = levelEnds)]
-pub fn level_ends(bytes: &[u8]) -> Result<Vec<f64>, JsError> {
+pub fn level_ends(bytes: &[u8]) -> JsResult<Vec<f64>> {
     Ok(codecs::level_ends(bytes)
         .map_err(to_js)?
         .into_iter()
@@ -139,14 +182,14 @@ pub fn level_ends(bytes: &[u8]) -> Result<Vec<f64>, JsError> {
 /// `units` with each one's byte range, `appearance` or null, `vertexCopies`, `normalCones`): the
 /// keys of `meshcodec info --json` and of the Python package's `info`, in camelCase.
 #[wasm_bindgen]
-pub fn info(bytes: &[u8]) -> Result<JsValue, JsError> {
+pub fn info(bytes: &[u8]) -> JsResult<JsValue> {
     let info = codecs::StreamInfo::of(bytes).map_err(to_js)?;
-    let value = serde_json::to_value(&info).map_err(|e| JsError::new(&e.to_string()))?;
+    let value = serde_json::to_value(&info).map_err(|e| error("internal", &e.to_string()))?;
     js_value(&value)
 }
 
 /// A JSON value as a JavaScript one, its objects' keys in camelCase.
-fn js_value(value: &serde_json::Value) -> Result<JsValue, JsError> {
+fn js_value(value: &serde_json::Value) -> JsResult<JsValue> {
     use serde_json::Value;
     Ok(match value {
         Value::Null => JsValue::NULL,
@@ -194,42 +237,41 @@ fn camel_case(key: &str) -> String {
 #[wasm_bindgen]
 pub struct ProgressiveDecoder {
     inner: Progressive,
-}
-
-impl Default for ProgressiveDecoder {
-    fn default() -> Self {
-        ProgressiveDecoder::new()
-    }
+    float32: bool,
 }
 
 #[wasm_bindgen]
 impl ProgressiveDecoder {
-    /// A decoder with no bytes yet.
+    /// A decoder with no bytes yet; its levels' positions as a Float32Array when `float32`.
     #[wasm_bindgen(constructor)]
-    pub fn new() -> ProgressiveDecoder {
+    pub fn new(float32: Option<bool>) -> ProgressiveDecoder {
         ProgressiveDecoder {
             inner: Progressive::new(),
+            float32: float32.unwrap_or(false),
         }
     }
 
     /// Takes the next chunk; returns the newest level now complete (a level object as
     /// `decode` returns), or `undefined` when the chunk completed none. Levels completed by
     /// the same chunk are handed over as one, the newest.
-    pub fn push(&mut self, chunk: &[u8]) -> Result<JsValue, JsError> {
+    pub fn push(&mut self, chunk: &[u8]) -> JsResult<JsValue> {
         let Some((mesh, level)) = self.inner.push(chunk).map_err(to_js)? else {
             return Ok(JsValue::UNDEFINED);
         };
         if mesh.mesh.positions.is_empty() {
-            return Err(JsError::new(&format!(
-                "the first {} bytes hold no complete level",
-                self.inner.received()
-            )));
+            return Err(error(
+                "truncated",
+                &format!(
+                    "the first {} bytes hold no complete level",
+                    self.inner.received()
+                ),
+            ));
         }
         let header = self
             .inner
             .header()
-            .ok_or_else(|| JsError::new("a level before the header"))?;
-        Ok(level_object(&mesh, level, self.inner.levels(), header)?.into())
+            .ok_or_else(|| error("internal", "a level before the header"))?;
+        Ok(level_object(&mesh, level, self.inner.levels(), header, self.float32)?.into())
     }
 
     /// Bytes taken so far.
@@ -270,14 +312,17 @@ pub struct CameView {
 /// How many of a `came` stream's first bytes `new CameView` needs (header, index, first unit),
 /// or `undefined` while `prefix` is too short to say (fetch a longer one).
 #[wasm_bindgen(js_name = cameHeadLength)]
-pub fn came_head_length(prefix: &[u8]) -> Result<Option<f64>, JsError> {
+pub fn came_head_length(prefix: &[u8]) -> JsResult<Option<f64>> {
     Ok(head_length(prefix).map_err(to_js)?.map(|n| n as f64))
 }
 
-fn vector(v: &[f64], name: &str) -> Result<DVec3, JsError> {
+fn vector(v: &[f64], name: &str) -> JsResult<DVec3> {
     match v {
         [x, y, z] => Ok(DVec3::new(*x, *y, *z)),
-        _ => Err(JsError::new(&format!("{name}: three numbers expected"))),
+        _ => Err(error(
+            "invalid-argument",
+            &format!("{name}: three numbers expected"),
+        )),
     }
 }
 
@@ -285,7 +330,7 @@ fn vector(v: &[f64], name: &str) -> Result<DVec3, JsError> {
 impl CameView {
     /// The front at the root, from the stream's first `cameHeadLength(…)` bytes (or more).
     #[wasm_bindgen(constructor)]
-    pub fn new(head: &[u8]) -> Result<CameView, JsError> {
+    pub fn new(head: &[u8]) -> JsResult<CameView> {
         let mesh = ViewMesh::open(head.to_vec(), Fetch::External).map_err(to_js)?;
         Ok(CameView { mesh })
     }
@@ -305,7 +350,7 @@ impl CameView {
         height: u32,
         tolerance: f64,
         two_sided: bool,
-    ) -> Result<Object, JsError> {
+    ) -> JsResult<Object> {
         let camera = Camera {
             eye: vector(eye, "eye")?,
             target: vector(target, "target")?,
@@ -343,24 +388,20 @@ impl CameView {
     /// Hands over unit `unit`'s bytes, as `wanted` asked: decoded now, taken in at the next
     /// `adapt` (refused there, its branch left coarse, if cut or corrupt). An `Error` if the
     /// unit was not asked for or was supplied already.
-    pub fn supply(&mut self, unit: u32, bytes: &[u8]) -> Result<(), JsError> {
+    pub fn supply(&mut self, unit: u32, bytes: &[u8]) -> JsResult<()> {
         self.mesh.supply(unit as usize, bytes).map_err(to_js)
     }
 
-    /// The adapted mesh: `{positions: Float64Array, indices: Uint32Array, vertices, triangles}`.
-    pub fn mesh(&self) -> Result<Object, JsError> {
+    /// The adapted mesh: `{positions: Float64Array (Float32Array when `float32`), indices:
+    /// Uint32Array, vertices, triangles}`.
+    pub fn mesh(&self, float32: Option<bool>) -> JsResult<Object> {
         let mesh = self.mesh.mesh();
-        let positions: Vec<f64> = mesh
-            .positions
-            .iter()
-            .flat_map(|p| [p.x, p.y, p.z])
-            .collect();
         let indices: Vec<u32> = mesh.faces.iter().flatten().copied().collect();
         let object = Object::new();
         set(
             &object,
             "positions",
-            Float64Array::from(positions.as_slice()),
+            positions_array(&mesh.positions, float32.unwrap_or(false)),
         )?;
         set(&object, "indices", Uint32Array::from(indices.as_slice()))?;
         set(&object, "vertices", mesh.positions.len() as f64)?;
@@ -370,7 +411,7 @@ impl CameView {
 
     /// What has been fetched: `{bytesRead, streamBytes, unitsLoaded, unitsRefused, units}`
     /// (bytes read: the first bytes and every unit supplied).
-    pub fn fetched(&self) -> Result<Object, JsError> {
+    pub fn fetched(&self) -> JsResult<Object> {
         let f = self.mesh.fetched();
         let object = Object::new();
         set(&object, "bytesRead", f.bytes_read as f64)?;

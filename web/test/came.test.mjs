@@ -8,11 +8,11 @@ import { execFileSync } from "node:child_process";
 import { mkdirSync, readFileSync } from "node:fs";
 import { join } from "node:path";
 
-import init from "../pkg/meshcodec.js";
+import { init } from "../index.js";
 import { CameStream, bytesReader } from "../came.js";
 import { assertSameBits, native, readPly, root, triangleSet } from "./native.mjs";
 
-await init({ module_or_path: readFileSync(join(root, "web/pkg/meshcodec_bg.wasm")) });
+await init();
 
 const scratch = join(root, "target/web-test");
 const bunny = join(scratch, "bunny-came.mc");
