@@ -4,7 +4,7 @@
 //! iteration adapts to the other view until the front settles and back, the same splits and
 //! collapses every time, so that the cost of an operation is measured apart from the machine's
 //! caches between frames and from meta-node fetches (the fly-through's figures include both:
-//! BENCHMARKS.md, "The fly-through's front timed alone").
+//! docs/notes/benchmarks-history.md, "The fly-through's front timed alone").
 //! Run: cargo bench --bench came_view
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};

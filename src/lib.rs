@@ -54,3 +54,8 @@ mod prefetch;
 pub mod metrics;
 
 pub use error::{Error, Result};
+
+/// The README's Rust quick start, compiled and run by `cargo test --doc` as written there.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeQuickStart;

@@ -1,7 +1,7 @@
 //! How many meta-nodes, and how many of a hierarchy's splits, the far, middle and near views of
 //! the came-vd table touch under other layouts of the same hierarchy: meta-nodes of L levels
 //! (the stream's 8, or 4), meta-nodes rooted at given depths before those of 8 levels, or of as
-//! many levels as keep a unit within S splits (BENCHMARKS.md, "What a meta-node costs"), units
+//! many levels as keep a unit within S splits (docs/notes/benchmarks-history.md, "What a meta-node costs"), units
 //! by depth band (a unit rooted at depth d holds its subtree's splits at depths d + K …
 //! d + K + B − 1), or units by error band (the same with each node's deviation step in place of
 //! its depth).

@@ -39,7 +39,7 @@
 //!   results/ at 12 bits, `pm` interpolated on log–log axes, as paper-tables/emc-vs-anchors.md
 //!   does) by those ratios: what the order would make of `emc-ahead`.
 //!
-//! BENCHMARKS.md ("An adaptive depth, probed") has the figures.
+//! docs/notes/benchmarks-history.md ("An adaptive depth, probed") has the figures.
 //! Run: cargo run --release --example emc_adaptive_probe -- [mesh…]
 //! (results/emc/adaptive-probe.md is its output for bunny dragon-50k armadillo-43k.)
 

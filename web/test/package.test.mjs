@@ -10,7 +10,7 @@ import { tmpdir } from "node:os";
 import { join } from "node:path";
 
 import { CameView, MeshcodecError, ProgressiveDecoder, decode, info, init } from "../index.js";
-import { root } from "./native.mjs";
+import { native, root } from "./native.mjs";
 
 const web = join(root, "web");
 const golden = join(root, "tests/golden/v8/emc-eight.mc");
@@ -100,7 +100,7 @@ test("CameView.adapt takes one camera object and checks every field", async () =
   view.free();
 });
 
-test("npm pack makes a package a scratch project installs and imports, in JavaScript and TypeScript", () => {
+test("npm pack makes a package a scratch project installs and imports, in JavaScript (the README's quick start) and TypeScript", () => {
   const scratch = mkdtempSync(join(tmpdir(), "meshcodec-npm-"));
   try {
     const packed = JSON.parse(execFileSync("npm", ["pack", "--json", "--pack-destination", scratch], { cwd: web }).toString())[0];
@@ -130,6 +130,16 @@ console.log(JSON.stringify({ codec: info(bytes).codec, level: mesh.level, vertic
     const said = JSON.parse(execFileSync("node", ["main.mjs", golden], { cwd: project }).toString());
     const ours = decode(bytes, { level: 3 });
     assert.deepEqual(said, { codec: "emc", level: 3, vertices: ours.vertices, float32: true });
+
+    // The README's JavaScript quick start, as written, on the stream its command-line quick
+    // start writes.
+    const readme = readFileSync(join(root, "README.md"), "utf8");
+    const quickStart = /\n### JavaScript\n[\s\S]*?```js\n([\s\S]*?)```/.exec(readme)[1];
+    writeFileSync(join(project, "readme.mjs"), quickStart);
+    execFileSync(native, ["encode", "bunny", join(project, "bunny.mc")]);
+    const printed = execFileSync("node", ["readme.mjs"], { cwd: project }).toString().trim().split(" ").map(Number);
+    const bunny = new Uint8Array(readFileSync(join(project, "bunny.mc")));
+    assert.deepEqual(printed, [info(bunny).levels, decode(bunny, { level: 6 }).vertices, decode(bunny).triangles]);
 
     // TypeScript resolves the package's types through its exports.
     writeFileSync(

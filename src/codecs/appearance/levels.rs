@@ -383,7 +383,7 @@ impl PartsPlan {
 /// Births are coded in the levels that hold at most this share of the vertices, sketched in
 /// the later ones (see [`PartsPlan`]). On spot.obj at 12 bits, 5% → 25% (levels 1–3 → 1–4)
 /// costs 3.3% more and lowers the uv error of levels 5–8 from 65–69 to 26–32 texels; 60%
-/// (1–5) 6.4% more again for 9–12 texels (BENCHMARKS.md, "Appearance with the levels").
+/// (1–5) 6.4% more again for 9–12 texels (docs/notes/benchmarks-history.md, "Appearance with the levels").
 pub const BIRTH_SHARE: f64 = 0.25;
 
 /// A born uv is coded to this many bits below its neighbours' spread ([`PartsPlan`]): on

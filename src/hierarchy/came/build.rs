@@ -41,7 +41,7 @@ impl BuildOptions {
     /// By quadric error alone (b = 0), which `came` builds from syntax 7: the pairs contract in a
     /// simplifier's order, so the front a far view keeps is a simplified mesh, flat regions
     /// merged and curved ones kept, and holds fewer faces for the same error (dragon-50k from
-    /// 20 diagonals: 972 → 700 faces, from 11.8% → 7.3% of its stream; BENCHMARKS.md, "`came`
+    /// 20 diagonals: 972 → 700 faces, from 11.8% → 7.3% of its stream; docs/notes/benchmarks-history.md, "`came`
     /// syntax 7"). The tree is 2–10 levels deeper and the streams within ±2.5% of the paper's.
     pub const QUADRIC_ORDER: BuildOptions = BuildOptions {
         balance: 0.0,

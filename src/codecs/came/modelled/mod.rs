@@ -136,7 +136,7 @@ pub fn encode_with_unit_fields(mesh: &CanonicalMesh) -> Result<(Encoded, UnitFie
 /// four, a unit holding the rest of its subtree when that is at most 256 splits. On the tree
 /// built by quadric error alone (syntax 7), regions of six, five, four, three and two read
 /// dragon-50k's far view in 7.3%, 7.1%, 5.8%, 6.1% and 6.3% of its stream, and the streams
-/// shrink with the regions down to three (BENCHMARKS.md, "`came` syntax 8: regions of four
+/// shrink with the regions down to three (docs/notes/benchmarks-history.md, "`came` syntax 8: regions of four
 /// levels").
 pub const SHAPE: Shape = Shape::Bands {
     region: 4,
@@ -149,7 +149,7 @@ pub const SHAPE: Shape = Shape::Bands {
 /// is at most 64 splits, so that a view of part of a large mesh reads small units. Units cost
 /// about 21 bytes each in contexts starting afresh, index entries and flushes, which a small
 /// mesh's stream feels (bunny.ply would take 30.51 → 32.81 bits a triangle in syntax 8) and a
-/// large mesh's views repay (BENCHMARKS.md, "`came` syntax 9").
+/// large mesh's views repay (docs/notes/benchmarks-history.md, "`came` syntax 9").
 pub const SHAPE_LARGE: Shape = Shape::Bands {
     region: 3,
     band: 1,
@@ -170,7 +170,7 @@ pub fn shape_for(mesh: &CanonicalMesh) -> Shape {
 }
 
 /// The bands of syntaxes 5 to 7: two levels over regions of six (chosen on the balanced tree
-/// of syntaxes 5 and 6: BENCHMARKS.md, "`came` syntax 5: units by depth band").
+/// of syntaxes 5 and 6: docs/notes/benchmarks-history.md, "`came` syntax 5: units by depth band").
 const SHAPE_BEFORE_8: Shape = Shape::Bands {
     region: 6,
     band: 2,

@@ -16,7 +16,7 @@
 //! cell or two (coarse levels, clusters) the prediction is better than σ² says; where they lie
 //! many cells away (the finest levels) it is worse. On bunny.ply this lowers the RMS error of
 //! levels 4–11, by 1.13–1.46× at levels 4–9 and 1.01–1.05× at levels 10–11 (`cargo run
-//! --release --example emc_placement`; BENCHMARKS.md, "Intermediate levels").
+//! --release --example emc_placement`; docs/notes/benchmarks-history.md, "Intermediate levels").
 
 use super::walk::{estimate, Walker};
 // The same exponential on every platform (the `libm` crate's, not the C library's, whose last

@@ -96,7 +96,7 @@ fn owns(slab: Option<(&[u8], u8)>, first_id: usize, next_id: usize, v: usize) ->
 
 /// Panics unless `v` is in the lanes and, in debug builds and the crate's tests, unless `owns`
 /// it: the check before every raw access. The ownership check costs `emc`'s decoder about 5%
-/// (BENCHMARKS.md, "Slab ownership"), so a release build leaves it to the argument in
+/// (docs/notes/benchmarks-history.md, "Slab ownership"), so a release build leaves it to the argument in
 /// [`Lanes`]'s docs, which the tests that feed hostile slab streams exercise with it on.
 #[inline(always)]
 pub(super) fn check(lanes: &Lanes, v: usize, owns: impl FnOnce() -> bool) {
