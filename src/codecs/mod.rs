@@ -503,10 +503,6 @@ pub fn open_owned(bytes: Vec<u8>) -> Result<Box<dyn LevelDecoder>> {
 
 fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
     let appearance = reader.header().appearance.clone().filter(|a| !a.in_levels);
-    // Kept apart from the reader, which the codec's decoder takes.
-    let unit = reader
-        .appearance_unit()
-        .map(|(bytes, number, start)| (bytes.to_vec(), number, start));
     let codec = for_header(reader.header())?;
     let in_levels = reader
         .header()
@@ -545,10 +541,17 @@ fn open_reader(reader: StreamReader<'_>) -> Result<Box<dyn LevelDecoder + '_>> {
             inner, parts, spec,
         )));
     }
-    let inner = codec.decoder(reader)?;
     Ok(match appearance {
-        Some(spec) => Box::new(appearance::decoder::WithAppearance::new(inner, spec, unit)),
-        None => inner,
+        Some(spec) => {
+            // A second view of the stream for the appearance unit, the codec's decoder taking
+            // the reader.
+            let stream = reader.clone();
+            let inner = codec.decoder(reader)?;
+            Box::new(appearance::decoder::WithAppearance::new(
+                inner, spec, stream,
+            ))
+        }
+        None => codec.decoder(reader)?,
     })
 }
 

@@ -221,11 +221,21 @@ pub trait LevelSource {
     fn header(&self) -> &Header;
     /// The next complete level, or `None` when no complete level follows (end or cut).
     fn next_owned_level(&mut self) -> Result<Option<OwnedLevel>>;
+    /// Takes the stream's next bytes as they arrive, so that the levels they complete can be
+    /// read next; `Ok(false)` from a source that cannot (it reads its own input).
+    fn extend(&mut self, _more: &[u8]) -> Result<bool> {
+        Ok(false)
+    }
 }
 
 impl LevelSource for StreamReader<'_> {
     fn header(&self) -> &Header {
         StreamReader::header(self)
+    }
+
+    fn extend(&mut self, more: &[u8]) -> Result<bool> {
+        StreamReader::extend(self, more)?;
+        Ok(true)
     }
 
     fn next_owned_level(&mut self) -> Result<Option<OwnedLevel>> {

@@ -231,9 +231,8 @@ fn camel_case(key: &str) -> String {
 }
 
 /// A decoder fed a stream's bytes as they arrive (the chunks of `fetch()`'s `ReadableStream`):
-/// each `push` returns the newest level its bytes completed, if any. `emc`, `emc-paper` and
-/// `raw` streams decode each level once, going on from the last; the others are decoded again
-/// from their first level for each level handed over (`incremental` says which).
+/// each `push` returns the newest level its bytes completed, if any. Every codec's stream is
+/// decoded once, each level going on from the last (`incremental` says so).
 #[wasm_bindgen]
 pub struct ProgressiveDecoder {
     inner: Progressive,

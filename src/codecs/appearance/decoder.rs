@@ -1,7 +1,7 @@
 //! A codec's level decoder with the appearance unit decoded after its last level.
 
 use crate::codecs::{LevelDecoder, LevelMesh, PartialLevels, PassStops};
-use crate::container::{AppearanceSpec, Header};
+use crate::container::{AppearanceSpec, Header, StreamReader};
 use crate::error::Result;
 use crate::mesh::attributes::Attributes;
 
@@ -10,23 +10,23 @@ use crate::mesh::attributes::Attributes;
 pub struct WithAppearance<'a> {
     inner: Box<dyn LevelDecoder + 'a>,
     spec: AppearanceSpec,
-    /// The unit's bytes when wholly present, its number and first byte.
-    unit: Option<(Vec<u8>, usize, usize)>,
+    /// The stream beside the codec's decoder (which took its own reader), growing with it as
+    /// bytes arrive: the appearance unit is read from it once wholly present.
+    stream: StreamReader<'a>,
     decoded: Option<Attributes>,
 }
 
 impl<'a> WithAppearance<'a> {
-    /// Wraps `inner`, whose stream declares `spec` and holds the appearance unit `unit` (its
-    /// bytes, number and offset) when it is wholly present.
+    /// Wraps `inner`, whose stream `stream` declares `spec` and holds the appearance unit.
     pub fn new(
         inner: Box<dyn LevelDecoder + 'a>,
         spec: AppearanceSpec,
-        unit: Option<(Vec<u8>, usize, usize)>,
+        stream: StreamReader<'a>,
     ) -> Self {
         WithAppearance {
             inner,
             spec,
-            unit,
+            stream,
             decoded: None,
         }
     }
@@ -45,9 +45,9 @@ impl LevelDecoder for WithAppearance<'_> {
     fn advance(&mut self) -> Result<bool> {
         let advanced = self.inner.advance()?;
         if advanced && self.inner.levels_decoded() == self.inner.levels() {
-            if let Some((bytes, unit, start)) = &self.unit {
+            if let Some((bytes, unit, start)) = self.stream.appearance_unit() {
                 let full = self.inner.mesh()?;
-                self.decoded = Some(super::decode(bytes, *unit, *start, &self.spec, &full.mesh)?);
+                self.decoded = Some(super::decode(bytes, unit, start, &self.spec, &full.mesh)?);
             }
         }
         Ok(advanced)
@@ -62,5 +62,14 @@ impl LevelDecoder for WithAppearance<'_> {
     }
     fn partial_levels(&mut self) -> Option<&mut dyn PartialLevels> {
         self.inner.partial_levels()
+    }
+    /// The codec's decoder takes the bytes, and the stream beside it keeps them for the
+    /// appearance unit; the full level (whose end is the unit's: `level_ends`) decodes it.
+    fn extend(&mut self, more: &[u8]) -> Result<bool> {
+        if !self.inner.extend(more)? {
+            return Ok(false);
+        }
+        self.stream.extend(more)?;
+        Ok(true)
     }
 }

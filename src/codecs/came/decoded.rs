@@ -856,4 +856,24 @@ impl<U: UnitDecoder + Send> LevelDecoder for CameDecoder<'_, U> {
             attributes: None,
         })
     }
+
+    /// The next bytes join the stream's: the units they complete decode at the next
+    /// `advance`, into the tree as it stands (a new depth band's units go on from the last).
+    /// A detached decoder, given each unit's bytes, holds no stream to extend.
+    fn extend(&mut self, more: &[u8]) -> Result<bool> {
+        if self.bytes.is_empty() {
+            return Ok(false);
+        }
+        let end = self.payload_start as u64 + self.index.payload_bytes;
+        let len = (self.bytes.len() + more.len()) as u64;
+        if len > end {
+            return Err(Error::malformed(
+                self.index.len(),
+                end as usize,
+                format!("{} bytes after the last unit", len - end),
+            ));
+        }
+        self.bytes.to_mut().extend_from_slice(more);
+        Ok(true)
+    }
 }

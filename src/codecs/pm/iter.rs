@@ -365,6 +365,16 @@ impl<'a> PMeshIter<'a> {
         Ok(true)
     }
 
+    /// Takes the stream's next bytes as they arrive, for an iterator over bytes it holds: the
+    /// levels they complete are read by the next [`PMeshIter::next_level`]. `Ok(false)` where its
+    /// source cannot take them (an input stream, records in memory).
+    pub(crate) fn extend(&mut self, more: &[u8]) -> Result<bool> {
+        match self.reader.as_mut() {
+            Some(reader) => reader.source.extend(more),
+            None => Ok(false),
+        }
+    }
+
     /// Undoes the last vertex split; `false` at M⁰.
     pub fn prev(&mut self) -> bool {
         if self.applied == 0 {

@@ -897,4 +897,17 @@ impl LevelDecoder for PmDecoder<'_> {
             .map(|i| i.level_mesh())
             .unwrap_or_default())
     }
+
+    /// The next bytes go to the stream, or to the iterator once it has taken the stream: the
+    /// splits of the levels they complete are applied to the mesh as it stands.
+    fn extend(&mut self, more: &[u8]) -> Result<bool> {
+        match (self.iter.as_mut(), self.stream.as_mut()) {
+            (Some(iter), _) => iter.extend(more),
+            (None, Some(stream)) => {
+                stream.extend(more)?;
+                Ok(true)
+            }
+            (None, None) => Ok(false),
+        }
+    }
 }
