@@ -48,7 +48,9 @@ mod writer;
 
 pub use header::{AppearanceSpec, Header, MaterialNames};
 pub use index::{Index, PartialIndex, UnitEntry};
-pub use reader::{LevelPayload, LevelSource, OwnedLevel, ReadLevels, StreamReader};
+pub use reader::{
+    check_stream_length, LevelPayload, LevelSource, OwnedLevel, ReadLevels, StreamReader,
+};
 pub use writer::{LevelCost, LevelRecord, StreamWriter};
 
 /// A varint count at `pos`, no larger than `limit`.

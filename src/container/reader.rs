@@ -49,18 +49,7 @@ impl<'a> StreamReader<'a> {
 
     /// Refuses a stream of `len` bytes that runs past the payload's end.
     fn check_length(&self, len: usize) -> Result<()> {
-        let present = (len - self.payload_start) as u64;
-        if present > self.index.payload_bytes {
-            return Err(Error::malformed(
-                self.index.len(),
-                self.payload_start + self.index.payload_bytes as usize,
-                format!(
-                    "{} bytes after the last unit",
-                    present - self.index.payload_bytes
-                ),
-            ));
-        }
-        Ok(())
+        check_stream_length(&self.index, self.payload_start, len)
     }
 
     /// Its header, index, payload offset and bytes.
@@ -180,6 +169,24 @@ impl StreamReader<'_> {
         self.bytes.to_mut().extend_from_slice(more);
         Ok(())
     }
+}
+
+/// Refuses a stream of `len` bytes, its payload starting at `payload_start`, that runs past the
+/// end of the payload `index` lists: for decoders that hold the stream's bytes apart from a
+/// [`StreamReader`] and take more as they arrive.
+pub fn check_stream_length(index: &Index, payload_start: usize, len: usize) -> Result<()> {
+    let present = (len - payload_start) as u64;
+    if present > index.payload_bytes {
+        return Err(Error::malformed(
+            index.len(),
+            payload_start + index.payload_bytes as usize,
+            format!(
+                "{} bytes after the last unit",
+                present - index.payload_bytes
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A level's payload read from any source.

@@ -76,8 +76,9 @@ test("streams the decoder refuses end in MeshcodecErrors with their codes", asyn
 
 test("CameView.adapt takes one camera object and checks every field", async () => {
   await init();
-  const view = new CameView(readFileSync(join(root, "tests/golden/v8/came-beethoven.mc")));
-  const { origin, cell, quantBits } = info(readFileSync(join(root, "tests/golden/v8/came-beethoven.mc")));
+  const came = readFileSync(join(root, "tests/golden/v8/came-beethoven.mc"));
+  const view = new CameView(came);
+  const { origin, cell, quantBits } = info(came);
   const centre = origin.map((o, k) => o + (cell[k] * (1 << quantBits)) / 2);
   const camera = { eye: [centre[0], centre[1], centre[2] + 3 * cell[2] * (1 << quantBits)], target: { x: centre[0], y: centre[1], z: centre[2] }, fov: 45, width: 640, height: 480 };
   const adapted = view.adapt(camera);

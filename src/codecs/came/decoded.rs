@@ -864,15 +864,11 @@ impl<U: UnitDecoder + Send> LevelDecoder for CameDecoder<'_, U> {
         if self.bytes.is_empty() {
             return Ok(false);
         }
-        let end = self.payload_start as u64 + self.index.payload_bytes;
-        let len = (self.bytes.len() + more.len()) as u64;
-        if len > end {
-            return Err(Error::malformed(
-                self.index.len(),
-                end as usize,
-                format!("{} bytes after the last unit", len - end),
-            ));
-        }
+        crate::container::check_stream_length(
+            &self.index,
+            self.payload_start,
+            self.bytes.len() + more.len(),
+        )?;
         self.bytes.to_mut().extend_from_slice(more);
         Ok(true)
     }
